@@ -1,0 +1,32 @@
+/*
+ * co_hb.h - heartbeat producer (0x1017) and boot-up message.
+ */
+#ifndef CO_HB_H
+#define CO_HB_H
+
+#include "co_common.h"
+#include "co_od.h"
+
+typedef struct co_node co_node_t;
+
+typedef struct co_hb {
+    uint16_t period_ms; /* 0x1017 as last applied; 0 = off */
+    bool restart;       /* period changed: next heartbeat one period from now */
+    uint32_t next;      /* time of the next heartbeat */
+} co_hb_t;
+
+/* Re-read 0x1017 and restart the period (call after a write or a reset). */
+void co_hb_reconfig(co_node_t *node);
+
+/* Send the boot-up message (0x700 + node-ID, one byte 0x00). */
+void co_hb_bootup(co_node_t *node);
+
+uint32_t co_hb_poll(co_node_t *node, uint32_t now);
+
+/*
+ * Standard write hook for 0x1017: stores the value and restarts the period.
+ * Products with extra rules (the DST's "1..19 not accepted") validate first.
+ */
+co_res_t co_hb_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+
+#endif /* CO_HB_H */

@@ -1,0 +1,72 @@
+/*
+ * co_incl.h - CiA 410 inclinometer profile logic.
+ *
+ * Objects: 0x6000 resolution (units of 0.001 deg per LSB), and per axis
+ * (X/longitudinal = axis 0 at 0x6010.., Y/lateral = axis 1 at 0x6020..):
+ * slope (computed), operating parameter (bit0 invert, bit1 scaling),
+ * preset, offset (= preset - measured at the preset instant) and
+ * differential offset. Angles enter as millidegrees through the filter.
+ *
+ *   m     = measured angle / resolution, rounded half away from zero
+ *   slope = s*m + offset + differential offset   (scaling on)
+ *         = s*m                                  (scaling off)
+ *   with s = -1 when the invert bit is set; clamped to INTEGER16.
+ */
+#ifndef CO_INCL_H
+#define CO_INCL_H
+
+#include "co_common.h"
+#include "co_filter.h"
+
+#define CO_INCL_OP_INVERT 0x01u
+#define CO_INCL_OP_SCALING 0x02u
+
+/* Stored parameters; products embed this in their PARA struct. */
+typedef struct co_incl_para {
+    uint16_t resolution;
+    uint8_t op[2];
+    int16_t preset[2];
+    int16_t offset[2];
+    int16_t diff[2];
+} co_incl_para_t;
+
+typedef struct co_incl {
+    co_incl_para_t *p;
+    uint8_t axes;        /* 1 (single axis) or 2 */
+    bool wrap;           /* single-axis full turn: angle in [-180, 180) */
+    bool fault;          /* sensor element error: outputs hold */
+    int32_t limit_mdeg;  /* output stops here, error beyond it; 0: none */
+    uint8_t shift;       /* active filter shift */
+    bool beyond[2];      /* measured angle strictly beyond the limit */
+    int32_t angle[2];    /* filtered, saturated angle (mdeg) */
+    int32_t unwrapped;   /* wrap mode: continuous input fed to the filter */
+    co_filter_t f[2];
+} co_incl_t;
+
+/* p is owned by the caller and must outlive incl. */
+void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limit_mdeg, bool wrap);
+
+/* Feed one sensor sample (mdeg per axis; unused axes ignored). */
+void co_incl_sample(co_incl_t *incl, const int32_t mdeg[2]);
+
+/* The slope object (0x6010 axis 0, 0x6020 axis 1) in resolution units. */
+int16_t co_incl_slope(const co_incl_t *incl, unsigned axis);
+
+/* Any axis beyond its limit. */
+bool co_incl_beyond(const co_incl_t *incl);
+
+/*
+ * Write the resolution (0x6000). Refused with CO_E_STATE unless the scaling
+ * bit is set on every axis the device has (0x6011 and 0x6021). A changed
+ * value clears every preset, offset and differential offset. The set of
+ * allowed values is the product's to check before calling.
+ */
+co_res_t co_incl_set_resolution(co_incl_t *incl, uint16_t res);
+
+/* Write the preset (0x6012/0x6022): offset = preset - s*m now. */
+void co_incl_set_preset(co_incl_t *incl, unsigned axis, int16_t preset);
+
+/* Round a / b to nearest, halves away from zero (b > 0). */
+int32_t co_div_round(int32_t a, int32_t b);
+
+#endif /* CO_INCL_H */

@@ -1,0 +1,123 @@
+/*
+ * co_node.h - the node object: one CANopen slave, all of its state.
+ *
+ * Typical main loop (see boards/linux/main.c):
+ *     co_node_init(&node, &cfg, port, app, ram);
+ *     co_node_start(&node, now());
+ *     for (;;) {
+ *         wait for a frame or for the delay co_node_poll() returned;
+ *         co_node_poll(&node, now());          // stamps node->now
+ *         while (frame received) co_node_receive(&node, &frame);
+ *     }
+ * Not reentrant for one node; separate nodes are independent. Never call
+ * from an interrupt: a receive interrupt queues frames, the loop feeds them.
+ */
+#ifndef CO_NODE_H
+#define CO_NODE_H
+
+#include "co_common.h"
+#include "co_emcy.h"
+#include "co_hb.h"
+#include "co_led.h"
+#include "co_nmt.h"
+#include "co_od.h"
+#include "co_sdo.h"
+#include "co_store.h"
+#include "co_sync.h"
+#include "co_tpdo.h"
+
+/* State of the CAN controller as the board reports it. */
+typedef enum co_can_state {
+    CO_CAN_ACTIVE = 0,
+    CO_CAN_WARNING,  /* an error counter reached the warning limit (96) */
+    CO_CAN_PASSIVE,
+    CO_CAN_BUSOFF,
+} co_can_state_t;
+
+/* Stored node-ID and bit rate: the RAM struct of class LSS. */
+typedef struct co_lss_para {
+    uint8_t node_id;
+    uint8_t bitrate; /* product's code */
+} co_lss_para_t;
+
+/* Product hooks; every one is optional (NULL). */
+typedef struct co_node_ops {
+    /* After the stack reloaded parameters for a reset; before boot-up. */
+    void (*reset)(co_node_t *node, co_reset_t kind);
+    /* After every NMT state change, boot-up included (old = INIT). */
+    void (*state)(co_node_t *node, co_nmt_state_t old_state);
+    /* After 0x1010 "save" or 0x1011 "load" succeeded. */
+    void (*stored)(co_node_t *node, uint32_t signature);
+    /* Product work; returns the delay until it next needs to run. */
+    uint32_t (*poll)(co_node_t *node, uint32_t now);
+    /* LED patterns; when NULL the CiA 303-3 mapping of co_node_leds() holds. */
+    void (*leds)(co_node_t *node, co_led_pattern_t *green, co_led_pattern_t *red);
+} co_node_ops_t;
+
+/* What a product type is; const, shared by every node of that product. */
+typedef struct co_node_cfg {
+    const co_od_t *od;
+    const co_node_ops_t *ops;
+    const co_led_timing_t *led;
+    uint16_t ram_size[CO_CLS_COUNT]; /* sizeof each class struct (0: none) */
+    uint8_t default_node_id;
+    uint8_t default_bitrate;    /* product's code for its default bit rate */
+    uint8_t tpdo_dlc;           /* 0: DLC = mapped bytes; 8: pad with zeros */
+    uint32_t store_write_limit; /* 0: unlimited */
+} co_node_cfg_t;
+
+struct co_node {
+    const co_node_cfg_t *cfg;
+    void *port;                 /* board context for co_port_* */
+    void *app;                  /* product context for its hooks */
+    void *ram[CO_CLS_COUNT];    /* the class structs, owned by the caller */
+    uint32_t nvm_base;          /* where this node's records start in NVM */
+    uint32_t now;               /* time of the latest co_node_poll() */
+    uint8_t node_id;            /* active node-ID */
+    uint8_t can_state;          /* co_can_state_t */
+    bool autostart;             /* set by the reset op: go operational after boot-up */
+    bool pdo_msb_first;         /* PDO values big-endian (DST 0x5001 = 0) */
+    uint32_t tx_dropped;        /* frames the board could not queue */
+    co_nmt_t nmt;
+    co_sdo_t sdo;
+    co_hb_t hb;
+    co_sync_t sync;
+    co_store_t store;
+    co_tpdo_t tpdo[CO_TPDO_MAX];
+};
+
+/*
+ * Prepare a node; nothing is sent. cfg, port, app and the ram structs are
+ * owned by the caller and must outlive the node. ram has CO_CLS_COUNT
+ * entries (NULL where cfg->ram_size is 0).
+ */
+void co_node_init(co_node_t *node, const co_node_cfg_t *cfg, void *port, void *app,
+                  void *const ram[CO_CLS_COUNT], uint32_t nvm_base);
+
+/* Power-on: reset node (load the store, boot-up, pre-operational). */
+void co_node_start(co_node_t *node, uint32_t now);
+
+/* Reset node or communication now (what the NMT commands do). */
+void co_node_reset(co_node_t *node, co_reset_t kind);
+
+/* One received frame. */
+void co_node_receive(co_node_t *node, const co_frame_t *f);
+
+/* Run timers; returns the delay (us) until the next call is needed. */
+uint32_t co_node_poll(co_node_t *node, uint32_t now);
+
+/* Send through the port, counting frames the board could not queue. */
+bool co_node_send(co_node_t *node, const co_frame_t *f);
+
+/* The board's view of the CAN controller (LEDs, diagnostics). */
+void co_node_set_can_state(co_node_t *node, co_can_state_t s);
+
+/*
+ * LED levels at time now; *next_us receives the delay until either changes.
+ */
+void co_node_leds(co_node_t *node, uint32_t now, bool *green, bool *red, uint32_t *next_us);
+
+/* Convenience: look up an entry in the node's dictionary (NULL if absent). */
+const co_od_entry_t *co_node_entry(const co_node_t *node, uint16_t index, uint8_t sub);
+
+#endif /* CO_NODE_H */

@@ -1,0 +1,149 @@
+/*
+ * co_od.h - the object dictionary.
+ *
+ * A product's dictionary is a const table of co_od_entry_t sorted by
+ * (index, sub-index); it lives in flash. Values live in RAM structs that the
+ * product owns, one struct per storage class (co_cls_t). An entry names its
+ * class and the byte offset of its value in that struct, so the same const
+ * table serves any number of nodes: each node carries its own struct
+ * pointers (co_node_t.ram).
+ *
+ * An entry without RAM (CO_CLS_NONE) is a constant: its value is .def, or
+ * the bytes at .cdata for strings, unless a read hook computes it.
+ *
+ * Every function returns a co_res_t whose value is the SDO abort code.
+ */
+#ifndef CO_OD_H
+#define CO_OD_H
+
+#include "co_common.h"
+
+typedef struct co_node co_node_t;
+typedef struct co_od_entry co_od_entry_t;
+
+/* CiA 301 data type indices (as used in EDS files). */
+typedef enum co_type {
+    CO_T_BOOL = 0x01,
+    CO_T_I8 = 0x02,
+    CO_T_I16 = 0x03,
+    CO_T_I32 = 0x04,
+    CO_T_U8 = 0x05,
+    CO_T_U16 = 0x06,
+    CO_T_U32 = 0x07,
+    CO_T_VSTR = 0x09,
+} co_type_t;
+
+/* Attribute bits of an entry. */
+enum {
+    CO_A_R = 0x01,      /* readable */
+    CO_A_W = 0x02,      /* writable */
+    CO_A_RW = 0x03,
+    CO_A_CONST = 0x04,  /* never changes (EDS "const"); combine with CO_A_R */
+    CO_A_PDO = 0x08,    /* may be mapped into a TPDO */
+    CO_A_NODEID = 0x10, /* a COB-ID whose default follows the node-ID (below) */
+};
+
+/* Storage classes: which RAM struct holds the value, and what stores it. */
+typedef enum co_cls {
+    CO_CLS_NONE = 0, /* no RAM: constant or computed by a read hook */
+    CO_CLS_VOL = 1,  /* RAM only, back to its default at every reset */
+    CO_CLS_PARA = 2, /* stored by 0x1010 "save", restored by 0x1011 "load" */
+    CO_CLS_LSS = 3,  /* node-ID / bit rate: stored by the product itself */
+    CO_CLS_COUNT = 4,
+} co_cls_t;
+
+/*
+ * Write hook: called instead of the plain store after access, length and
+ * range checks passed. It may validate further, act, and call co_od_store()
+ * to keep the value. Read hook: computes the value of a numeric entry.
+ */
+typedef co_res_t (*co_od_write_fn)(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+typedef co_res_t (*co_od_read_fn)(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
+
+struct co_od_entry {
+    uint16_t index;
+    uint8_t sub;
+    uint8_t type;     /* co_type_t */
+    uint8_t attr;     /* CO_A_* */
+    uint8_t cls;      /* co_cls_t */
+    uint16_t size;    /* bytes: 1, 2 or 4 for numbers, string length */
+    uint16_t off;     /* offset of the value in the class's RAM struct */
+    uint32_t def;     /* default / constant value (numbers) */
+    int32_t min, max; /* inclusive limits, checked when min != max */
+    co_od_write_fn write;
+    co_od_read_fn read;
+    const void *cdata; /* constant bytes (strings) */
+    const char *name;  /* the manual's name, for people and EDS files */
+};
+
+/* A product's dictionary: the table and its length. */
+typedef struct co_od {
+    const co_od_entry_t *entries;
+    uint16_t count;
+} co_od_t;
+
+/*
+ * COB-IDs that follow the node-ID (CO_A_NODEID): the RAM value holds the
+ * base (e.g. 0x80 for EMCY) while the CAN-ID part equals the base of the
+ * default, and the node-ID is added on every read. A master writing
+ * "base + current node-ID" is stored as the base again, so a saved default
+ * COB-ID follows a later node-ID change (CiA 301 behaviour).
+ */
+uint32_t co_cobid_resolve(uint32_t raw, uint32_t def, uint8_t node_id);
+
+/*
+ * Find (index, sub). Returns the entry, or NULL with *res set to
+ * CO_E_NO_OBJ (no such index) or CO_E_NO_SUB (index exists, sub does not).
+ * Binary search: O(log n). res may be NULL.
+ */
+const co_od_entry_t *co_od_find(const co_od_t *od, uint16_t index, uint8_t sub, co_res_t *res);
+
+/*
+ * Read a numeric entry's value (zero- or sign-extended to 32 bits) the way
+ * the bus sees it, read hook and node-ID resolution included. Does not
+ * check read access (the stack's own reads use it too).
+ */
+co_res_t co_od_get(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
+
+/*
+ * Copy up to cap bytes of the entry's value, starting at byte offset 'at',
+ * into buf (little-endian). *len receives the number of bytes copied.
+ * Checks read access. Used by the SDO server for all sizes.
+ */
+co_res_t co_od_read(co_node_t *node, const co_od_entry_t *e, uint32_t at, uint8_t *buf,
+                    uint32_t cap, uint32_t *len);
+
+/*
+ * Write len bytes (little-endian) to the entry as an SDO download does:
+ * checks write access, length (too high / too low), limits, then calls the
+ * write hook or stores the value.
+ */
+co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len);
+
+/* Plain store of a numeric value into the entry's RAM (no checks, no hook). */
+co_res_t co_od_store(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+
+/* Set every entry of class cls whose index is in [lo, hi] to its default. */
+void co_od_defaults(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi);
+
+/* Size in bytes of an entry's value as seen on the bus. */
+static inline uint32_t co_od_size(const co_od_entry_t *e)
+{
+    return e->size;
+}
+
+/*
+ * Table-building helpers for od/ files: one entry a line, designated
+ * initializers, the manual's names.
+ */
+#define CO_TYPE_U8 .type = CO_T_U8, .size = 1
+#define CO_TYPE_U16 .type = CO_T_U16, .size = 2
+#define CO_TYPE_U32 .type = CO_T_U32, .size = 4
+#define CO_TYPE_I8 .type = CO_T_I8, .size = 1
+#define CO_TYPE_I16 .type = CO_T_I16, .size = 2
+#define CO_TYPE_I32 .type = CO_T_I32, .size = 4
+#define CO_TYPE_STR(s) .type = CO_T_VSTR, .size = (uint16_t)(sizeof(s) - 1u), .cdata = (s)
+/* Value stored in field f of RAM struct T of class c. */
+#define CO_AT(c, T, f) .cls = (c), .off = (uint16_t)offsetof(T, f)
+
+#endif /* CO_OD_H */

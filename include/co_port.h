@@ -1,0 +1,32 @@
+/*
+ * co_port.h - what a board must provide to the stack.
+ *
+ * Every function takes the board context the node was created with
+ * (co_node_t.port); the stack never interprets it. There are no weak
+ * defaults: a board that misses one of these fails to link.
+ * None of these is called from interrupt context by the stack; the stack
+ * itself runs in the board's main loop.
+ */
+#ifndef CO_PORT_H
+#define CO_PORT_H
+
+#include "co_common.h"
+
+/*
+ * Queue one frame for transmission. Must not block.
+ * Returns true when the frame was queued, false when the transmit queue is
+ * full (the frame is lost; the stack counts it and goes on).
+ */
+bool co_port_can_send(void *port, const co_frame_t *frame);
+
+/*
+ * EEPROM emulation: byte-addressed non-volatile memory of co_port_nvm_size()
+ * bytes. A read of never-written memory returns 0xFF. Reads and writes are
+ * synchronous; a write returns only when the bytes are durable.
+ * Both return false on a hardware failure (nothing is retried).
+ */
+uint32_t co_port_nvm_size(void *port);
+bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len);
+bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len);
+
+#endif /* CO_PORT_H */

@@ -1,0 +1,85 @@
+/*
+ * co_store.h - the parameter store: 0x1010 "save", 0x1011 "load", and the
+ * non-volatile image in the board's EEPROM emulation (co_port_nvm_*).
+ *
+ * Each stored class (PARA, LSS) has two slots. A record is
+ *   header { magic, layout hash, sequence, write count, length, flags }
+ *   data   (the class's RAM struct, byte for byte)
+ *   CRC-32 over header and data.
+ * A save writes the slot that does not hold the newest valid record, with
+ * sequence + 1, so a power cut at any point of a save leaves the previous
+ * complete record valid. A restore first verifies both slots (reading from
+ * NVM only), and only then copies the newest valid one into RAM; live
+ * values are never touched by unverified data.
+ * The layout hash is computed from the dictionary (index, sub-index, size
+ * and offset of every entry of the class), so a firmware whose layout
+ * differs treats an old image as invalid instead of misreading it.
+ */
+#ifndef CO_STORE_H
+#define CO_STORE_H
+
+#include "co_common.h"
+#include "co_od.h"
+
+/* Bytes of one slot in NVM; a class's RAM struct must fit with the header. */
+#define CO_STORE_SLOT 128u
+#define CO_STORE_HDR 24u
+#define CO_STORE_MAX_DATA (CO_STORE_SLOT - CO_STORE_HDR - 4u)
+/* NVM bytes one node needs (2 classes x 2 slots). */
+#define CO_STORE_NVM_SIZE (4u * CO_STORE_SLOT)
+
+/* "save" and "load" signatures (CiA 301). */
+#define CO_SIG_SAVE 0x65766173u
+#define CO_SIG_LOAD 0x64616F6Cu
+
+typedef enum co_store_status {
+    CO_STORE_OK = 0,       /* a valid record was applied */
+    CO_STORE_BLANK,        /* nothing ever stored: defaults */
+    CO_STORE_DEFAULTS,     /* "load" was requested: defaults */
+    CO_STORE_CORRUPT,      /* records exist but none is valid: defaults */
+    CO_STORE_HW,           /* NVM read failed: defaults */
+} co_store_status_t;
+
+typedef struct co_store {
+    uint32_t writes;       /* save cycles so far (from the newest record) */
+    uint8_t status[CO_CLS_COUNT]; /* co_store_status_t of the last restore */
+} co_store_t;
+
+/* Scan the NVM for the write count. Call once before the first restore. */
+void co_store_init(co_node_t *node);
+
+/*
+ * Restore the entries of class cls with index in [lo, hi] from the newest
+ * valid record, or set them to their defaults; [0, 0xFFFF] restores the
+ * whole struct (the LSS struct has no dictionary entries of its own).
+ * Returns and remembers why.
+ */
+co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi);
+
+/*
+ * Save the RAM struct of class cls. Returns CO_OK, CO_E_STORE when the
+ * write-cycle limit is reached, CO_E_HW when the NVM write failed.
+ */
+co_res_t co_store_save(co_node_t *node, co_cls_t cls);
+
+/* Make the next restore of cls use defaults (0x1011 "load"). */
+co_res_t co_store_request_defaults(co_node_t *node, co_cls_t cls);
+
+/* Write-cycle limit reached: further saves are refused. */
+bool co_store_limit_reached(const co_node_t *node);
+
+/* Layout hash of class cls in the node's dictionary. */
+uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls);
+
+/* CRC-32 (IEEE 802.3, reflected, init and xor 0xFFFFFFFF), chainable. */
+uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len);
+
+/*
+ * Write hooks for 0x1010 sub 1 and 0x1011 sub 1. "save" stores PARA;
+ * "load" requests defaults for PARA and LSS at the next reset. Wrong
+ * signature: CO_E_STORE. Both call the node's on_store op afterwards.
+ */
+co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_store_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+
+#endif /* CO_STORE_H */

@@ -1,0 +1,22 @@
+/*
+ * co_sync.h - SYNC consumer (CiA 301 7.2.5). The COB-ID is 0x1005 when the
+ * dictionary has it, 0x080 otherwise.
+ */
+#ifndef CO_SYNC_H
+#define CO_SYNC_H
+
+#include "co_common.h"
+
+typedef struct co_node co_node_t;
+
+typedef struct co_sync {
+    uint16_t cob_id;
+    uint32_t count; /* SYNCs received in operational, for diagnostics */
+} co_sync_t;
+
+void co_sync_reconfig(co_node_t *node);
+
+/* Returns true if f was a SYNC; drives the synchronous TPDOs. */
+bool co_sync_receive(co_node_t *node, const co_frame_t *f);
+
+#endif /* CO_SYNC_H */

@@ -1,0 +1,240 @@
+/*
+ * dst.c - behaviour shared by the Danfoss DST inclinometers.
+ *
+ * Decisions where the manual is silent or contradicts itself follow
+ * ../shared/specs/danfoss-dst-x730.md section 5 (C-n below), CiA 301/410
+ * otherwise.
+ */
+#include "dst.h"
+
+#include <string.h>
+
+static dst_dev_t *dev_of(co_node_t *n)
+{
+    return n->app;
+}
+
+/* ---- dictionary hooks ---------------------------------------------- */
+
+co_res_t dst_write_hb(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    if (v >= 1u && v <= 19u) {
+        return CO_E_VAL; /* manual: "From 1 - 19 NOT ACCEPTED" */
+    }
+    return co_hb_write_hook(n, e, v);
+}
+
+co_res_t dst_write_emcy_cobid(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    /* CiA 301: bits 30..29 must be 0 (no RTR, 11-bit); an 11-bit CAN-ID. */
+    if ((v & 0x7FFFF800u) != 0u || (v & 0x7FFu) == 0u) {
+        return CO_E_VAL;
+    }
+    return co_od_store(n, e, v);
+}
+
+co_res_t dst_write_tx_type(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    /* 1..240 every n-th SYNC, 254 event timer. 252, 253, 255 are "not
+     * implemented" per the manual; 0 and 241..251 are not listed (C-18). */
+    if (!((v >= 1u && v <= 240u) || v == 254u)) {
+        return CO_E_VAL;
+    }
+    return co_tpdo_write_hook(n, e, v);
+}
+
+co_res_t dst_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    if (v >= 1u && v <= 3u) {
+        return CO_E_VAL; /* 0 = inactive, 4..65535 ms (C-17) */
+    }
+    return co_tpdo_write_hook(n, e, v);
+}
+
+/* Node-ID / bit rate: a value is committed when both copies agree; the
+ * committed pair is written to EEPROM at once (no "save" needed, B-44) and
+ * becomes active at the next reset. */
+static co_res_t commit_pair(co_node_t *n, uint8_t *copies, unsigned which, uint8_t v,
+                            uint8_t *committed)
+{
+    copies[which] = v;
+    if (copies[0] != copies[1] || copies[0] == *committed) {
+        return CO_OK;
+    }
+    uint8_t old = *committed;
+    *committed = v;
+    co_res_t r = co_store_save(n, CO_CLS_LSS);
+    if (r != CO_OK) {
+        *committed = old;
+    }
+    return r;
+}
+
+co_res_t dst_write_id(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    dst_dev_t *d = dev_of(n);
+    return commit_pair(n, d->vol.id, e->index == 0x20F0u ? 0u : 1u, (uint8_t)v, &d->lss.node_id);
+}
+
+co_res_t dst_write_bitrate(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    dst_dev_t *d = dev_of(n);
+    return commit_pair(n, d->vol.br, e->index == 0x20F2u ? 0u : 1u, (uint8_t)v, &d->lss.bitrate);
+}
+
+co_res_t dst_write_coding(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    co_res_t r = co_od_store(n, e, v);
+    n->pdo_msb_first = dev_of(n)->para.pdo_coding == 0u;
+    return r;
+}
+
+co_res_t dst_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    (void)e;
+    if (v != 10u && v != 50u && v != 100u && v != 500u && v != 1000u) {
+        return CO_E_VAL;
+    }
+    return co_incl_set_resolution(&dev_of(n)->incl, (uint16_t)v);
+}
+
+co_res_t dst_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    /* Immediate (manual L1018): the output equals the preset from now on. */
+    unsigned axis = e->index == 0x6012u ? 0u : 1u;
+    co_incl_set_preset(&dev_of(n)->incl, axis, (int16_t)v);
+    return CO_OK;
+}
+
+co_res_t dst_read_errors(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
+{
+    (void)e;
+    *v = dev_of(n)->errors;
+    return CO_OK;
+}
+
+co_res_t dst_read_slope(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
+{
+    unsigned axis = e->index == 0x6010u ? 0u : 1u;
+    *v = (uint32_t)(int32_t)co_incl_slope(&dev_of(n)->incl, axis);
+    return CO_OK;
+}
+
+/* ---- node ops ------------------------------------------------------ */
+
+static void apply_filter(dst_dev_t *d)
+{
+    d->filter_active = d->para.filter;
+    d->incl.shift = co_filter_shift(d->filter_active);
+}
+
+static void dst_reset(co_node_t *n, co_reset_t kind)
+{
+    dst_dev_t *d = dev_of(n);
+    (void)kind;
+    /* Both copies read the active values after a reset (B-46). */
+    d->vol.id[0] = d->vol.id[1] = n->node_id;
+    d->vol.br[0] = d->vol.br[1] = d->lss.bitrate;
+    n->pdo_msb_first = d->para.pdo_coding == 0u;
+    n->autostart = d->para.autostart == 1u; /* B-11: after any reset */
+    apply_filter(d);
+    /* Errors are re-evaluated and re-reported after every boot-up. */
+    d->reported = 0;
+}
+
+static void dst_stored(co_node_t *n, uint32_t sig)
+{
+    /* The filter setting takes effect on "save" (manual L488). */
+    if (sig == CO_SIG_SAVE) {
+        apply_filter(dev_of(n));
+    }
+}
+
+static uint8_t current_errors(dst_dev_t *d)
+{
+    co_node_t *n = &d->node;
+    uint8_t e = 0;
+    if (d->sensor_fault || co_incl_beyond(&d->incl)) {
+        e |= DST_ERR_SENSOR;
+    }
+    if (co_store_limit_reached(n)) {
+        e |= DST_ERR_FLASH;
+    }
+    /* The manual has one bit for stored-data checksums ("LSS parameter
+     * checksum error"); a corrupt PARA set is reported with it too rather
+     * than not at all. Defaults are in use until the next good save. */
+    if (n->store.status[CO_CLS_LSS] == CO_STORE_CORRUPT ||
+        n->store.status[CO_CLS_PARA] == CO_STORE_CORRUPT ||
+        n->store.status[CO_CLS_LSS] == CO_STORE_HW || n->store.status[CO_CLS_PARA] == CO_STORE_HW) {
+        e |= DST_ERR_CHECKSUM;
+    }
+    return e;
+}
+
+static uint32_t dst_poll(co_node_t *n, uint32_t now)
+{
+    (void)now;
+    dst_dev_t *d = dev_of(n);
+    d->errors = current_errors(d);
+    if (d->errors == d->reported) {
+        return CO_NEVER;
+    }
+    /* EMCY layout from the manual's table (C-6): code, 0x1001 (always 0,
+     * C-14), 0x00, 0x4001, 0, 0, 0. Error reset: all zero (B-27). */
+    uint8_t msef[5] = {0x00, d->errors, 0, 0, 0};
+    uint16_t code = d->errors != 0u ? CO_EMCY_GENERIC : CO_EMCY_NO_ERROR;
+    if (n->nmt.state != CO_NMT_PREOP && n->nmt.state != CO_NMT_OPERATIONAL) {
+        return CO_NEVER; /* no EMCY in stopped: reported when it is allowed again */
+    }
+    (void)co_emcy_send(n, code, 0x00, msef); /* may be disabled by 0x1014 bit 31 */
+    bool new_error = d->reported == 0u && d->errors != 0u;
+    d->reported = d->errors;
+    if (new_error) {
+        /* 0x4000: 0 pre-operational, 2 stopped, anything else no change (C-42). */
+        if (d->para.err_behaviour == 0u && n->nmt.state == CO_NMT_OPERATIONAL) {
+            co_nmt_enter(n, CO_NMT_PREOP);
+        } else if (d->para.err_behaviour == 2u) {
+            co_nmt_enter(n, CO_NMT_STOPPED);
+        }
+    }
+    return CO_NEVER;
+}
+
+static void dst_leds(co_node_t *n, co_led_pattern_t *g, co_led_pattern_t *r)
+{
+    /* "Limit angles reached": red and green both on (manual L539). */
+    if (co_incl_beyond(&dev_of(n)->incl)) {
+        *g = CO_LED_ON;
+        *r = CO_LED_ON;
+    }
+}
+
+const co_node_ops_t dst_ops = {
+    .reset = dst_reset,
+    .stored = dst_stored,
+    .poll = dst_poll,
+    .leds = dst_leds,
+};
+
+/* Green blinks 200/200 ms; "single flash" is 500 ms on / 500 ms off (C-38). */
+const co_led_timing_t dst_led = {.flicker_ms = 50, .blink_ms = 200, .flash_ms = 500, .pause_ms = 500};
+
+void dst_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
+{
+    dst_dev_t *d = mem;
+    const dst_variant_t *v = p->variant;
+    memset(d, 0, sizeof(*d));
+    d->v = v;
+    co_incl_init(&d->incl, &d->para.incl, v->axes, v->limit_mdeg, v->wrap);
+    void *const ram[CO_CLS_COUNT] = {NULL, &d->vol, &d->para, &d->lss};
+    co_node_init(&d->node, v->cfg, ports[0], d, ram, 0);
+    nodes[0] = &d->node;
+}
+
+void dst_sample(void *mem, const int32_t values[], bool fault)
+{
+    dst_dev_t *d = mem;
+    d->sensor_fault = fault;
+    d->incl.fault = fault;
+    co_incl_sample(&d->incl, values);
+}

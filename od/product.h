@@ -1,0 +1,51 @@
+/*
+ * product.h - what a product is, for the boards: an ID, a description, the
+ * simulated inputs, and how to build its nodes in caller-supplied memory.
+ * The products' dictionaries and behaviour live beside this file, one
+ * table per product family, written to be read next to the manual.
+ */
+#ifndef PRODUCT_H
+#define PRODUCT_H
+
+#include <stddef.h>
+
+#include "co_node.h"
+
+/* Largest number of nodes one product runs (the redundant GSH-A has two). */
+#define PRODUCT_MAX_NODES 2u
+/* Largest number of simulated inputs ("x", "y", ...). */
+#define PRODUCT_MAX_INPUTS 4u
+/* Bytes of the largest product instance; checked by each product. */
+#define PRODUCT_INST_MAX 1024u
+
+typedef struct product product_t;
+
+struct product {
+    const char *id;          /* e.g. "dst-x730-xy30" */
+    const char *summary;     /* one line for --list-products */
+    const char *inputs[PRODUCT_MAX_INPUTS]; /* simulator input names, NULL-ended */
+    const char *units;       /* unit of the inputs, for messages */
+    unsigned nodes;          /* nodes this product runs */
+    size_t inst_size;        /* bytes create() needs */
+    /*
+     * Build the instance in mem (inst_size bytes, aligned for any type);
+     * node i talks through ports[i]. Stores the node pointers in nodes[].
+     * Nothing is sent until the board calls co_node_start().
+     */
+    void (*create)(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[]);
+    /*
+     * One sensor sample: values in thousandths of the input's unit
+     * (millidegrees), in the order of inputs[]; fault forces a sensor error.
+     * Call every CO_FILTER_PERIOD_US.
+     */
+    void (*sample)(void *mem, const int32_t values[], bool fault);
+    const void *variant;     /* product-specific constants */
+};
+
+/* Every product, in --list-products order; NULL-terminated. */
+extern const product_t *const product_list[];
+
+/* The product with this ID, or NULL. */
+const product_t *product_find(const char *id);
+
+#endif /* PRODUCT_H */

@@ -1,0 +1,23 @@
+/*
+ * products.c - the product registry.
+ */
+#include "product.h"
+
+#include <string.h>
+
+#include "dst.h"
+
+const product_t *const product_list[] = {
+    &dst_x730_xy10, &dst_x730_xy15, &dst_x730_xy20, &dst_x730_xy30, &dst_x730_xy45,
+    &dst_x730_xy60, &dst_x730_xy90, &dst_x730_z360, NULL,
+};
+
+const product_t *product_find(const char *id)
+{
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        if (strcmp(product_list[i]->id, id) == 0) {
+            return product_list[i];
+        }
+    }
+    return NULL;
+}

@@ -1,0 +1,137 @@
+/*
+ * incl.c - CiA 410 inclinometer profile logic. See co_incl.h.
+ */
+#include "co_incl.h"
+
+#include <string.h>
+
+#define FULL_TURN_MDEG 360000
+
+int32_t co_div_round(int32_t a, int32_t b)
+{
+    return a >= 0 ? (a + b / 2) / b : -((-a + b / 2) / b);
+}
+
+void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limit_mdeg, bool wrap)
+{
+    memset(incl, 0, sizeof(*incl));
+    incl->p = p;
+    incl->axes = axes;
+    incl->limit_mdeg = limit_mdeg;
+    incl->wrap = wrap;
+    incl->shift = co_filter_shift(0);
+    co_filter_reset(&incl->f[0]);
+    co_filter_reset(&incl->f[1]);
+}
+
+/* Angle in [-180000, 180000) millidegrees. */
+static int32_t wrap180(int32_t a)
+{
+    a %= FULL_TURN_MDEG;
+    if (a >= FULL_TURN_MDEG / 2) {
+        a -= FULL_TURN_MDEG;
+    } else if (a < -FULL_TURN_MDEG / 2) {
+        a += FULL_TURN_MDEG;
+    }
+    return a;
+}
+
+void co_incl_sample(co_incl_t *incl, const int32_t mdeg[2])
+{
+    if (incl->fault) {
+        return; /* no valid reading: the outputs hold their last value */
+    }
+    for (unsigned a = 0; a < incl->axes; a++) {
+        int32_t x = mdeg[a];
+        if (incl->wrap) {
+            /* Feed the filter a continuous angle so that crossing +-180
+             * does not sweep the output through zero. */
+            if (!incl->f[a].primed) {
+                incl->unwrapped = wrap180(x);
+            } else {
+                incl->unwrapped += wrap180(x - incl->unwrapped);
+            }
+            int32_t y = co_filter_step(&incl->f[a], incl->unwrapped, incl->shift);
+            int32_t w = wrap180(y);
+            /* Keep the filter state near the [-180, 180) window. */
+            if (w != y) {
+                int32_t d = w - y;
+                for (unsigned i = 0; i < CO_FILTER_STAGES; i++) {
+                    incl->f[a].s[i] += d * 256;
+                }
+                incl->unwrapped += d;
+            }
+            incl->angle[a] = w;
+            incl->beyond[a] = false;
+            continue;
+        }
+        int32_t y = co_filter_step(&incl->f[a], x, incl->shift);
+        int32_t lim = incl->limit_mdeg;
+        incl->beyond[a] = lim != 0 && (y > lim || y < -lim);
+        if (lim != 0 && y > lim) {
+            y = lim;
+        } else if (lim != 0 && y < -lim) {
+            y = -lim;
+        }
+        incl->angle[a] = y;
+    }
+}
+
+bool co_incl_beyond(const co_incl_t *incl)
+{
+    return incl->beyond[0] || incl->beyond[1];
+}
+
+/* s*m: the measured angle in resolution units with the sign applied. */
+static int32_t signed_measure(const co_incl_t *incl, unsigned axis)
+{
+    int32_t res = incl->p->resolution != 0u ? (int32_t)incl->p->resolution : 1;
+    int32_t m = co_div_round(incl->angle[axis], res);
+    return (incl->p->op[axis] & CO_INCL_OP_INVERT) != 0u ? -m : m;
+}
+
+int16_t co_incl_slope(const co_incl_t *incl, unsigned axis)
+{
+    if (axis >= incl->axes) {
+        return 0;
+    }
+    int32_t v = signed_measure(incl, axis);
+    if ((incl->p->op[axis] & CO_INCL_OP_SCALING) != 0u) {
+        v += incl->p->offset[axis] + incl->p->diff[axis];
+    }
+    if (v > INT16_MAX) {
+        v = INT16_MAX;
+    } else if (v < INT16_MIN) {
+        v = INT16_MIN;
+    }
+    return (int16_t)v;
+}
+
+co_res_t co_incl_set_resolution(co_incl_t *incl, uint16_t res)
+{
+    co_incl_para_t *p = incl->p;
+    /* Both operating parameters are checked even on a single-axis device:
+     * 0x6021 exists there too and the manuals require its bit. */
+    if ((p->op[0] & CO_INCL_OP_SCALING) == 0u || (p->op[1] & CO_INCL_OP_SCALING) == 0u) {
+        return CO_E_STATE;
+    }
+    if (res != p->resolution) {
+        p->resolution = res;
+        memset(p->preset, 0, sizeof(p->preset));
+        memset(p->offset, 0, sizeof(p->offset));
+        memset(p->diff, 0, sizeof(p->diff));
+    }
+    return CO_OK;
+}
+
+void co_incl_set_preset(co_incl_t *incl, unsigned axis, int16_t preset)
+{
+    int32_t off = (int32_t)preset - signed_measure(incl, axis);
+    if (off > INT16_MAX) {
+        off = INT16_MAX;
+    } else if (off < INT16_MIN) {
+        off = INT16_MIN;
+    }
+    incl->p->preset[axis] = preset;
+    incl->p->offset[axis] = (int16_t)off;
+}

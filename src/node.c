@@ -1,0 +1,148 @@
+/*
+ * node.c - the node object: reset sequence, frame dispatch, timers, LEDs.
+ * See co_node.h.
+ */
+#include "co_node.h"
+
+#include <string.h>
+
+#include "co_port.h"
+
+void co_node_init(co_node_t *node, const co_node_cfg_t *cfg, void *port, void *app,
+                  void *const ram[CO_CLS_COUNT], uint32_t nvm_base)
+{
+    memset(node, 0, sizeof(*node));
+    node->cfg = cfg;
+    node->port = port;
+    node->app = app;
+    for (unsigned i = 0; i < CO_CLS_COUNT; i++) {
+        node->ram[i] = ram[i];
+    }
+    node->nvm_base = nvm_base;
+    node->node_id = cfg->default_node_id;
+    node->nmt.state = CO_NMT_INIT;
+}
+
+const co_od_entry_t *co_node_entry(const co_node_t *node, uint16_t index, uint8_t sub)
+{
+    return co_od_find(node->cfg->od, index, sub, NULL);
+}
+
+bool co_node_send(co_node_t *node, const co_frame_t *f)
+{
+    if (!co_port_can_send(node->port, f)) {
+        node->tx_dropped++;
+        return false;
+    }
+    return true;
+}
+
+void co_node_reset(co_node_t *node, co_reset_t kind)
+{
+    /* Silent while re-initialising: no state hook for INIT. */
+    co_tpdo_stop(node);
+    node->nmt.state = CO_NMT_INIT;
+    if (kind == CO_RESET_NODE) {
+        co_od_defaults(node, CO_CLS_VOL, 0x0000, 0xFFFF);
+        (void)co_store_restore(node, CO_CLS_PARA, 0x0000, 0xFFFF);
+        (void)co_store_restore(node, CO_CLS_LSS, 0x0000, 0xFFFF);
+        const co_lss_para_t *lss = node->ram[CO_CLS_LSS];
+        bool id_ok = lss != NULL && lss->node_id >= 1u && lss->node_id <= 127u;
+        node->node_id = id_ok ? lss->node_id : node->cfg->default_node_id;
+    } else {
+        co_od_defaults(node, CO_CLS_VOL, 0x1000, 0x1FFF);
+        (void)co_store_restore(node, CO_CLS_PARA, 0x1000, 0x1FFF);
+    }
+    co_sdo_init(&node->sdo);
+    node->autostart = false;
+    if (node->cfg->ops != NULL && node->cfg->ops->reset != NULL) {
+        node->cfg->ops->reset(node, kind);
+    }
+    co_hb_reconfig(node);
+    co_sync_reconfig(node);
+    for (unsigned n = 0; n < CO_TPDO_MAX; n++) {
+        co_tpdo_reconfig(node, n);
+    }
+    co_hb_bootup(node);
+    co_nmt_enter(node, CO_NMT_PREOP);
+    if (node->autostart) {
+        co_nmt_enter(node, CO_NMT_OPERATIONAL);
+    }
+}
+
+void co_node_start(co_node_t *node, uint32_t now)
+{
+    node->now = now;
+    co_store_init(node);
+    co_node_reset(node, CO_RESET_NODE);
+}
+
+void co_node_receive(co_node_t *node, const co_frame_t *f)
+{
+    if (node->nmt.state == CO_NMT_INIT) {
+        return;
+    }
+    if (co_nmt_receive(node, f) || co_sync_receive(node, f) || co_sdo_receive(node, f)) {
+        return;
+    }
+    /* Anything else (other nodes' traffic, RTRs nobody serves) is ignored. */
+}
+
+uint32_t co_node_poll(co_node_t *node, uint32_t now)
+{
+    node->now = now;
+    uint32_t next = co_sdo_poll(node, now);
+    next = co_min_u32(next, co_hb_poll(node, now));
+    if (node->cfg->ops != NULL && node->cfg->ops->poll != NULL) {
+        next = co_min_u32(next, node->cfg->ops->poll(node, now));
+    }
+    next = co_min_u32(next, co_tpdo_poll(node, now));
+    return next;
+}
+
+void co_node_set_can_state(co_node_t *node, co_can_state_t s)
+{
+    node->can_state = (uint8_t)s;
+}
+
+void co_node_leds(co_node_t *node, uint32_t now, bool *green, bool *red, uint32_t *next_us)
+{
+    co_led_pattern_t g;
+    co_led_pattern_t r;
+    switch (node->nmt.state) {
+    case CO_NMT_OPERATIONAL:
+        g = CO_LED_ON;
+        break;
+    case CO_NMT_STOPPED:
+        g = CO_LED_FLASH1;
+        break;
+    case CO_NMT_PREOP:
+        g = CO_LED_BLINK;
+        break;
+    default:
+        g = CO_LED_OFF;
+        break;
+    }
+    switch ((co_can_state_t)node->can_state) {
+    case CO_CAN_BUSOFF:
+        r = CO_LED_ON;
+        break;
+    case CO_CAN_WARNING:
+    case CO_CAN_PASSIVE:
+        r = CO_LED_FLASH1;
+        break;
+    case CO_CAN_ACTIVE:
+    default:
+        r = CO_LED_OFF;
+        break;
+    }
+    if (node->cfg->ops != NULL && node->cfg->ops->leds != NULL) {
+        node->cfg->ops->leds(node, &g, &r);
+    }
+    const co_led_timing_t *t = node->cfg->led != NULL ? node->cfg->led : &co_led_cia303;
+    uint32_t ng;
+    uint32_t nr;
+    *green = co_led_level(g, t, now, &ng);
+    *red = co_led_level(r, t, now, &nr);
+    *next_us = co_min_u32(ng, nr);
+}

@@ -1,0 +1,221 @@
+/*
+ * od.c - object dictionary access: lookup, typed read/write, limits,
+ * defaults. See co_od.h.
+ */
+#include "co_od.h"
+
+#include <string.h>
+
+#include "co_node.h"
+
+static bool is_signed(const co_od_entry_t *e)
+{
+    return e->type == CO_T_I8 || e->type == CO_T_I16 || e->type == CO_T_I32;
+}
+
+static bool is_number(const co_od_entry_t *e)
+{
+    return e->type != CO_T_VSTR;
+}
+
+static uint8_t *ram_of(const co_node_t *node, const co_od_entry_t *e)
+{
+    if (e->cls == CO_CLS_NONE || node->ram[e->cls] == NULL) {
+        return NULL;
+    }
+    return (uint8_t *)node->ram[e->cls] + e->off;
+}
+
+uint32_t co_cobid_resolve(uint32_t raw, uint32_t def, uint8_t node_id)
+{
+    if ((raw & 0x7FFu) == (def & 0x7FFu)) {
+        return raw + node_id;
+    }
+    return raw;
+}
+
+const co_od_entry_t *co_od_find(const co_od_t *od, uint16_t index, uint8_t sub, co_res_t *res)
+{
+    uint32_t key = ((uint32_t)index << 8) | sub;
+    uint32_t lo = 0;
+    uint32_t hi = od->count;
+    while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2u;
+        const co_od_entry_t *e = &od->entries[mid];
+        uint32_t k = ((uint32_t)e->index << 8) | e->sub;
+        if (k == key) {
+            if (res != NULL) {
+                *res = CO_OK;
+            }
+            return e;
+        }
+        if (k < key) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    if (res != NULL) {
+        /* lo is where the key would go; the index exists if a neighbour has it. */
+        bool index_exists = (lo < od->count && od->entries[lo].index == index) ||
+                            (lo > 0u && od->entries[lo - 1u].index == index);
+        *res = index_exists ? CO_E_NO_SUB : CO_E_NO_OBJ;
+    }
+    return NULL;
+}
+
+/* Load a size-byte little-endian host value, sign-extending INTEGERn. */
+static uint32_t load_value(const co_od_entry_t *e, const uint8_t *p)
+{
+    uint32_t v = 0;
+    switch (e->size) {
+    case 1: {
+        uint8_t x;
+        memcpy(&x, p, 1);
+        v = is_signed(e) ? (uint32_t)(int32_t)(int8_t)x : x;
+        break;
+    }
+    case 2: {
+        uint16_t x;
+        memcpy(&x, p, 2);
+        v = is_signed(e) ? (uint32_t)(int32_t)(int16_t)x : x;
+        break;
+    }
+    default: {
+        uint32_t x;
+        memcpy(&x, p, 4);
+        v = x;
+        break;
+    }
+    }
+    return v;
+}
+
+static void store_value(const co_od_entry_t *e, uint8_t *p, uint32_t v)
+{
+    switch (e->size) {
+    case 1: {
+        uint8_t x = (uint8_t)v;
+        memcpy(p, &x, 1);
+        break;
+    }
+    case 2: {
+        uint16_t x = (uint16_t)v;
+        memcpy(p, &x, 2);
+        break;
+    }
+    default:
+        memcpy(p, &v, 4);
+        break;
+    }
+}
+
+co_res_t co_od_get(co_node_t *node, const co_od_entry_t *e, uint32_t *value)
+{
+    if (e->read != NULL) {
+        return e->read(node, e, value);
+    }
+    const uint8_t *p = ram_of(node, e);
+    uint32_t v = (p != NULL) ? load_value(e, p) : e->def;
+    if ((e->attr & CO_A_NODEID) != 0u) {
+        v = co_cobid_resolve(v, e->def, node->node_id);
+    }
+    *value = v;
+    return CO_OK;
+}
+
+co_res_t co_od_read(co_node_t *node, const co_od_entry_t *e, uint32_t at, uint8_t *buf,
+                    uint32_t cap, uint32_t *len)
+{
+    *len = 0;
+    if ((e->attr & CO_A_R) == 0u) {
+        return CO_E_WO;
+    }
+    uint8_t tmp[4];
+    const uint8_t *src;
+    if (is_number(e)) {
+        uint32_t v;
+        co_res_t r = co_od_get(node, e, &v);
+        if (r != CO_OK) {
+            return r;
+        }
+        co_put_u32(tmp, v);
+        src = tmp;
+    } else {
+        src = e->cdata;
+    }
+    uint32_t size = e->size;
+    if (at >= size) {
+        return CO_OK;
+    }
+    uint32_t n = co_min_u32(size - at, cap);
+    memcpy(buf, src + at, n);
+    *len = n;
+    return CO_OK;
+}
+
+co_res_t co_od_store(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+{
+    uint8_t *p = ram_of(node, e);
+    if (p == NULL) {
+        return CO_E_RO;
+    }
+    if ((e->attr & CO_A_NODEID) != 0u && (value & 0x7FFu) == (e->def & 0x7FFu) + node->node_id) {
+        value -= node->node_id; /* the default COB-ID: keep following the node-ID */
+    }
+    store_value(e, p, value);
+    return CO_OK;
+}
+
+co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len)
+{
+    if ((e->attr & CO_A_W) == 0u) {
+        return CO_E_RO;
+    }
+    if (len > e->size) {
+        return CO_E_LEN_HIGH;
+    }
+    if (len < e->size) {
+        return CO_E_LEN_LOW;
+    }
+    if (!is_number(e)) {
+        return CO_E_RO; /* no writable strings in any product yet */
+    }
+    uint8_t tmp[4] = {0, 0, 0, 0};
+    memcpy(tmp, buf, len);
+    uint32_t v = load_value(e, tmp);
+    if (e->min != e->max) {
+        if (is_signed(e)) {
+            int32_t s = (int32_t)v;
+            if (s < e->min) {
+                return CO_E_VAL_LOW;
+            }
+            if (s > e->max) {
+                return CO_E_VAL_HIGH;
+            }
+        } else {
+            if (v < (uint32_t)e->min) {
+                return CO_E_VAL_LOW;
+            }
+            if (v > (uint32_t)e->max) {
+                return CO_E_VAL_HIGH;
+            }
+        }
+    }
+    if (e->write != NULL) {
+        return e->write(node, e, v);
+    }
+    return co_od_store(node, e, v);
+}
+
+void co_od_defaults(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)
+{
+    const co_od_t *od = node->cfg->od;
+    for (uint16_t i = 0; i < od->count; i++) {
+        const co_od_entry_t *e = &od->entries[i];
+        uint8_t *p = ram_of(node, e);
+        if (e->cls == cls && e->index >= lo && e->index <= hi && p != NULL) {
+            store_value(e, p, e->def);
+        }
+    }
+}

@@ -1,0 +1,291 @@
+/*
+ * param_store.c - parameter store on the board's EEPROM emulation.
+ * See co_store.h for the record format and the power-cut argument.
+ */
+#include "co_store.h"
+
+#include <string.h>
+
+#include "co_node.h"
+#include "co_port.h"
+
+#define STORE_MAGIC 0x53506F43u /* "CoPS" */
+#define FLAG_DEFAULTS 0x01u
+
+typedef struct slot_info {
+    bool present; /* the magic is there */
+    bool valid;   /* header, length, layout and CRC all check out */
+    uint8_t flags;
+    uint32_t seq;
+    uint32_t writes;
+    uint32_t len;
+} slot_info_t;
+
+uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len)
+{
+    const uint8_t *p = data;
+    crc = ~crc;
+    for (uint32_t i = 0; i < len; i++) {
+        crc ^= p[i];
+        for (unsigned b = 0; b < 8u; b++) {
+            crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+        }
+    }
+    return ~crc;
+}
+
+uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls)
+{
+    /* FNV-1a over (index, sub, size, offset) of every entry with RAM in cls. */
+    uint32_t h = 2166136261u;
+    const co_od_t *od = node->cfg->od;
+    for (uint16_t i = 0; i < od->count; i++) {
+        const co_od_entry_t *e = &od->entries[i];
+        if (e->cls != cls) {
+            continue;
+        }
+        uint8_t k[7] = {(uint8_t)e->index, (uint8_t)(e->index >> 8), e->sub,
+                        (uint8_t)e->size, (uint8_t)(e->size >> 8), (uint8_t)e->off,
+                        (uint8_t)(e->off >> 8)};
+        for (unsigned j = 0; j < sizeof(k); j++) {
+            h = (h ^ k[j]) * 16777619u;
+        }
+    }
+    return h ^ node->cfg->ram_size[cls];
+}
+
+static uint32_t slot_addr(const co_node_t *node, co_cls_t cls, unsigned copy)
+{
+    unsigned c = (cls == CO_CLS_PARA) ? 0u : 1u;
+    return node->nvm_base + (c * 2u + copy) * CO_STORE_SLOT;
+}
+
+static bool stored_class(const co_node_t *node, co_cls_t cls)
+{
+    return (cls == CO_CLS_PARA || cls == CO_CLS_LSS) && node->cfg->ram_size[cls] != 0u &&
+           node->ram[cls] != NULL;
+}
+
+/* Read and verify one slot without touching any live value. */
+static slot_info_t check_slot(co_node_t *node, co_cls_t cls, unsigned copy, bool *hw_error)
+{
+    slot_info_t s = {0};
+    uint32_t a = slot_addr(node, cls, copy);
+    uint8_t h[CO_STORE_HDR];
+    if (!co_port_nvm_read(node->port, a, h, sizeof(h))) {
+        *hw_error = true;
+        return s;
+    }
+    if (co_get_u32(&h[0]) != STORE_MAGIC) {
+        return s;
+    }
+    s.present = true;
+    s.seq = co_get_u32(&h[8]);
+    s.writes = co_get_u32(&h[12]);
+    s.len = co_get_u16(&h[16]);
+    s.flags = h[18];
+    bool defaults = (s.flags & FLAG_DEFAULTS) != 0u;
+    uint32_t want = defaults ? 0u : node->cfg->ram_size[cls];
+    if (h[19] != (uint8_t)cls || s.len != want ||
+        co_get_u32(&h[4]) != co_store_layout_hash(node, cls)) {
+        return s;
+    }
+    uint32_t crc = co_crc32(0, h, sizeof(h));
+    uint8_t chunk[16];
+    for (uint32_t at = 0; at < s.len; at += sizeof(chunk)) {
+        uint32_t n = co_min_u32(sizeof(chunk), s.len - at);
+        if (!co_port_nvm_read(node->port, a + CO_STORE_HDR + at, chunk, n)) {
+            *hw_error = true;
+            return s;
+        }
+        crc = co_crc32(crc, chunk, n);
+    }
+    uint8_t c[4];
+    if (!co_port_nvm_read(node->port, a + CO_STORE_HDR + s.len, c, 4)) {
+        *hw_error = true;
+        return s;
+    }
+    s.valid = co_get_u32(c) == crc;
+    return s;
+}
+
+/* Index of the newest valid copy, or -1. */
+static int newest(const slot_info_t s[2])
+{
+    if (s[0].valid && s[1].valid) {
+        return (int32_t)(s[1].seq - s[0].seq) > 0 ? 1 : 0;
+    }
+    return s[0].valid ? 0 : (s[1].valid ? 1 : -1);
+}
+
+void co_store_init(co_node_t *node)
+{
+    node->store.writes = 0;
+    for (unsigned cls = CO_CLS_PARA; cls <= CO_CLS_LSS; cls++) {
+        if (!stored_class(node, (co_cls_t)cls)) {
+            continue;
+        }
+        for (unsigned copy = 0; copy < 2u; copy++) {
+            bool hw = false;
+            slot_info_t s = check_slot(node, (co_cls_t)cls, copy, &hw);
+            if (s.valid && s.writes > node->store.writes) {
+                node->store.writes = s.writes;
+            }
+        }
+    }
+}
+
+/* Defaults: from the dictionary; the LSS struct's from the node config. */
+static void set_defaults(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)
+{
+    co_od_defaults(node, cls, lo, hi);
+    if (cls == CO_CLS_LSS) {
+        co_lss_para_t *l = node->ram[CO_CLS_LSS];
+        l->node_id = node->cfg->default_node_id;
+        l->bitrate = node->cfg->default_bitrate;
+    }
+}
+
+co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)
+{
+    if (!stored_class(node, cls)) {
+        return CO_STORE_BLANK;
+    }
+    slot_info_t s[2];
+    bool hw = false;
+    s[0] = check_slot(node, cls, 0, &hw);
+    s[1] = check_slot(node, cls, 1, &hw);
+    int k = newest(s);
+    co_store_status_t st;
+    if (k < 0) {
+        st = hw ? CO_STORE_HW : (s[0].present || s[1].present) ? CO_STORE_CORRUPT : CO_STORE_BLANK;
+    } else if ((s[k].flags & FLAG_DEFAULTS) != 0u) {
+        st = CO_STORE_DEFAULTS;
+    } else {
+        st = CO_STORE_OK;
+    }
+    if (st != CO_STORE_OK) {
+        set_defaults(node, cls, lo, hi);
+        node->store.status[cls] = (uint8_t)st;
+        return st;
+    }
+    /* Verified: now copy what was asked for, straight from NVM. */
+    uint32_t data = slot_addr(node, cls, (unsigned)k) + CO_STORE_HDR;
+    if (lo == 0u && hi == 0xFFFFu) {
+        if (!co_port_nvm_read(node->port, data, node->ram[cls], s[k].len)) {
+            set_defaults(node, cls, lo, hi);
+            st = CO_STORE_HW;
+        }
+        node->store.status[cls] = (uint8_t)st;
+        return st;
+    }
+    const co_od_t *od = node->cfg->od;
+    for (uint16_t i = 0; i < od->count; i++) {
+        const co_od_entry_t *e = &od->entries[i];
+        if (e->cls == cls && e->index >= lo && e->index <= hi) {
+            uint8_t *p = (uint8_t *)node->ram[cls] + e->off;
+            if (!co_port_nvm_read(node->port, data + e->off, p, e->size)) {
+                set_defaults(node, cls, lo, hi);
+                st = CO_STORE_HW;
+                break;
+            }
+        }
+    }
+    node->store.status[cls] = (uint8_t)st;
+    return st;
+}
+
+bool co_store_limit_reached(const co_node_t *node)
+{
+    uint32_t lim = node->cfg->store_write_limit;
+    return lim != 0u && node->store.writes >= lim;
+}
+
+static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags)
+{
+    if (!stored_class(node, cls)) {
+        return CO_E_STORE;
+    }
+    if (co_store_limit_reached(node)) {
+        return CO_E_STORE;
+    }
+    slot_info_t s[2];
+    bool hw = false;
+    s[0] = check_slot(node, cls, 0, &hw);
+    s[1] = check_slot(node, cls, 1, &hw);
+    int k = newest(s);
+    unsigned target = (k == 0) ? 1u : 0u;
+    uint32_t seq = (k < 0) ? 1u : s[k].seq + 1u;
+    uint32_t len = (flags & FLAG_DEFAULTS) != 0u ? 0u : node->cfg->ram_size[cls];
+
+    uint8_t h[CO_STORE_HDR] = {0};
+    co_put_u32(&h[0], STORE_MAGIC);
+    co_put_u32(&h[4], co_store_layout_hash(node, cls));
+    co_put_u32(&h[8], seq);
+    co_put_u32(&h[12], node->store.writes + 1u);
+    co_put_u16(&h[16], (uint16_t)len);
+    h[18] = flags;
+    h[19] = (uint8_t)cls;
+    uint32_t crc = co_crc32(0, h, sizeof(h));
+    crc = co_crc32(crc, node->ram[cls], len);
+    uint8_t c[4];
+    co_put_u32(c, crc);
+
+    uint32_t a = slot_addr(node, cls, target);
+    if (!co_port_nvm_write(node->port, a, h, sizeof(h)) ||
+        !co_port_nvm_write(node->port, a + CO_STORE_HDR, node->ram[cls], len) ||
+        !co_port_nvm_write(node->port, a + CO_STORE_HDR + len, c, sizeof(c))) {
+        return CO_E_HW;
+    }
+    node->store.writes++;
+    if (node->store.status[cls] != CO_STORE_OK && flags == 0u) {
+        node->store.status[cls] = CO_STORE_OK; /* the stored set is sound again */
+    }
+    return CO_OK;
+}
+
+co_res_t co_store_save(co_node_t *node, co_cls_t cls)
+{
+    return write_record(node, cls, 0);
+}
+
+co_res_t co_store_request_defaults(co_node_t *node, co_cls_t cls)
+{
+    return write_record(node, cls, FLAG_DEFAULTS);
+}
+
+static void notify(co_node_t *node, uint32_t sig)
+{
+    if (node->cfg->ops != NULL && node->cfg->ops->stored != NULL) {
+        node->cfg->ops->stored(node, sig);
+    }
+}
+
+co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+{
+    (void)e;
+    if (value != CO_SIG_SAVE) {
+        return CO_E_STORE;
+    }
+    co_res_t r = co_store_save(node, CO_CLS_PARA);
+    if (r == CO_OK) {
+        notify(node, value);
+    }
+    return r;
+}
+
+co_res_t co_store_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+{
+    (void)e;
+    if (value != CO_SIG_LOAD) {
+        return CO_E_STORE;
+    }
+    co_res_t r = co_store_request_defaults(node, CO_CLS_PARA);
+    if (r == CO_OK && stored_class(node, CO_CLS_LSS)) {
+        r = co_store_request_defaults(node, CO_CLS_LSS);
+    }
+    if (r == CO_OK) {
+        notify(node, value);
+    }
+    return r;
+}

@@ -1,0 +1,252 @@
+/*
+ * sdo_server.c - SDO server, expedited and segmented. See co_sdo.h.
+ */
+#include "co_sdo.h"
+
+#include <string.h>
+
+#include "co_node.h"
+
+enum { SDO_IDLE = 0, SDO_DOWNLOAD, SDO_UPLOAD };
+
+/* Client command specifiers (byte 0 bits 7..5). */
+enum {
+    CCS_DOWNLOAD_SEGMENT = 0,
+    CCS_DOWNLOAD_INITIATE = 1,
+    CCS_UPLOAD_INITIATE = 2,
+    CCS_UPLOAD_SEGMENT = 3,
+    CCS_ABORT = 4,
+};
+
+void co_sdo_init(co_sdo_t *sdo)
+{
+    memset(sdo, 0, sizeof(*sdo));
+}
+
+static void reply(co_node_t *node, const uint8_t d[8])
+{
+    co_frame_t f = {.id = (uint16_t)(0x580u + node->node_id), .dlc = 8};
+    memcpy(f.data, d, 8);
+    (void)co_node_send(node, &f);
+}
+
+static void reply_head(co_node_t *node, uint8_t cmd, const uint8_t *req, uint32_t val)
+{
+    uint8_t d[8] = {cmd, req[1], req[2], req[3], 0, 0, 0, 0};
+    co_put_u32(&d[4], val);
+    reply(node, d);
+}
+
+static void sdo_abort(co_node_t *node, const uint8_t *mux, co_res_t r)
+{
+    node->sdo.state = SDO_IDLE;
+    reply_head(node, 0x80, mux, co_res_abort_code(r));
+}
+
+static void start_timer(co_sdo_t *sdo)
+{
+    sdo->restart = true;
+}
+
+static void initiate_download(co_node_t *node, const uint8_t *d)
+{
+    co_sdo_t *sdo = &node->sdo;
+    co_res_t r;
+    const co_od_entry_t *e = co_od_find(node->cfg->od, co_get_u16(&d[1]), d[3], &r);
+    if (e == NULL) {
+        sdo_abort(node, d, r);
+        return;
+    }
+    if ((e->attr & CO_A_W) == 0u) {
+        sdo_abort(node, d, CO_E_RO);
+        return;
+    }
+    bool expedited = (d[0] & 0x02u) != 0u;
+    bool sized = (d[0] & 0x01u) != 0u;
+    if (expedited) {
+        /* Size not indicated (0x22): the object's own size, at most 4. */
+        uint32_t len = sized ? 4u - ((d[0] >> 2) & 0x03u) : co_min_u32(co_od_size(e), 4u);
+        r = co_od_write(node, e, &d[4], len);
+        if (r != CO_OK) {
+            sdo_abort(node, d, r);
+        } else {
+            reply_head(node, 0x60, d, 0);
+        }
+        return;
+    }
+    uint32_t size = sized ? co_get_u32(&d[4]) : 0u;
+    if (sized && size > co_od_size(e)) {
+        sdo_abort(node, d, CO_E_LEN_HIGH);
+        return;
+    }
+    if (sized && size < co_od_size(e)) {
+        sdo_abort(node, d, CO_E_LEN_LOW);
+        return;
+    }
+    if (co_od_size(e) > CO_SDO_BUF) {
+        sdo_abort(node, d, CO_E_OOM);
+        return;
+    }
+    sdo->state = SDO_DOWNLOAD;
+    sdo->e = e;
+    sdo->size = co_od_size(e);
+    sdo->pos = 0;
+    sdo->toggle = 0;
+    start_timer(sdo);
+    reply_head(node, 0x60, d, 0);
+}
+
+static void download_segment(co_node_t *node, const uint8_t *d)
+{
+    co_sdo_t *sdo = &node->sdo;
+    uint8_t mux[4] = {0, (uint8_t)sdo->e->index, (uint8_t)(sdo->e->index >> 8), sdo->e->sub};
+    if ((d[0] & 0x10u) != sdo->toggle) {
+        sdo_abort(node, mux, CO_E_TOGGLE);
+        return;
+    }
+    uint32_t n = 7u - ((d[0] >> 1) & 0x07u);
+    if (sdo->pos + n > sdo->size) {
+        sdo_abort(node, mux, CO_E_LEN_HIGH);
+        return;
+    }
+    memcpy(&sdo->buf[sdo->pos], &d[1], n);
+    sdo->pos += n;
+    uint8_t ack[8] = {(uint8_t)(0x20u | sdo->toggle), 0, 0, 0, 0, 0, 0, 0};
+    sdo->toggle ^= 0x10u;
+    if ((d[0] & 0x01u) == 0u) { /* more segments follow */
+        start_timer(sdo);
+        reply(node, ack);
+        return;
+    }
+    sdo->state = SDO_IDLE;
+    if (sdo->pos != sdo->size) {
+        sdo_abort(node, mux, sdo->pos < sdo->size ? CO_E_LEN_LOW : CO_E_LEN_HIGH);
+        return;
+    }
+    co_res_t r = co_od_write(node, sdo->e, sdo->buf, sdo->pos);
+    if (r != CO_OK) {
+        sdo_abort(node, mux, r);
+        return;
+    }
+    reply(node, ack);
+}
+
+static void initiate_upload(co_node_t *node, const uint8_t *d)
+{
+    co_sdo_t *sdo = &node->sdo;
+    co_res_t r;
+    const co_od_entry_t *e = co_od_find(node->cfg->od, co_get_u16(&d[1]), d[3], &r);
+    if (e == NULL) {
+        sdo_abort(node, d, r);
+        return;
+    }
+    uint8_t out[8] = {0, d[1], d[2], d[3], 0, 0, 0, 0};
+    uint32_t len;
+    r = co_od_read(node, e, 0, &out[4], 4, &len);
+    if (r != CO_OK) {
+        sdo_abort(node, d, r);
+        return;
+    }
+    uint32_t size = co_od_size(e);
+    if (size <= 4u) {
+        /* Expedited, size indicated: 0x4F / 0x4B / 0x47 / 0x43. */
+        out[0] = (uint8_t)(0x43u | ((4u - size) << 2));
+        reply(node, out);
+        return;
+    }
+    sdo->state = SDO_UPLOAD;
+    sdo->e = e;
+    sdo->size = size;
+    sdo->pos = 0;
+    sdo->toggle = 0;
+    start_timer(sdo);
+    reply_head(node, 0x41, d, size);
+}
+
+static void upload_segment(co_node_t *node, const uint8_t *d)
+{
+    co_sdo_t *sdo = &node->sdo;
+    uint8_t mux[4] = {0, (uint8_t)sdo->e->index, (uint8_t)(sdo->e->index >> 8), sdo->e->sub};
+    if ((d[0] & 0x10u) != sdo->toggle) {
+        sdo_abort(node, mux, CO_E_TOGGLE);
+        return;
+    }
+    uint8_t out[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    uint32_t n;
+    co_res_t r = co_od_read(node, sdo->e, sdo->pos, &out[1], 7, &n);
+    if (r != CO_OK) {
+        sdo_abort(node, mux, r);
+        return;
+    }
+    sdo->pos += n;
+    bool last = sdo->pos >= sdo->size;
+    out[0] = (uint8_t)(sdo->toggle | ((7u - n) << 1) | (last ? 1u : 0u));
+    sdo->toggle ^= 0x10u;
+    if (last) {
+        sdo->state = SDO_IDLE;
+    } else {
+        start_timer(sdo);
+    }
+    reply(node, out);
+}
+
+bool co_sdo_receive(co_node_t *node, const co_frame_t *f)
+{
+    if (f->id != 0x600u + node->node_id || f->rtr) {
+        return false;
+    }
+    if (f->dlc != 8u || !co_nmt_sdo_allowed(node->nmt.state)) {
+        return true; /* CiA 301: SDO frames are 8 bytes; no SDO in stopped */
+    }
+    const uint8_t *d = f->data;
+    co_sdo_t *sdo = &node->sdo;
+    switch (d[0] >> 5) {
+    case CCS_DOWNLOAD_INITIATE:
+        sdo->state = SDO_IDLE; /* a new request replaces an unfinished one */
+        initiate_download(node, d);
+        break;
+    case CCS_UPLOAD_INITIATE:
+        sdo->state = SDO_IDLE;
+        initiate_upload(node, d);
+        break;
+    case CCS_DOWNLOAD_SEGMENT:
+        if (sdo->state == SDO_DOWNLOAD) {
+            download_segment(node, d);
+        } else {
+            sdo_abort(node, d, CO_E_CMD);
+        }
+        break;
+    case CCS_UPLOAD_SEGMENT:
+        if (sdo->state == SDO_UPLOAD) {
+            upload_segment(node, d);
+        } else {
+            sdo_abort(node, d, CO_E_CMD);
+        }
+        break;
+    case CCS_ABORT:
+        sdo->state = SDO_IDLE; /* the client gave up; no answer */
+        break;
+    default:
+        sdo_abort(node, d, CO_E_CMD); /* block transfer and reserved */
+        break;
+    }
+    return true;
+}
+
+uint32_t co_sdo_poll(co_node_t *node, uint32_t now)
+{
+    co_sdo_t *sdo = &node->sdo;
+    if (sdo->state == SDO_IDLE) {
+        return CO_NEVER;
+    }
+    if (sdo->restart) {
+        sdo->restart = false;
+        sdo->deadline = now + CO_SDO_TIMEOUT_US;
+    }
+    if (!co_time_before(now, sdo->deadline)) {
+        uint8_t mux[4] = {0, (uint8_t)sdo->e->index, (uint8_t)(sdo->e->index >> 8), sdo->e->sub};
+        sdo_abort(node, mux, CO_E_TIMEOUT);
+        return CO_NEVER;
+    }
+    return sdo->deadline - now;
+}

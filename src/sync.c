@@ -1,0 +1,29 @@
+/*
+ * sync.c - SYNC consumer. See co_sync.h.
+ */
+#include "co_sync.h"
+
+#include "co_node.h"
+
+void co_sync_reconfig(co_node_t *node)
+{
+    uint32_t cob = 0x80u;
+    const co_od_entry_t *e = co_node_entry(node, 0x1005, 0);
+    if (e != NULL) {
+        (void)co_od_get(node, e, &cob);
+    }
+    node->sync.cob_id = (uint16_t)(cob & 0x7FFu);
+}
+
+bool co_sync_receive(co_node_t *node, const co_frame_t *f)
+{
+    if (f->id != node->sync.cob_id || f->rtr) {
+        return false;
+    }
+    /* CiA 301: a SYNC has no data, or a one-byte counter. */
+    if (f->dlc <= 1u && node->nmt.state == CO_NMT_OPERATIONAL) {
+        node->sync.count++;
+        co_tpdo_sync(node);
+    }
+    return true;
+}

@@ -1,0 +1,246 @@
+/*
+ * harness.c - see harness.h.
+ */
+#include "harness.h"
+
+#include <stdlib.h>
+
+#include "co_filter.h"
+#include "co_port.h"
+
+int h_failures;
+int h_checks;
+int h_tests;
+int h_failed_tests;
+
+int h_finish(void)
+{
+    printf("%d checks\n", h_checks);
+    printf("%d passed, %d failed\n", h_tests - h_failed_tests, h_failed_tests);
+    return h_failures == 0 ? 0 : 1;
+}
+
+/* ---- the fake port ------------------------------------------------- */
+
+void fake_port_init(fake_port_t *p)
+{
+    memset(p, 0, sizeof(*p));
+    memset(p->nvm, 0xFF, sizeof(p->nvm));
+    p->cut_after = -1;
+}
+
+bool co_port_can_send(void *port, const co_frame_t *frame)
+{
+    fake_port_t *p = port;
+    if (p->tx_full || p->ntx >= FAKE_TX_MAX) {
+        return false;
+    }
+    p->tx[p->ntx++] = *frame;
+    return true;
+}
+
+uint32_t co_port_nvm_size(void *port)
+{
+    (void)port;
+    return FAKE_NVM_SIZE;
+}
+
+bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
+{
+    fake_port_t *p = port;
+    if (p->nvm_read_fails || addr + len > FAKE_NVM_SIZE) {
+        return false;
+    }
+    memcpy(buf, &p->nvm[addr], len);
+    return true;
+}
+
+bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
+{
+    fake_port_t *p = port;
+    if (addr + len > FAKE_NVM_SIZE) {
+        return false;
+    }
+    const uint8_t *b = buf;
+    for (uint32_t i = 0; i < len; i++) {
+        if (p->cut_after == 0) {
+            return false; /* power is gone: nothing more reaches the EEPROM */
+        }
+        if (p->cut_after > 0) {
+            p->cut_after--;
+        }
+        p->nvm[addr + i] = b[i];
+    }
+    p->nvm_writes++;
+    return true;
+}
+
+/* ---- device under test --------------------------------------------- */
+
+static void create(h_dev_t *d)
+{
+    void *ports[PRODUCT_MAX_NODES] = {&d->port, &d->port};
+    co_node_t *nodes[PRODUCT_MAX_NODES];
+    d->prod->create(d->prod, d->mem, ports, nodes);
+    d->node = nodes[0];
+    /* One sample before start, as a board reads its sensor before booting. */
+    d->prod->sample(d->mem, d->truth, d->fault);
+    co_node_start(d->node, d->now);
+    d->next_sample = d->now + CO_FILTER_PERIOD_US;
+}
+
+void h_boot(h_dev_t *d, const product_t *p, bool keep_nvm)
+{
+    if (!keep_nvm) {
+        memset(d, 0, sizeof(*d));
+        fake_port_init(&d->port);
+        d->now = 1000000u;
+    }
+    d->prod = p;
+    create(d);
+}
+
+void h_power_cycle(h_dev_t *d)
+{
+    d->port.ntx = 0;
+    d->port.rd = 0;
+    d->port.cut_after = -1;
+    d->now += 1000000u;
+    create(d);
+}
+
+void h_advance(h_dev_t *d, uint32_t us)
+{
+    uint32_t end = d->now + us;
+    for (;;) {
+        uint32_t delay = co_node_poll(d->node, d->now);
+        uint32_t step = co_min_u32(co_time_until(d->now, end), co_time_until(d->now, d->next_sample));
+        step = co_min_u32(step, delay);
+        if (step == 0u && !co_time_before(d->now, d->next_sample)) {
+            d->prod->sample(d->mem, d->truth, d->fault);
+            d->next_sample += CO_FILTER_PERIOD_US;
+            continue;
+        }
+        if (!co_time_before(d->now, end)) {
+            break;
+        }
+        d->now += step == 0u ? 1u : step;
+    }
+}
+
+unsigned h_hex(const char *hex, uint8_t *out, unsigned cap)
+{
+    unsigned n = 0;
+    while (*hex != '\0') {
+        if (*hex == ' ') {
+            hex++;
+            continue;
+        }
+        char *end;
+        unsigned long v = strtoul(hex, &end, 16);
+        if (end == hex || n >= cap) {
+            fprintf(stderr, "bad hex in test: %s\n", hex);
+            abort();
+        }
+        out[n++] = (uint8_t)v;
+        hex = end;
+    }
+    return n;
+}
+
+void h_rx_frame(h_dev_t *d, const co_frame_t *f)
+{
+    co_node_poll(d->node, d->now);
+    co_node_receive(d->node, f);
+    co_node_poll(d->node, d->now);
+}
+
+void h_rx(h_dev_t *d, uint16_t id, const char *hex)
+{
+    co_frame_t f = {.id = id};
+    f.dlc = (uint8_t)h_hex(hex, f.data, 8);
+    h_rx_frame(d, &f);
+}
+
+const co_frame_t *h_next(h_dev_t *d)
+{
+    if (d->port.rd >= d->port.ntx) {
+        return NULL;
+    }
+    return &d->port.tx[d->port.rd++];
+}
+
+void h_drain(h_dev_t *d)
+{
+    d->port.rd = d->port.ntx;
+}
+
+unsigned h_pending(const h_dev_t *d)
+{
+    return d->port.ntx - d->port.rd;
+}
+
+static void print_frame(const char *what, const co_frame_t *f)
+{
+    fprintf(stderr, "    %s %03X [%u]", what, f->id, f->dlc);
+    for (unsigned i = 0; i < f->dlc; i++) {
+        fprintf(stderr, " %02X", f->data[i]);
+    }
+    fprintf(stderr, "\n");
+}
+
+void h_expect(h_dev_t *d, uint16_t id, const char *hex, const char *file, int line)
+{
+    co_frame_t want = {.id = id};
+    want.dlc = (uint8_t)h_hex(hex, want.data, 8);
+    const co_frame_t *got = h_next(d);
+    h_checks++;
+    if (got == NULL) {
+        h_failures++;
+        fprintf(stderr, "%s:%d: expected a frame, none was sent\n", file, line);
+        print_frame("want", &want);
+        return;
+    }
+    if (got->id != want.id || got->dlc != want.dlc || memcmp(got->data, want.data, want.dlc) != 0) {
+        h_failures++;
+        fprintf(stderr, "%s:%d: frame differs\n", file, line);
+        print_frame("want", &want);
+        print_frame("got ", got);
+    }
+}
+
+void h_expect_none(h_dev_t *d, const char *file, int line)
+{
+    h_checks++;
+    const co_frame_t *got = h_next(d);
+    if (got != NULL) {
+        h_failures++;
+        fprintf(stderr, "%s:%d: expected no frame\n", file, line);
+        print_frame("got ", got);
+    }
+}
+
+void h_sdo(h_dev_t *d, const char *req, const char *resp, const char *file, int line)
+{
+    h_drain(d);
+    h_rx(d, (uint16_t)(0x600u + d->node->node_id), req);
+    h_expect(d, (uint16_t)(0x580u + d->node->node_id), resp, file, line);
+}
+
+long long h_read(h_dev_t *d, uint16_t index, uint8_t sub)
+{
+    h_drain(d);
+    co_frame_t f = {.id = (uint16_t)(0x600u + d->node->node_id), .dlc = 8,
+                    .data = {0x40, (uint8_t)index, (uint8_t)(index >> 8), sub}};
+    h_rx_frame(d, &f);
+    const co_frame_t *r = h_next(d);
+    if (r == NULL || r->data[0] == 0x80u) {
+        return -1;
+    }
+    unsigned size = 4u - ((r->data[0] >> 2) & 3u);
+    uint32_t v = co_get_u32(&r->data[4]);
+    if (size < 4u) {
+        v &= (1u << (8u * size)) - 1u;
+    }
+    return (long long)v;
+}

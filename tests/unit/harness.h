@@ -1,0 +1,122 @@
+/*
+ * harness.h - unit-test harness: checks, a fake port and a virtual clock.
+ *
+ * The fake port records every frame the node sends and emulates an EEPROM
+ * that can be told to lose power after a given number of written bytes.
+ * Tests drive time explicitly (h_advance), so every timing is exact.
+ */
+#ifndef HARNESS_H
+#define HARNESS_H
+
+#include <stdio.h>
+#include <string.h>
+
+#include "co_node.h"
+#include "product.h"
+
+extern int h_failures;
+extern int h_checks;
+
+#define CHECK(cond)                                                                     \
+    do {                                                                                \
+        h_checks++;                                                                     \
+        if (!(cond)) {                                                                  \
+            h_failures++;                                                               \
+            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond);    \
+        }                                                                               \
+    } while (0)
+
+#define CHECK_EQ(a, b)                                                                  \
+    do {                                                                                \
+        long long a_ = (long long)(a), b_ = (long long)(b);                             \
+        h_checks++;                                                                     \
+        if (a_ != b_) {                                                                 \
+            h_failures++;                                                               \
+            fprintf(stderr, "%s:%d: %s == %lld, expected %s == %lld\n", __FILE__,       \
+                    __LINE__, #a, a_, #b, b_);                                          \
+        }                                                                               \
+    } while (0)
+
+/* Runs one test function and reports it. */
+#define RUN(fn)                                                                         \
+    do {                                                                                \
+        int before_ = h_failures;                                                       \
+        fn();                                                                           \
+        printf("%s %s\n", h_failures == before_ ? "ok  " : "FAIL", #fn);                \
+        h_tests++;                                                                      \
+        if (h_failures != before_) {                                                    \
+            h_failed_tests++;                                                           \
+        }                                                                               \
+    } while (0)
+
+extern int h_tests;
+extern int h_failed_tests;
+
+/* Prints "N passed, M failed" and returns the exit status. */
+int h_finish(void);
+
+#define FAKE_TX_MAX 4096u
+#define FAKE_NVM_SIZE 2048u
+
+typedef struct fake_port {
+    co_frame_t tx[FAKE_TX_MAX];
+    unsigned ntx;      /* frames sent */
+    unsigned rd;       /* frames consumed by h_next() */
+    bool tx_full;      /* co_port_can_send() refuses */
+    uint8_t nvm[FAKE_NVM_SIZE];
+    long cut_after;    /* bytes that may still be written; -1 = no power cut */
+    unsigned nvm_writes;
+    bool nvm_read_fails;
+} fake_port_t;
+
+void fake_port_init(fake_port_t *p);
+
+/* A product under test: its memory, port, node and virtual clock. */
+typedef struct h_dev {
+    _Alignas(max_align_t) unsigned char mem[PRODUCT_INST_MAX];
+    const product_t *prod;
+    fake_port_t port;
+    co_node_t *node;
+    uint32_t now;          /* virtual time, us */
+    uint32_t next_sample;  /* time of the next sensor sample */
+    int32_t truth[PRODUCT_MAX_INPUTS]; /* true inputs, milli-units */
+    bool fault;
+} h_dev_t;
+
+/* Create (port and NVM fresh unless keep_nvm) and power on. */
+void h_boot(h_dev_t *d, const product_t *p, bool keep_nvm);
+/* Power cycle: keep the NVM, rebuild everything else. */
+void h_power_cycle(h_dev_t *d);
+
+/* Advance virtual time by us, sampling the sensor and polling as a board does. */
+void h_advance(h_dev_t *d, uint32_t us);
+
+/* Deliver a frame: data as hex bytes "2B 00 18 05 14 00 00 00". */
+void h_rx(h_dev_t *d, uint16_t id, const char *hex);
+void h_rx_frame(h_dev_t *d, const co_frame_t *f);
+
+/* Next unread sent frame, or NULL. */
+const co_frame_t *h_next(h_dev_t *d);
+/* Drop every unread sent frame. */
+void h_drain(h_dev_t *d);
+/* Unread sent frames. */
+unsigned h_pending(const h_dev_t *d);
+
+/* Check the next sent frame against id and hex bytes (DLC = byte count). */
+#define EXPECT(d, id, hex) h_expect((d), (id), (hex), __FILE__, __LINE__)
+void h_expect(h_dev_t *d, uint16_t id, const char *hex, const char *file, int line);
+/* Check that nothing more was sent. */
+#define EXPECT_NONE(d) h_expect_none((d), __FILE__, __LINE__)
+void h_expect_none(h_dev_t *d, const char *file, int line);
+
+/* SDO request to the node, expect this exact response. */
+#define SDO(d, req, resp) h_sdo((d), (req), (resp), __FILE__, __LINE__)
+void h_sdo(h_dev_t *d, const char *req, const char *resp, const char *file, int line);
+
+/* Read a numeric object through SDO (expedited); -1 on abort. */
+long long h_read(h_dev_t *d, uint16_t index, uint8_t sub);
+
+/* Parse hex bytes; returns count. */
+unsigned h_hex(const char *hex, uint8_t *out, unsigned cap);
+
+#endif /* HARNESS_H */

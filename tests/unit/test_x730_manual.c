@@ -1,0 +1,542 @@
+/*
+ * test_x730_manual.c - every CAN exchange of the DST X730 manual, as listed
+ * in shared/specs/danfoss-dst-x730.md section 4 (N, H, P, E vectors), and
+ * the spec's derived vectors (D). Node-ID 0x7F as in the manual.
+ *
+ * Where the manual's bytes are wrong the corrected bytes are tested and the
+ * line says so (C-n: the spec's contradiction number).
+ */
+#include "dst.h"
+#include "harness.h"
+
+static h_dev_t dev;
+static h_dev_t *const d = &dev;
+
+#define SAVE() SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00")
+
+static void boot(const product_t *p)
+{
+    h_boot(d, p, false);
+    EXPECT(d, 0x77F, "00"); /* D1: boot-up */
+    EXPECT_NONE(d);
+}
+
+/* Start, let the filter settle on the true angle, keep only what follows. */
+static void operational_settled(void)
+{
+    h_rx(d, 0x000, "01 7F");
+    h_advance(d, 3000000);
+    h_drain(d);
+}
+
+/* The next TPDO1 (waits up to one event period). */
+static void expect_tpdo(const char *hex, int line)
+{
+    h_advance(d, 100000);
+    const co_frame_t *f = NULL;
+    const co_frame_t *g;
+    while ((g = h_next(d)) != NULL) {
+        if (g->id == 0x1FF) {
+            f = g;
+        }
+    }
+    h_checks++;
+    uint8_t want[8];
+    unsigned n = h_hex(hex, want, 8);
+    if (f == NULL || f->dlc != n || memcmp(f->data, want, n) != 0) {
+        h_failures++;
+        fprintf(stderr, "test_x730_manual.c:%d: TPDO1 differs from %s\n", line, hex);
+        if (f != NULL) {
+            fprintf(stderr, "    got %02X %02X %02X %02X %02X %02X %02X %02X\n", f->data[0],
+                    f->data[1], f->data[2], f->data[3], f->data[4], f->data[5], f->data[6],
+                    f->data[7]);
+        }
+    }
+}
+#define EXPECT_TPDO(hex) expect_tpdo((hex), __LINE__)
+
+/* ---- 4.1 NMT and heartbeat --------------------------------------------- */
+
+static void test_nmt_n1_to_n5(void)
+{
+    boot(&dst_x730_xy30);
+    SDO(d, "2B 17 10 00 E8 03 00 00", "60 17 10 00 00 00 00 00"); /* D11 */
+    h_advance(d, 1000000);
+    EXPECT(d, 0x77F, "7F"); /* D2: heartbeat in pre-operational */
+    h_rx(d, 0x000, "01 7F"); /* N1 */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
+    h_drain(d);
+    h_advance(d, 1000000);
+    const co_frame_t *f;
+    bool seen = false;
+    while ((f = h_next(d)) != NULL) {
+        if (f->id == 0x77F) {
+            CHECK_EQ(f->data[0], 0x05); /* D2: operational */
+            seen = true;
+        }
+    }
+    CHECK(seen);
+    h_rx(d, 0x000, "02 7F"); /* N2 */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_STOPPED);
+    h_drain(d);
+    h_advance(d, 1000000);
+    EXPECT(d, 0x77F, "04"); /* D2: stopped; no TPDO in stopped */
+    EXPECT_NONE(d);
+    h_rx(d, 0x000, "80 7F"); /* N3 */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
+    h_rx(d, 0x000, "82 7F"); /* N5: reset communication */
+    EXPECT(d, 0x77F, "00");
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
+    h_rx(d, 0x000, "81 7F"); /* N4: reset node, unsaved heartbeat lost */
+    EXPECT(d, 0x77F, "00");
+    h_drain(d);
+    h_advance(d, 3000000);
+    EXPECT_NONE(d);
+}
+
+/* ---- 4.2 TPDO examples, resolution 0.01 deg, little-endian ------------- */
+
+static void set_res_001(void)
+{
+    SDO(d, "2B 00 60 00 0A 00 00 00", "60 00 60 00 00 00 00 00");
+}
+
+static void test_tpdo_p1_to_p6(void)
+{
+    boot(&dst_x730_xy90);
+    set_res_001();
+    operational_settled();
+    EXPECT_TPDO("00 00 00 00 00 00 00 00"); /* P1 */
+    d->truth[0] = 45000;
+    h_advance(d, 3000000);
+    EXPECT_TPDO("94 11 00 00 00 00 00 00"); /* P2 */
+    d->truth[0] = -45000;
+    h_advance(d, 3000000);
+    /* P3: the manual prints 6B EE (its "value - 65535" rule, C-1); INTEGER16
+     * two's complement of -4500 is 6C EE. */
+    EXPECT_TPDO("6C EE 00 00 00 00 00 00");
+    d->truth[0] = 0;
+    h_advance(d, 3000000);
+    EXPECT_TPDO("00 00 00 00 00 00 00 00"); /* P4 */
+    d->truth[1] = 45000;
+    h_advance(d, 3000000);
+    EXPECT_TPDO("00 00 94 11 00 00 00 00"); /* P5 */
+    d->truth[1] = -45000;
+    h_advance(d, 3000000);
+    EXPECT_TPDO("00 00 6C EE 00 00 00 00"); /* P6: manual 6B EE, corrected (C-1) */
+}
+
+static void test_tpdo_p7_to_p10_z360(void)
+{
+    boot(&dst_x730_z360);
+    set_res_001();
+    d->truth[0] = -180000;
+    operational_settled();
+    /* P7: manual AF B9 (C-1); -18000 is B0 B9. */
+    EXPECT_TPDO("B0 B9 00 00 00 00 00 00");
+    d->truth[0] = -90000;
+    h_advance(d, 3000000);
+    EXPECT_TPDO("D8 DC 00 00 00 00 00 00"); /* P8: manual D7 DC, corrected (C-1) */
+    d->truth[0] = 0;
+    h_advance(d, 3000000);
+    EXPECT_TPDO("00 00 00 00 00 00 00 00"); /* P9 */
+    d->truth[0] = 90000;
+    h_advance(d, 3000000);
+    EXPECT_TPDO("28 23 00 00 00 00 00 00"); /* P10 */
+    /* Past +180 the single axis wraps to the negative side. */
+    d->truth[0] = 190000;
+    h_advance(d, 4000000);
+    EXPECT_TPDO("98 BD 00 00 00 00 00 00"); /* -170.00 = -17000 */
+}
+
+/* ---- 4.3 SDO examples 1..13 -------------------------------------------- */
+
+static void test_e1_bitrate(void)
+{
+    boot(&dst_x730_xy30);
+    SDO(d, "2F F2 20 00 02 00 00 00", "60 F2 20 00 00 00 00 00"); /* E1.1/E1.2 */
+    SDO(d, "2F F3 20 00 02 00 00 00", "60 F3 20 00 00 00 00 00"); /* E1.3/E1.4 */
+    dst_dev_t *x = (dst_dev_t *)d->mem;
+    CHECK_EQ(x->lss.bitrate, 2);
+    h_power_cycle(d); /* no "save" needed (B-50) */
+    EXPECT(d, 0x77F, "00");
+    x = (dst_dev_t *)d->mem;
+    CHECK_EQ(x->lss.bitrate, 2);
+    CHECK_EQ(h_read(d, 0x20F2, 0), 2);
+    CHECK_EQ(h_read(d, 0x20F3, 0), 2);
+}
+
+static void test_e2_node_id(void)
+{
+    boot(&dst_x730_xy30);
+    SDO(d, "2F F0 20 00 06 00 00 00", "60 F0 20 00 00 00 00 00"); /* E2.1/E2.2 */
+    SDO(d, "2F F1 20 00 06 00 00 00", "60 F1 20 00 00 00 00 00"); /* E2.3/E2.4 */
+    CHECK_EQ(d->node->node_id, 0x7F); /* old ID until reset (B-44) */
+    h_power_cycle(d);
+    EXPECT(d, 0x706, "00"); /* boot-up on the new ID */
+    CHECK_EQ(d->node->node_id, 6);
+    h_drain(d);
+    h_rx(d, 0x606, "40 00 12 01 00 00 00 00");
+    EXPECT(d, 0x586, "43 00 12 01 06 06 00 00"); /* SDO COB-ID follows (B-45) */
+    h_rx(d, 0x606, "40 14 10 00 00 00 00 00");
+    EXPECT(d, 0x586, "43 14 10 00 86 00 00 00"); /* EMCY COB-ID follows */
+    h_rx(d, 0x606, "40 00 18 01 00 00 00 00");
+    EXPECT(d, 0x586, "43 00 18 01 86 01 00 00"); /* TPDO COB-ID follows */
+    CHECK_EQ(h_read(d, 0x20F0, 0), 6);
+    /* Copies that differ commit nothing. */
+    SDO(d, "2F F0 20 00 09 00 00 00", "60 F0 20 00 00 00 00 00");
+    h_power_cycle(d);
+    EXPECT(d, 0x706, "00");
+}
+
+static void test_e3_event_timer(void)
+{
+    boot(&dst_x730_xy30);
+    SDO(d, "2B 00 18 05 14 00 00 00", "60 00 18 05 00 00 00 00"); /* E3.1/E3.2 */
+    SAVE();                                                        /* E3.3/E3.4 */
+    h_power_cycle(d);
+    h_drain(d);
+    h_rx(d, 0x000, "01 7F");
+    h_advance(d, 1000000 - 1);
+    unsigned n = 0;
+    const co_frame_t *f;
+    while ((f = h_next(d)) != NULL) {
+        n += f->id == 0x1FF;
+    }
+    CHECK_EQ(n, 50); /* 20 ms period: 50 in one second, the first at once */
+}
+
+static void test_e4_autostart(void)
+{
+    boot(&dst_x730_xy30);
+    SDO(d, "2F 00 50 00 01 00 00 00", "60 00 50 00 00 00 00 00"); /* E4.1/E4.2 */
+    SAVE();
+    h_power_cycle(d);
+    EXPECT(d, 0x77F, "00"); /* boot-up first */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
+    h_advance(d, 1);
+    EXPECT(d, 0x1FF, "00 00 00 00 00 00 00 00"); /* TPDO without NMT start */
+    SDO(d, "2F 00 50 00 02 00 00 00", "80 00 50 00 31 00 09 06"); /* B-12: > 1 */
+}
+
+static void test_e5_e6_preset_xy(void)
+{
+    boot(&dst_x730_xy30);
+    set_res_001();
+    d->truth[0] = 12340;
+    d->truth[1] = -5000;
+    operational_settled();
+    EXPECT_TPDO("D2 04 0C FE 00 00 00 00");
+    SDO(d, "2B 12 60 00 00 00 00 00", "60 12 60 00 00 00 00 00"); /* E5.1/E5.2 */
+    EXPECT_TPDO("00 00 0C FE 00 00 00 00");                      /* immediate */
+    /* E6.1: the manual prints CMD 28h (C-11); 2B is the 2-byte download. */
+    SDO(d, "2B 22 60 00 00 00 00 00", "60 22 60 00 00 00 00 00");
+    EXPECT_TPDO("00 00 00 00 00 00 00 00");
+    SAVE();
+    h_power_cycle(d);
+    h_rx(d, 0x000, "01 7F");
+    h_advance(d, 3000000);
+    EXPECT_TPDO("00 00 00 00 00 00 00 00"); /* the zero point survived */
+    d->truth[0] = 13340;
+    h_advance(d, 3000000);
+    EXPECT_TPDO("64 00 00 00 00 00 00 00"); /* +1.00 deg from the zero point */
+}
+
+static void test_e7_e8_z_preset_and_direction(void)
+{
+    boot(&dst_x730_z360);
+    set_res_001();
+    d->truth[0] = 30000;
+    operational_settled();
+    SDO(d, "2B 12 60 00 00 00 00 00", "60 12 60 00 00 00 00 00"); /* E7.1/E7.2 */
+    SAVE();
+    EXPECT_TPDO("00 00 00 00 00 00 00 00");
+    d->truth[0] = 40000;
+    h_advance(d, 3000000);
+    EXPECT_TPDO("E8 03 00 00 00 00 00 00"); /* +10.00 clockwise */
+    SDO(d, "2F 11 60 00 03 00 00 00", "60 11 60 00 00 00 00 00"); /* E8.1/E8.2 */
+    SAVE();                                                        /* E8.3/E8.4 */
+    /* Inverted: -m + offset where offset = -3000 from the preset: -7000. */
+    EXPECT_TPDO("A8 E4 00 00 00 00 00 00");
+}
+
+static void test_e9_resolution(void)
+{
+    boot(&dst_x730_xy30);
+    d->truth[0] = 10000;
+    operational_settled();
+    EXPECT_TPDO("C8 00 00 00 00 00 00 00"); /* 10 deg at 0.05 = 200 (D18 style) */
+    SDO(d, "2B 14 60 00 05 00 00 00", "60 14 60 00 00 00 00 00");
+    SDO(d, "2B 00 60 00 0A 00 00 00", "60 00 60 00 00 00 00 00"); /* E9.1/E9.2 */
+    CHECK_EQ(h_read(d, 0x6014, 0), 0); /* offsets cleared (B-71) */
+    SAVE();
+    EXPECT_TPDO("E8 03 00 00 00 00 00 00"); /* 1000 at 0.01 */
+    h_power_cycle(d);
+    CHECK_EQ(h_read(d, 0x6000, 0), 10);
+}
+
+static void test_e10_filter_after_save(void)
+{
+    boot(&dst_x730_xy30);
+    dst_dev_t *x = (dst_dev_t *)d->mem;
+    SDO(d, "2F 01 20 00 02 00 00 00", "60 01 20 00 00 00 00 00");
+    CHECK_EQ(x->filter_active, 0); /* not yet: only after STORE (B-81) */
+    CHECK_EQ(h_read(d, 0x2001, 0), 2);
+    SAVE();
+    CHECK_EQ(x->filter_active, 2);
+    SDO(d, "2F 01 20 00 00 00 00 00", "60 01 20 00 00 00 00 00"); /* E10.1/E10.2 */
+    CHECK_EQ(x->filter_active, 2);
+    SAVE(); /* E10.3/E10.4 */
+    CHECK_EQ(x->filter_active, 0);
+    SDO(d, "2F 01 20 00 03 00 00 00", "80 01 20 00 31 00 09 06"); /* > 2 */
+}
+
+static void test_e11_restore_defaults(void)
+{
+    boot(&dst_x730_xy30);
+    SDO(d, "2B 00 18 05 14 00 00 00", "60 00 18 05 00 00 00 00");
+    SDO(d, "2F F0 20 00 06 00 00 00", "60 F0 20 00 00 00 00 00");
+    SDO(d, "2F F1 20 00 06 00 00 00", "60 F1 20 00 00 00 00 00");
+    SAVE();
+    h_power_cycle(d);
+    EXPECT(d, 0x706, "00");
+    h_drain(d);
+    h_rx(d, 0x606, "23 11 10 01 6C 6F 61 64"); /* E11.1 */
+    EXPECT(d, 0x586, "60 11 10 01 00 00 00 00"); /* E11.2 */
+    h_rx(d, 0x606, "40 00 18 05 00 00 00 00");
+    EXPECT(d, 0x586, "4B 00 18 05 14 00 00 00"); /* RAM unchanged until reset */
+    h_rx(d, 0x000, "81 06");
+    EXPECT(d, 0x77F, "00"); /* PARA and LSS-PARA back to defaults (C-5) */
+    CHECK_EQ(h_read(d, 0x1800, 5), 100);
+    CHECK_EQ(h_read(d, 0x1011, 1), 1);
+    SDO(d, "23 11 10 01 6C 6F 61 65", "80 11 10 01 20 00 00 08"); /* wrong signature */
+}
+
+static void test_e12_event_timer_off(void)
+{
+    boot(&dst_x730_xy30);
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* E12.1/E12.2 */
+    SAVE();                                                        /* E12.3/E12.4 */
+    h_rx(d, 0x000, "01 7F");
+    h_drain(d);
+    h_advance(d, 2000000);
+    EXPECT_NONE(d); /* asynchronous TPDO inactive */
+}
+
+static void test_e13_sync(void)
+{
+    boot(&dst_x730_xy30);
+    SDO(d, "2F 00 18 02 01 00 00 00", "60 00 18 02 00 00 00 00"); /* E13.1/E13.2 */
+    SAVE();                                                        /* E13.3/E13.4 */
+    h_rx(d, 0x000, "01 7F");
+    h_drain(d);
+    h_advance(d, 500000);
+    EXPECT_NONE(d); /* no event-timer PDO in synchronous mode (B-61) */
+    h_rx(d, 0x080, "");
+    EXPECT(d, 0x1FF, "00 00 00 00 00 00 00 00");
+    h_rx(d, 0x080, "");
+    EXPECT(d, 0x1FF, "00 00 00 00 00 00 00 00");
+    SDO(d, "2F 00 18 02 03 00 00 00", "60 00 18 02 00 00 00 00"); /* every 3rd */
+    h_rx(d, 0x080, "");
+    h_rx(d, 0x080, "");
+    EXPECT_NONE(d);
+    h_rx(d, 0x080, "");
+    EXPECT(d, 0x1FF, "00 00 00 00 00 00 00 00");
+    h_rx(d, 0x000, "80 7F");
+    h_rx(d, 0x080, "");
+    h_rx(d, 0x080, "");
+    h_rx(d, 0x080, "");
+    EXPECT_NONE(d); /* no PDO outside operational */
+}
+
+/* ---- 4.4 derived vectors ----------------------------------------------- */
+
+static void test_derived_reads(void)
+{
+    boot(&dst_x730_xy30);
+    SDO(d, "40 00 10 00 00 00 00 00", "43 00 10 00 9A 01 08 00"); /* D3 */
+    SDO(d, "40 18 10 01 00 00 00 00", "43 18 10 01 93 00 00 00"); /* D4 */
+    SDO(d, "40 18 10 02 00 00 00 00", "43 18 10 02 64 00 00 00"); /* D5 */
+    SDO(d, "40 08 10 00 00 00 00 00", "47 08 10 00 47 49 42 00"); /* D6 */
+    SDO(d, "40 09 10 00 00 00 00 00", "43 09 10 00 31 2E 30 30");
+    SDO(d, "40 0A 10 00 00 00 00 00", "43 0A 10 00 31 2E 32 34"); /* D7 */
+    SDO(d, "40 00 60 00 00 00 00 00", "4B 00 60 00 32 00 00 00"); /* D8 */
+    SDO(d, "40 00 1A 02 00 00 00 00", "43 00 1A 02 10 00 20 60"); /* D9, C-4 */
+    SDO(d, "40 01 10 00 00 00 00 00", "4F 01 10 00 00 00 00 00");
+    SDO(d, "40 00 12 01 00 00 00 00", "43 00 12 01 7F 06 00 00");
+    SDO(d, "40 00 12 02 00 00 00 00", "43 00 12 02 FF 05 00 00");
+    SDO(d, "40 00 18 00 00 00 00 00", "4F 00 18 00 05 00 00 00");
+    SDO(d, "40 00 18 05 00 00 00 00", "4B 00 18 05 64 00 00 00");
+    SDO(d, "40 11 60 00 00 00 00 00", "4F 11 60 00 02 00 00 00"); /* C-3 */
+    SDO(d, "40 01 50 00 00 00 00 00", "4F 01 50 00 01 00 00 00");
+}
+
+static void test_derived_rejections(void)
+{
+    boot(&dst_x730_xy30);
+    SDO(d, "2B 17 10 00 0A 00 00 00", "80 17 10 00 30 00 09 06"); /* D10 */
+    SDO(d, "2B 17 10 00 13 00 00 00", "80 17 10 00 30 00 09 06"); /* 19 */
+    SDO(d, "2B 17 10 00 14 00 00 00", "60 17 10 00 00 00 00 00"); /* 20 */
+    SDO(d, "2B 17 10 00 E8 03 00 00", "60 17 10 00 00 00 00 00"); /* D11 */
+    SDO(d, "2B 00 18 05 03 00 00 00", "80 00 18 05 30 00 09 06"); /* D12 */
+    SDO(d, "2B 00 18 05 04 00 00 00", "60 00 18 05 00 00 00 00");
+    SDO(d, "2F 00 18 02 FF 00 00 00", "80 00 18 02 30 00 09 06"); /* D13 */
+    SDO(d, "2F 00 18 02 00 00 00 00", "80 00 18 02 30 00 09 06"); /* C-18 */
+    SDO(d, "2F 00 18 02 F1 00 00 00", "80 00 18 02 30 00 09 06");
+    SDO(d, "2F 00 18 02 FC 00 00 00", "80 00 18 02 30 00 09 06");
+    SDO(d, "2F 00 18 02 FD 00 00 00", "80 00 18 02 30 00 09 06");
+    SDO(d, "2F 00 18 02 F0 00 00 00", "60 00 18 02 00 00 00 00");
+    /* D14/D15: the spec suggests 0x06090030 for every range error; CiA 301
+     * has the more precise "value too low" / "too high", used here. */
+    SDO(d, "2F F0 20 00 00 00 00 00", "80 F0 20 00 32 00 09 06"); /* D14 */
+    SDO(d, "2F F0 20 00 80 00 00 00", "80 F0 20 00 31 00 09 06");
+    SDO(d, "2F F2 20 00 08 00 00 00", "80 F2 20 00 31 00 09 06"); /* D15 */
+    SDO(d, "2B 00 60 00 14 00 00 00", "80 00 60 00 30 00 09 06"); /* D16 */
+    SDO(d, "2F 11 60 00 00 00 00 00", "60 11 60 00 00 00 00 00"); /* D17 */
+    SDO(d, "2B 00 60 00 64 00 00 00", "80 00 60 00 22 00 00 08");
+    SDO(d, "2F 11 60 00 04 00 00 00", "80 11 60 00 31 00 09 06"); /* > 3 */
+    SDO(d, "40 10 10 01 00 00 00 00", "80 10 10 01 01 00 01 06"); /* D25 */
+    SDO(d, "23 10 10 01 00 00 00 00", "80 10 10 01 20 00 00 08"); /* D26 */
+    SDO(d, "2B 10 10 01 73 61 00 00", "80 10 10 01 13 00 07 06"); /* B-54 length */
+    SDO(d, "23 00 10 00 00 00 00 00", "80 00 10 00 02 00 01 06"); /* ro */
+    SDO(d, "2B 10 60 00 00 00 00 00", "80 10 60 00 02 00 01 06"); /* slope ro */
+    SDO(d, "2F 01 40 00 00 00 00 00", "80 01 40 00 02 00 01 06");
+    SDO(d, "23 00 1A 02 10 00 20 60", "80 00 1A 02 02 00 01 06"); /* B-69 */
+    SDO(d, "40 00 18 04 00 00 00 00", "80 00 18 04 11 00 09 06"); /* C-19 */
+    SDO(d, "40 01 10 01 00 00 00 00", "80 01 10 01 11 00 09 06"); /* "1001h sub 1" */
+    SDO(d, "40 06 21 06 00 00 00 00", "80 06 21 06 00 00 02 06"); /* "2106h sub 6" */
+    SDO(d, "40 05 10 00 00 00 00 00", "80 05 10 00 00 00 02 06");
+    SDO(d, "2F 00 40 00 FF 00 00 00", "60 00 40 00 00 00 00 00"); /* 0x4000 0..255 */
+    SDO(d, "2F 01 50 00 02 00 00 00", "80 01 50 00 31 00 09 06");
+    SDO(d, "23 14 10 00 FF 00 00 40", "80 14 10 00 30 00 09 06"); /* bit 30 */
+    SDO(d, "22 01 20 00 01 00 00 00", "60 01 20 00 00 00 00 00"); /* B-39 */
+    SDO(d, "2B 01 20 00 01 00 00 00", "80 01 20 00 12 00 07 06"); /* length high */
+}
+
+static void test_derived_pdo_coding(void)
+{
+    boot(&dst_x730_xy90);
+    d->truth[0] = 45000;
+    operational_settled();
+    EXPECT_TPDO("84 03 00 00 00 00 00 00"); /* D18: 900 at 0.05 */
+    set_res_001();
+    SDO(d, "2F 01 50 00 00 00 00 00", "60 01 50 00 00 00 00 00");
+    EXPECT_TPDO("11 94 00 00 00 00 00 00"); /* D19: big-endian */
+}
+
+static void test_derived_preset_and_diff(void)
+{
+    boot(&dst_x730_xy30);
+    set_res_001();
+    d->truth[0] = 12340;
+    operational_settled();
+    SDO(d, "2B 12 60 00 00 00 00 00", "60 12 60 00 00 00 00 00"); /* D20 */
+    SDO(d, "40 13 60 00 00 00 00 00", "4B 13 60 00 2E FB 00 00");
+    EXPECT_TPDO("00 00 00 00 00 00 00 00");
+    SDO(d, "2B 14 60 00 64 00 00 00", "60 14 60 00 00 00 00 00"); /* D21 */
+    EXPECT_TPDO("64 00 00 00 00 00 00 00");
+    /* Scaling off: offsets no longer applied (CiA 410). */
+    SDO(d, "2F 11 60 00 00 00 00 00", "60 11 60 00 00 00 00 00");
+    EXPECT_TPDO("D2 04 00 00 00 00 00 00");
+}
+
+static void test_derived_limits_and_emcy(void)
+{
+    boot(&dst_x730_xy10);
+    set_res_001();
+    operational_settled();
+    d->truth[0] = 15000;
+    h_advance(d, 3000000);
+    /* D23 first: the EMCY goes out when the angle crosses the limit. */
+    const co_frame_t *f;
+    bool emcy = false;
+    while ((f = h_next(d)) != NULL) {
+        if (f->id == 0xFF) {
+            emcy = true;
+            CHECK(memcmp(f->data, "\x00\x10\x00\x00\x01\x00\x00\x00", 8) == 0); /* D23 */
+        }
+    }
+    CHECK(emcy);
+    EXPECT_TPDO("4C 04 00 00 00 00 00 00"); /* D22: stops at +11.00 */
+    CHECK_EQ(h_read(d, 0x4001, 0), 0x01);
+    CHECK_EQ(h_read(d, 0x1001, 0), 0x00); /* C-14 */
+    bool g;
+    bool r;
+    uint32_t nx;
+    co_node_leds(d->node, d->now, &g, &r, &nx);
+    CHECK(g && r); /* both LEDs on: limit angles reached */
+    d->truth[0] = 5000;
+    h_advance(d, 3000000);
+    emcy = false;
+    while ((f = h_next(d)) != NULL) {
+        if (f->id == 0xFF) {
+            emcy = true;
+            CHECK(memcmp(f->data, "\0\0\0\0\0\0\0\0", 8) == 0); /* D24 */
+        }
+    }
+    CHECK(emcy);
+    CHECK_EQ(h_read(d, 0x4001, 0), 0x00);
+    /* Negative side, the +-90 variant stops at -87 (C-8). */
+    boot(&dst_x730_xy90);
+    set_res_001();
+    d->truth[1] = -89000;
+    operational_settled();
+    EXPECT_TPDO("00 00 04 DE 00 00 00 00"); /* -8700 */
+}
+
+static void test_error_behaviour(void)
+{
+    boot(&dst_x730_xy10);
+    SDO(d, "2F 00 40 00 02 00 00 00", "60 00 40 00 00 00 00 00"); /* stopped */
+    operational_settled();
+    d->fault = true;
+    h_advance(d, 100000);
+    CHECK_EQ(d->node->nmt.state, CO_NMT_STOPPED);
+    CHECK_EQ(((dst_dev_t *)d->mem)->errors, DST_ERR_SENSOR);
+    boot(&dst_x730_xy10);
+    SDO(d, "2F 00 40 00 00 00 00 00", "60 00 40 00 00 00 00 00"); /* pre-op */
+    operational_settled();
+    d->fault = true;
+    h_advance(d, 100000);
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
+    EXPECT(d, 0xFF, "00 10 00 00 01 00 00 00");
+}
+
+static void test_emcy_cobid(void)
+{
+    boot(&dst_x730_xy10);
+    SDO(d, "23 14 10 00 85 00 00 00", "60 14 10 00 00 00 00 00");
+    d->fault = true;
+    h_advance(d, 10000);
+    EXPECT(d, 0x85, "00 10 00 00 01 00 00 00");
+    SDO(d, "23 14 10 00 FF 00 00 80", "60 14 10 00 00 00 00 00"); /* disabled */
+    d->fault = false;
+    h_advance(d, 10000);
+    EXPECT_NONE(d);
+}
+
+int main(void)
+{
+    RUN(test_nmt_n1_to_n5);
+    RUN(test_tpdo_p1_to_p6);
+    RUN(test_tpdo_p7_to_p10_z360);
+    RUN(test_e1_bitrate);
+    RUN(test_e2_node_id);
+    RUN(test_e3_event_timer);
+    RUN(test_e4_autostart);
+    RUN(test_e5_e6_preset_xy);
+    RUN(test_e7_e8_z_preset_and_direction);
+    RUN(test_e9_resolution);
+    RUN(test_e10_filter_after_save);
+    RUN(test_e11_restore_defaults);
+    RUN(test_e12_event_timer_off);
+    RUN(test_e13_sync);
+    RUN(test_derived_reads);
+    RUN(test_derived_rejections);
+    RUN(test_derived_pdo_coding);
+    RUN(test_derived_preset_and_diff);
+    RUN(test_derived_limits_and_emcy);
+    RUN(test_error_behaviour);
+    RUN(test_emcy_cobid);
+    return h_finish();
+}
