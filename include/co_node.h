@@ -112,6 +112,12 @@ bool co_node_send(co_node_t *node, const co_frame_t *f);
 /* The board's view of the CAN controller (LEDs, diagnostics). */
 void co_node_set_can_state(co_node_t *node, co_can_state_t s);
 
+/* The patterns the two LEDs show now (CiA 303-3 mapping, product hook). */
+void co_node_led_patterns(co_node_t *node, co_led_pattern_t *green, co_led_pattern_t *red);
+
+/* Name of a pattern, for logs. */
+const char *co_led_pattern_name(co_led_pattern_t p);
+
 /*
  * LED levels at time now; *next_us receives the delay until either changes.
  */

@@ -105,7 +105,7 @@ void co_node_set_can_state(co_node_t *node, co_can_state_t s)
     node->can_state = (uint8_t)s;
 }
 
-void co_node_leds(co_node_t *node, uint32_t now, bool *green, bool *red, uint32_t *next_us)
+void co_node_led_patterns(co_node_t *node, co_led_pattern_t *green, co_led_pattern_t *red)
 {
     co_led_pattern_t g;
     co_led_pattern_t r;
@@ -139,6 +139,35 @@ void co_node_leds(co_node_t *node, uint32_t now, bool *green, bool *red, uint32_
     if (node->cfg->ops != NULL && node->cfg->ops->leds != NULL) {
         node->cfg->ops->leds(node, &g, &r);
     }
+    *green = g;
+    *red = r;
+}
+
+const char *co_led_pattern_name(co_led_pattern_t p)
+{
+    switch (p) {
+    case CO_LED_OFF:
+        return "off";
+    case CO_LED_ON:
+        return "on";
+    case CO_LED_FLICKER:
+        return "flickering";
+    case CO_LED_BLINK:
+        return "blinking";
+    case CO_LED_FLASH1:
+        return "single flash";
+    case CO_LED_FLASH2:
+        return "double flash";
+    default:
+        return "?";
+    }
+}
+
+void co_node_leds(co_node_t *node, uint32_t now, bool *green, bool *red, uint32_t *next_us)
+{
+    co_led_pattern_t g;
+    co_led_pattern_t r;
+    co_node_led_patterns(node, &g, &r);
     const co_led_timing_t *t = node->cfg->led != NULL ? node->cfg->led : &co_led_cia303;
     uint32_t ng;
     uint32_t nr;

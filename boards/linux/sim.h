@@ -1,0 +1,27 @@
+/*
+ * sim.h - the simulated physics, one command a line on standard input:
+ *   set NAME=VALUE [NAME=VALUE...]   true value of inputs (product's names)
+ *   fault sensor on|off              force a sensor error
+ *   quit                             stop the program
+ * A bad line gets a message on stderr and changes nothing.
+ */
+#ifndef LINUX_SIM_H
+#define LINUX_SIM_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "product.h"
+
+typedef struct sim {
+    const product_t *prod;
+    int32_t values[PRODUCT_MAX_INPUTS]; /* thousandths of the input's unit */
+    bool fault;
+    bool quit;
+} sim_t;
+
+/* Apply one line (without its newline). Returns false (and writes why to
+ * err, errlen bytes) if the line was rejected; nothing changed then. */
+bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen);
+
+#endif /* LINUX_SIM_H */
