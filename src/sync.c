@@ -15,6 +15,18 @@ void co_sync_reconfig(co_node_t *node)
     node->sync.cob_id = (uint16_t)(cob & 0x7FFu);
 }
 
+co_res_t co_sync_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+{
+    if ((value & 0xBFFFF800u) != 0u) {
+        return CO_E_VAL; /* 11-bit IDs only; bit 30 (we generate SYNC) not supported */
+    }
+    co_res_t r = co_od_store(node, e, value);
+    if (r == CO_OK) {
+        co_sync_reconfig(node);
+    }
+    return r;
+}
+
 bool co_sync_receive(co_node_t *node, const co_frame_t *f)
 {
     if (f->id != node->sync.cob_id || f->rtr) {

@@ -1,0 +1,440 @@
+/*
+ * test_stack.c - the portable stack against a test dictionary that uses
+ * every feature (long strings, writable PDO parameters, inhibit time,
+ * limits of signed and unsigned types), frame-exact, on a virtual clock.
+ */
+#include "dst.h"
+#include "harness.h"
+
+typedef struct t_para {
+    uint32_t sync_cob;
+    uint32_t emcy_cob;
+    uint16_t hb;
+    uint32_t cob[2];
+    uint8_t type[2];
+    uint16_t inhibit[2];
+    uint16_t event[2];
+    uint32_t u32;
+    int16_t i16;
+} t_para_t;
+
+typedef struct t_vol {
+    uint32_t scratch;
+    uint32_t counter;
+} t_vol_t;
+
+typedef struct t_dev {
+    co_node_t node;
+    t_para_t para;
+    t_vol_t vol;
+    co_lss_para_t lss;
+} t_dev_t;
+
+#define P(f) CO_AT(CO_CLS_PARA, t_para_t, f)
+#define V(f) CO_AT(CO_CLS_VOL, t_vol_t, f)
+#define TPW .write = co_tpdo_write_hook
+
+static const co_od_entry_t t_entries[] = {
+    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x12345678u},
+    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(sync_cob), .def = 0x80, .write = co_sync_write_hook},
+    {.index = 0x1008, .sub = 0, CO_TYPE_STR("A long device name for segmented transfer"), .attr = CO_A_R | CO_A_CONST},
+    {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = CO_A_W, .write = co_store_save_hook},
+    {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
+    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, .def = 1, .write = co_store_load_hook},
+    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, P(emcy_cob), .def = 0x80},
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(hb), .def = 0, .write = co_hb_write_hook},
+    {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 5},
+    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, TPW, P(cob[0]), .def = 0x180},
+    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = CO_A_RW, TPW, P(type[0]), .def = 254},
+    {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = CO_A_RW, TPW, P(inhibit[0]), .def = 0},
+    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = CO_A_RW, TPW, P(event[0]), .def = 100},
+    {.index = 0x1801, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 5},
+    {.index = 0x1801, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, TPW, P(cob[1]), .def = 0x280},
+    {.index = 0x1801, .sub = 2, CO_TYPE_U8, .attr = CO_A_RW, TPW, P(type[1]), .def = 1},
+    {.index = 0x1801, .sub = 3, CO_TYPE_U16, .attr = CO_A_RW, TPW, P(inhibit[1]), .def = 0},
+    {.index = 0x1801, .sub = 5, CO_TYPE_U16, .attr = CO_A_RW, TPW, P(event[1]), .def = 0},
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 2},
+    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21000020u},
+    {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, .def = 0x20010010u},
+    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
+    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x20020020u}, /* not mappable */
+    {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(u32), .def = 100, .min = 10, .max = 1000},
+    {.index = 0x2001, .sub = 0, CO_TYPE_I16, .attr = CO_A_RW | CO_A_PDO, P(i16), .def = (uint32_t)-5, .min = -100, .max = 100},
+    {.index = 0x2002, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, V(scratch), .def = 7},
+    {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, V(counter), .def = 0},
+};
+
+static const co_od_t t_od = {.entries = t_entries, .count = sizeof(t_entries) / sizeof(t_entries[0])};
+
+static const co_node_cfg_t t_cfg = {
+    .od = &t_od,
+    .ram_size = {0, sizeof(t_vol_t), sizeof(t_para_t), sizeof(co_lss_para_t)},
+    .default_node_id = 0x10,
+};
+
+static void t_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
+{
+    (void)p;
+    t_dev_t *t = mem;
+    memset(t, 0, sizeof(*t));
+    void *const ram[CO_CLS_COUNT] = {NULL, &t->vol, &t->para, &t->lss};
+    co_node_init(&t->node, &t_cfg, ports[0], t, ram, 0);
+    nodes[0] = &t->node;
+}
+
+static void t_sample(void *mem, const int32_t v[], bool fault)
+{
+    (void)v;
+    (void)fault;
+    ((t_dev_t *)mem)->vol.counter++;
+}
+
+static const product_t t_prod = {.id = "test", .inputs = {NULL}, .nodes = 1,
+                                 .inst_size = sizeof(t_dev_t), .create = t_create,
+                                 .sample = t_sample};
+
+static h_dev_t dev;
+static h_dev_t *const d = &dev;
+
+static void boot(void)
+{
+    h_boot(d, &t_prod, false);
+    EXPECT(d, 0x710, "00");
+}
+
+static void test_od_find(void)
+{
+    co_res_t r;
+    CHECK(co_od_find(&t_od, 0x1000, 0, &r) != NULL && r == CO_OK);
+    CHECK(co_od_find(&t_od, 0x1000, 1, &r) == NULL && r == CO_E_NO_SUB);
+    CHECK(co_od_find(&t_od, 0x1800, 4, &r) == NULL && r == CO_E_NO_SUB);
+    CHECK(co_od_find(&t_od, 0x1802, 0, &r) == NULL && r == CO_E_NO_OBJ);
+    CHECK(co_od_find(&t_od, 0x0000, 0, &r) == NULL && r == CO_E_NO_OBJ);
+    CHECK(co_od_find(&t_od, 0xFFFF, 0xFF, &r) == NULL && r == CO_E_NO_OBJ);
+    /* Every table of the product registry is sorted: the search relies on it. */
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        h_boot(d, product_list[i], false);
+        const co_od_t *od = d->node->cfg->od;
+        for (uint16_t k = 1; k < od->count; k++) {
+            uint32_t a = ((uint32_t)od->entries[k - 1].index << 8) | od->entries[k - 1].sub;
+            uint32_t b = ((uint32_t)od->entries[k].index << 8) | od->entries[k].sub;
+            CHECK(a < b);
+        }
+    }
+}
+
+static void test_sdo_expedited(void)
+{
+    boot();
+    SDO(d, "40 00 10 00 00 00 00 00", "43 00 10 00 78 56 34 12");
+    SDO(d, "40 01 20 00 00 00 00 00", "4B 01 20 00 FB FF 00 00"); /* -5 */
+    SDO(d, "2B 01 20 00 9C FF 00 00", "60 01 20 00 00 00 00 00"); /* -100 */
+    SDO(d, "2B 01 20 00 9B FF 00 00", "80 01 20 00 32 00 09 06"); /* -101 low */
+    SDO(d, "2B 01 20 00 65 00 00 00", "80 01 20 00 31 00 09 06"); /* 101 high */
+    SDO(d, "23 00 20 00 09 00 00 00", "80 00 20 00 32 00 09 06");
+    SDO(d, "23 00 20 00 E9 03 00 00", "80 00 20 00 31 00 09 06");
+    SDO(d, "23 00 20 00 E8 03 00 00", "60 00 20 00 00 00 00 00");
+    SDO(d, "22 00 20 00 0A 00 00 00", "60 00 20 00 00 00 00 00"); /* size not indicated */
+    CHECK_EQ(h_read(d, 0x2000, 0), 10);
+    SDO(d, "2F 00 20 00 0A 00 00 00", "80 00 20 00 13 00 07 06"); /* length too low */
+    SDO(d, "2B 02 10 00 00 00 00 00", "80 02 10 00 00 00 02 06");
+    SDO(d, "40 00 10 05 00 00 00 00", "80 00 10 05 11 00 09 06");
+    SDO(d, "A0 00 10 00 00 00 00 00", "80 00 10 00 01 00 04 05"); /* block upload */
+    SDO(d, "C0 00 10 00 00 00 00 00", "80 00 10 00 01 00 04 05"); /* block download */
+    SDO(d, "E0 00 10 00 00 00 00 00", "80 00 10 00 01 00 04 05");
+    SDO(d, "00 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05"); /* segment, none open */
+    /* Not 8 bytes: ignored. A client abort: no answer. */
+    h_drain(d);
+    h_rx(d, 0x610, "40 00 10 00");
+    h_rx(d, 0x610, "80 00 10 00 00 00 00 00");
+    EXPECT_NONE(d);
+    /* Another node's SDO is not ours. */
+    h_rx(d, 0x611, "40 00 10 00 00 00 00 00");
+    EXPECT_NONE(d);
+}
+
+static void test_sdo_segmented_upload(void)
+{
+    boot();
+    const char *name = "A long device name for segmented transfer"; /* 41 bytes */
+    SDO(d, "40 08 10 00 00 00 00 00", "41 08 10 00 29 00 00 00");
+    char got[64] = {0};
+    unsigned at = 0;
+    uint8_t toggle = 0;
+    for (int seg = 0; seg < 10; seg++) {
+        uint8_t req[8] = {(uint8_t)(0x60u | toggle)};
+        co_frame_t f = {.id = 0x610, .dlc = 8};
+        memcpy(f.data, req, 8);
+        h_drain(d);
+        h_rx_frame(d, &f);
+        const co_frame_t *r = h_next(d);
+        CHECK(r != NULL);
+        if (r == NULL) {
+            return;
+        }
+        CHECK_EQ(r->data[0] & 0x10u, toggle);
+        unsigned n = 7u - ((r->data[0] >> 1) & 7u);
+        memcpy(&got[at], &r->data[1], n);
+        at += n;
+        toggle ^= 0x10u;
+        if (r->data[0] & 1u) {
+            break;
+        }
+    }
+    CHECK_EQ(at, 41);
+    CHECK(strcmp(got, name) == 0);
+    /* Toggle error aborts with 0x05030000. */
+    SDO(d, "40 08 10 00 00 00 00 00", "41 08 10 00 29 00 00 00");
+    SDO(d, "60 00 00 00 00 00 00 00", "00 41 20 6C 6F 6E 67 20");
+    SDO(d, "60 00 00 00 00 00 00 00", "80 08 10 00 00 00 03 05");
+    /* SDO timeout: one second without the next segment request. */
+    SDO(d, "40 08 10 00 00 00 00 00", "41 08 10 00 29 00 00 00");
+    h_drain(d);
+    h_advance(d, 999000);
+    EXPECT_NONE(d);
+    h_advance(d, 2000);
+    EXPECT(d, 0x590, "80 08 10 00 00 00 04 05");
+}
+
+static void test_sdo_segmented_download(void)
+{
+    boot();
+    SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00");
+    SDO(d, "07 C8 00 00 00 00 00 00", "20 00 00 00 00 00 00 00"); /* 200, last (n=3) */
+    CHECK_EQ(h_read(d, 0x2000, 0), 200);
+    /* Two segments. */
+    SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00");
+    SDO(d, "0A 2C 01 00 00 00 00 00", "20 00 00 00 00 00 00 00"); /* 2 bytes, more */
+    SDO(d, "1B 00 00 00 00 00 00 00", "30 00 00 00 00 00 00 00"); /* 2 bytes, last */
+    CHECK_EQ(h_read(d, 0x2000, 0), 300);
+    /* Indicated size above the object: length too high, at once. */
+    SDO(d, "21 00 20 00 05 00 00 00", "80 00 20 00 12 00 07 06");
+    SDO(d, "21 00 20 00 02 00 00 00", "80 00 20 00 13 00 07 06");
+    /* Fewer bytes than the object: too low at the last segment. */
+    SDO(d, "20 00 20 00 00 00 00 00", "60 00 20 00 00 00 00 00");
+    SDO(d, "0B 01 02 00 00 00 00 00", "80 00 20 00 13 00 07 06");
+    /* Toggle wrong on the first segment. */
+    SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00");
+    SDO(d, "17 C8 00 00 00 00 00 00", "80 00 20 00 00 00 03 05");
+    /* Value out of range reported at the end. */
+    SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00");
+    SDO(d, "07 01 00 00 00 00 00 00", "80 00 20 00 32 00 09 06");
+    /* Read-only and constant objects refuse at initiate. */
+    SDO(d, "21 08 10 00 05 00 00 00", "80 08 10 00 02 00 01 06");
+    SDO(d, "21 00 21 00 04 00 00 00", "80 00 21 00 02 00 01 06");
+    CHECK_EQ(h_read(d, 0x2000, 0), 300);
+}
+
+static void test_nmt(void)
+{
+    boot();
+    h_rx(d, 0x000, "01 11"); /* another node */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
+    h_rx(d, 0x000, "01 10 00"); /* DLC 3 */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
+    h_rx(d, 0x000, "01");
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
+    h_rx(d, 0x000, "55 10"); /* unknown command */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
+    h_rx(d, 0x000, "01 00"); /* broadcast */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
+    h_rx(d, 0x000, "02 10");
+    CHECK_EQ(d->node->nmt.state, CO_NMT_STOPPED);
+}
+
+static void test_nmt_stopped_is_silent(void)
+{
+    boot();
+    h_rx(d, 0x000, "02 10");
+    h_drain(d);
+    h_rx(d, 0x610, "40 00 10 00 00 00 00 00");
+    h_advance(d, 1000000);
+    EXPECT_NONE(d); /* no SDO, no TPDO, no heartbeat (off) */
+    h_rx(d, 0x000, "80 10");
+    SDO(d, "40 00 10 00 00 00 00 00", "43 00 10 00 78 56 34 12");
+}
+
+static void test_reset_comm_keeps_application(void)
+{
+    boot();
+    SDO(d, "2B 17 10 00 64 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "23 02 20 00 09 00 00 00", "60 02 20 00 00 00 00 00"); /* volatile, app area */
+    SDO(d, "2B 01 20 00 03 00 00 00", "60 01 20 00 00 00 00 00"); /* PARA, app area */
+    h_rx(d, 0x000, "82 10");
+    EXPECT(d, 0x710, "00");
+    CHECK_EQ(h_read(d, 0x1017, 0), 0);   /* communication: back to stored */
+    CHECK_EQ(h_read(d, 0x2002, 0), 9);   /* application: untouched */
+    CHECK_EQ(h_read(d, 0x2001, 0), 3);
+    h_rx(d, 0x000, "81 10");
+    EXPECT(d, 0x710, "00");
+    CHECK_EQ(h_read(d, 0x2002, 0), 7);
+    CHECK_EQ(h_read(d, 0x2001, 0), -5 & 0xFFFF);
+}
+
+static void test_heartbeat_timing(void)
+{
+    boot();
+    SDO(d, "2B 17 10 00 32 00 00 00", "60 17 10 00 00 00 00 00"); /* 50 ms */
+    uint32_t t0 = d->now;
+    h_drain(d);
+    h_advance(d, 49999);
+    EXPECT_NONE(d);
+    h_advance(d, 1);
+    EXPECT(d, 0x710, "7F");
+    CHECK_EQ(d->now - t0, 50000);
+    h_advance(d, 50000);
+    EXPECT(d, 0x710, "7F");
+    SDO(d, "2B 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");
+    h_advance(d, 500000);
+    EXPECT_NONE(d);
+}
+
+static unsigned count_id(h_dev_t *x, uint16_t id)
+{
+    unsigned n = 0;
+    const co_frame_t *f;
+    while ((f = h_next(x)) != NULL) {
+        n += f->id == id;
+    }
+    return n;
+}
+
+static void test_tpdo_event_and_inhibit(void)
+{
+    boot();
+    h_rx(d, 0x000, "01 10");
+    h_advance(d, 0);
+    const co_frame_t *f = h_next(d);
+    CHECK(f != NULL && f->id == 0x190 && f->dlc == 6); /* 4 + 2 bytes, no padding */
+    if (f != NULL) {
+        CHECK_EQ(f->data[4], 0xFB); /* 0x2001 = -5 */
+        CHECK_EQ(f->data[5], 0xFF);
+    }
+    h_advance(d, 1000000 - 1);
+    CHECK_EQ(count_id(d, 0x190), 9); /* 100 ms period */
+    /* Event timer 10 ms with inhibit 25 ms (250 x 100 us): one per 25 ms. */
+    SDO(d, "2B 00 18 03 FA 00 00 00", "60 00 18 03 00 00 00 00");
+    SDO(d, "2B 00 18 05 0A 00 00 00", "60 00 18 05 00 00 00 00");
+    h_drain(d);
+    h_advance(d, 1000000);
+    unsigned n = count_id(d, 0x190);
+    CHECK(n >= 39 && n <= 41);
+    /* Disabled by COB-ID bit 31: silence. */
+    SDO(d, "23 00 18 01 90 01 00 80", "60 00 18 01 00 00 00 00");
+    h_drain(d);
+    h_advance(d, 300000);
+    CHECK_EQ(count_id(d, 0x190), 0);
+    /* COB-ID written as 0x180 + node-ID is stored as following the ID. */
+    SDO(d, "23 00 18 01 90 01 00 00", "60 00 18 01 00 00 00 00");
+    CHECK_EQ(((t_dev_t *)d->mem)->para.cob[0], 0x180);
+    SDO(d, "23 00 18 01 85 03 00 00", "60 00 18 01 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x1800, 1), 0x385);
+    h_drain(d);
+    h_advance(d, 100000);
+    CHECK(count_id(d, 0x385) >= 1);
+    /* Leaving operational stops them. */
+    h_rx(d, 0x000, "80 10");
+    h_drain(d);
+    h_advance(d, 500000);
+    EXPECT_NONE(d);
+}
+
+static void test_tpdo_sync_and_bad_mapping(void)
+{
+    boot();
+    /* TPDO2 maps a non-mappable object: it stays silent on SYNC. */
+    h_rx(d, 0x000, "01 10");
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00");
+    SDO(d, "2F 00 18 02 02 00 00 00", "60 00 18 02 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x080, "");
+    EXPECT_NONE(d);
+    h_rx(d, 0x080, "");
+    const co_frame_t *f = h_next(d);
+    CHECK(f != NULL && f->id == 0x190);
+    EXPECT_NONE(d);
+    /* A SYNC with a counter byte counts; with 2+ bytes it is not a SYNC. */
+    h_rx(d, 0x080, "01");
+    h_rx(d, 0x080, "01 02");
+    EXPECT_NONE(d);
+    h_rx(d, 0x080, "");
+    f = h_next(d);
+    CHECK(f != NULL && f->id == 0x190);
+    /* SYNC COB-ID from 0x1005, effective at once. */
+    SDO(d, "23 05 10 00 81 00 00 00", "60 05 10 00 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x080, "");
+    h_rx(d, 0x080, "");
+    EXPECT_NONE(d);
+    h_rx(d, 0x081, "");
+    h_rx(d, 0x081, "");
+    f = h_next(d);
+    CHECK(f != NULL && f->id == 0x190);
+}
+
+static void test_emcy(void)
+{
+    boot();
+    uint8_t m[5] = {1, 2, 3, 4, 5};
+    h_drain(d);
+    CHECK(co_emcy_send(d->node, 0x5530, 0x81, m));
+    EXPECT(d, 0x90, "30 55 81 01 02 03 04 05");
+    SDO(d, "23 14 10 00 90 00 00 80", "60 14 10 00 00 00 00 00");
+    CHECK(!co_emcy_send(d->node, 0x5530, 0x81, m));
+    EXPECT_NONE(d);
+    SDO(d, "23 14 10 00 A0 00 00 00", "60 14 10 00 00 00 00 00");
+    CHECK(co_emcy_send(d->node, 0x1000, 0x01, NULL));
+    EXPECT(d, 0xA0, "00 10 01 00 00 00 00 00");
+    h_rx(d, 0x000, "02 10");
+    CHECK(!co_emcy_send(d->node, 0x1000, 0x01, NULL)); /* not in stopped */
+}
+
+static void test_tx_full_is_counted(void)
+{
+    boot();
+    d->port.tx_full = true;
+    h_rx(d, 0x610, "40 00 10 00 00 00 00 00");
+    CHECK_EQ(d->node->tx_dropped, 1);
+    d->port.tx_full = false;
+    SDO(d, "40 00 10 00 00 00 00 00", "43 00 10 00 78 56 34 12");
+}
+
+static void test_two_nodes_one_process(void)
+{
+    static h_dev_t a;
+    static h_dev_t b;
+    h_boot(&a, &t_prod, false);
+    h_boot(&b, &dst_x730_xy30, false);
+    SDO(&a, "2B 17 10 00 64 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(&b, "2B 17 10 00 C8 00 00 00", "60 17 10 00 00 00 00 00");
+    CHECK_EQ(h_read(&a, 0x1017, 0), 100);
+    CHECK_EQ(h_read(&b, 0x1017, 0), 200);
+    h_rx(&a, 0x000, "01 10");
+    CHECK_EQ(a.node->nmt.state, CO_NMT_OPERATIONAL);
+    CHECK_EQ(b.node->nmt.state, CO_NMT_PREOP);
+    SDO(&a, "2B 01 20 00 05 00 00 00", "60 01 20 00 00 00 00 00");
+    SDO(&a, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_power_cycle(&b);
+    CHECK_EQ(h_read(&b, 0x1017, 0), 0); /* b's save never happened */
+    h_power_cycle(&a);
+    CHECK_EQ(h_read(&a, 0x2001, 0), 5);
+}
+
+int main(void)
+{
+    RUN(test_od_find);
+    RUN(test_sdo_expedited);
+    RUN(test_sdo_segmented_upload);
+    RUN(test_sdo_segmented_download);
+    RUN(test_nmt);
+    RUN(test_nmt_stopped_is_silent);
+    RUN(test_reset_comm_keeps_application);
+    RUN(test_heartbeat_timing);
+    RUN(test_tpdo_event_and_inhibit);
+    RUN(test_tpdo_sync_and_bad_mapping);
+    RUN(test_emcy);
+    RUN(test_tx_full_is_counted);
+    RUN(test_two_nodes_one_process);
+    return h_finish();
+}
