@@ -233,7 +233,10 @@ long long h_read(h_dev_t *d, uint16_t index, uint8_t sub)
     co_frame_t f = {.id = (uint16_t)(0x600u + d->node->node_id), .dlc = 8,
                     .data = {0x40, (uint8_t)index, (uint8_t)(index >> 8), sub}};
     h_rx_frame(d, &f);
-    const co_frame_t *r = h_next(d);
+    const co_frame_t *r;
+    while ((r = h_next(d)) != NULL && r->id != 0x580u + d->node->node_id) {
+        /* other traffic (EMCY, PDO) sent at the same time */
+    }
     if (r == NULL || r->data[0] == 0x80u) {
         return -1;
     }

@@ -1,0 +1,178 @@
+/*
+ * test_profile.c - the angle filter, the CiA 410 arithmetic and the LED
+ * patterns, on exact virtual time.
+ */
+#include "co_filter.h"
+#include "co_incl.h"
+#include "co_led.h"
+#include "dst.h"
+#include "harness.h"
+
+/* Settling time (ms) to within 1 LSB of 0.01 deg after a step. */
+static uint32_t settle_ms(uint8_t speed, int32_t from, int32_t to)
+{
+    co_filter_t f;
+    co_filter_reset(&f);
+    (void)co_filter_step(&f, from, co_filter_shift(speed));
+    uint32_t last_bad = 0;
+    for (uint32_t i = 1; i <= 2000; i++) {
+        int32_t y = co_filter_step(&f, to, co_filter_shift(speed));
+        if (y - to >= 10 || to - y >= 10) {
+            last_bad = i;
+        }
+    }
+    return last_bad * (CO_FILTER_PERIOD_US / 1000u);
+}
+
+static void test_filter_settling(void)
+{
+    uint32_t slow = settle_ms(0, 0, 90000);
+    uint32_t medium = settle_ms(1, 0, 90000);
+    uint32_t fast = settle_ms(2, 0, 90000);
+    printf("     settling to 0.01 deg after a 90 deg step: slow %u ms, medium %u ms, fast %u ms\n",
+           slow, medium, fast);
+    CHECK(slow >= 1700 && slow <= 2500);
+    CHECK(medium >= 400 && medium <= 650);
+    CHECK(fast >= 150 && fast <= 300);
+    /* Symmetric to a sample (the shifts floor toward minus infinity). */
+    uint32_t neg = settle_ms(0, 0, -90000);
+    CHECK(neg + 5u >= slow && neg <= slow + 5u);
+    /* No overshoot: the output never passes the target. */
+    co_filter_t f;
+    co_filter_reset(&f);
+    (void)co_filter_step(&f, 0, 2);
+    int32_t max = 0;
+    for (int i = 0; i < 400; i++) {
+        int32_t y = co_filter_step(&f, 45000, 2);
+        max = y > max ? y : max;
+    }
+    CHECK(max <= 45000);
+    CHECK_EQ(max, 45000);
+    /* First sample primes: no ramp from zero at power-on. */
+    co_filter_reset(&f);
+    CHECK_EQ(co_filter_step(&f, -12345, 5), -12345);
+}
+
+static void test_filter_through_the_device(void)
+{
+    static h_dev_t dv;
+    h_dev_t *d = &dv;
+    h_boot(d, &dst_x730_xy90, false);
+    SDO(d, "2B 00 60 00 0A 00 00 00", "60 00 60 00 00 00 00 00");
+    SDO(d, "2F 01 20 00 02 00 00 00", "60 01 20 00 00 00 00 00");
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_advance(d, 100000);
+    d->truth[0] = 10000;
+    h_advance(d, 100000);
+    long long mid = h_read(d, 0x6010, 0);
+    CHECK(mid > 100 && mid < 990); /* on its way after 0.1 s */
+    h_advance(d, 200000);
+    CHECK_EQ(h_read(d, 0x6010, 0), 1000); /* fast: settled after 0.3 s */
+}
+
+static void test_incl_arithmetic(void)
+{
+    co_incl_para_t p = {.resolution = 50, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
+    co_incl_t in;
+    co_incl_init(&in, &p, 2, 0, false);
+    int32_t a[2] = {1024, -1025}; /* 20.48 and -20.5 LSB of 0.05 */
+    co_incl_sample(&in, a);
+    CHECK_EQ(co_incl_slope(&in, 0), 20);
+    CHECK_EQ(co_incl_slope(&in, 1), -21); /* half away from zero */
+    CHECK_EQ(co_div_round(25, 50), 1);
+    CHECK_EQ(co_div_round(-25, 50), -1);
+    CHECK_EQ(co_div_round(24, 50), 0);
+    p.op[0] |= CO_INCL_OP_INVERT;
+    CHECK_EQ(co_incl_slope(&in, 0), -20);
+    co_incl_set_preset(&in, 0, 100);
+    CHECK_EQ(p.offset[0], 120);
+    CHECK_EQ(co_incl_slope(&in, 0), 100);
+    p.diff[0] = 32767; /* clamped, not wrapped */
+    CHECK_EQ(co_incl_slope(&in, 0), 32767);
+    p.diff[0] = -32768;
+    p.offset[0] = -32768;
+    CHECK_EQ(co_incl_slope(&in, 0), -32768);
+    CHECK_EQ(co_incl_slope(&in, 5), 0); /* no such axis */
+    /* Same resolution: offsets kept. New one: cleared. */
+    p.diff[0] = 7;
+    CHECK_EQ(co_incl_set_resolution(&in, 50), CO_OK);
+    CHECK_EQ(p.diff[0], 7);
+    CHECK_EQ(co_incl_set_resolution(&in, 10), CO_OK);
+    CHECK_EQ(p.diff[0], 0);
+    CHECK_EQ(p.preset[0], 0);
+    CHECK_EQ(p.offset[0], 0);
+    p.op[1] = 0;
+    CHECK_EQ(co_incl_set_resolution(&in, 100), CO_E_STATE);
+    CHECK_EQ(p.resolution, 10);
+}
+
+static void test_incl_wrap(void)
+{
+    co_incl_para_t p = {.resolution = 10, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
+    co_incl_t in;
+    co_incl_init(&in, &p, 1, 0, true);
+    in.shift = co_filter_shift(2);
+    int32_t a[2] = {179000, 0};
+    co_incl_sample(&in, a);
+    CHECK_EQ(co_incl_slope(&in, 0), 17900);
+    /* Crossing +180 goes to -180 by the short way: never near 0 on the way. */
+    a[0] = -179000;
+    int16_t worst = 32767;
+    for (int i = 0; i < 200; i++) {
+        co_incl_sample(&in, a);
+        int16_t s = co_incl_slope(&in, 0);
+        int16_t mag = (int16_t)(s < 0 ? -s : s);
+        worst = mag < worst ? mag : worst;
+    }
+    CHECK(worst >= 17900);
+    CHECK_EQ(co_incl_slope(&in, 0), -17900);
+    a[0] = 540000; /* 540 = 180: the window is [-180, 180) */
+    for (int i = 0; i < 400; i++) {
+        co_incl_sample(&in, a);
+    }
+    CHECK_EQ(co_incl_slope(&in, 0), -18000);
+}
+
+static void test_led_patterns(void)
+{
+    const co_led_timing_t *t = &co_led_cia303;
+    uint32_t next;
+    CHECK(co_led_level(CO_LED_ON, t, 123, &next) && next == CO_NEVER);
+    CHECK(!co_led_level(CO_LED_OFF, t, 123, &next) && next == CO_NEVER);
+    CHECK(co_led_level(CO_LED_BLINK, t, 0, &next) && next == 200000);
+    CHECK(!co_led_level(CO_LED_BLINK, t, 250000, &next) && next == 150000);
+    CHECK(co_led_level(CO_LED_FLASH1, t, 100000, &next) && next == 100000);
+    CHECK(!co_led_level(CO_LED_FLASH1, t, 300000, &next) && next == 900000);
+    CHECK(co_led_level(CO_LED_FLASH2, t, 450000, &next));
+    CHECK(!co_led_level(CO_LED_FLASH2, t, 700000, &next) && next == 900000);
+    CHECK(co_led_level(CO_LED_FLICKER, t, 10000, &next) && next == 40000);
+    /* The DST's single flash: 500 ms on, 500 ms off (C-38). */
+    CHECK(co_led_level(CO_LED_FLASH1, &dst_led, 499000, &next) && next == 1000);
+    CHECK(!co_led_level(CO_LED_FLASH1, &dst_led, 500000, &next) && next == 500000);
+    /* Node state to pattern. */
+    static h_dev_t dv;
+    h_boot(&dv, &dst_x730_xy30, false);
+    co_led_pattern_t g;
+    co_led_pattern_t r;
+    co_node_led_patterns(dv.node, &g, &r);
+    CHECK(g == CO_LED_BLINK && r == CO_LED_OFF);
+    h_rx(&dv, 0x000, "02 7F");
+    co_node_set_can_state(dv.node, CO_CAN_WARNING);
+    co_node_led_patterns(dv.node, &g, &r);
+    CHECK(g == CO_LED_FLASH1 && r == CO_LED_FLASH1);
+    h_rx(&dv, 0x000, "01 7F");
+    co_node_set_can_state(dv.node, CO_CAN_BUSOFF);
+    co_node_led_patterns(dv.node, &g, &r);
+    CHECK(g == CO_LED_ON && r == CO_LED_ON);
+    CHECK(strcmp(co_led_pattern_name(CO_LED_FLASH1), "single flash") == 0);
+}
+
+int main(void)
+{
+    RUN(test_filter_settling);
+    RUN(test_filter_through_the_device);
+    RUN(test_incl_arithmetic);
+    RUN(test_incl_wrap);
+    RUN(test_led_patterns);
+    return h_finish();
+}
