@@ -20,8 +20,6 @@ IFACE = "vcan0"
 
 
 def pytest_sessionstart(session):
-    if not pathlib.Path("/sys/class/net", IFACE).exists():
-        pytest.exit(f"{IFACE} is not up: run these tests through tools/vcan-run", returncode=3)
     if not os.access(BINARY, os.X_OK):
         pytest.exit(f"{BINARY} is missing: build first (see README)", returncode=3)
 
@@ -118,6 +116,8 @@ class Bus(can.Listener):
 
 @pytest.fixture
 def network():
+    if not pathlib.Path("/sys/class/net", IFACE).exists():
+        pytest.fail(f"{IFACE} is not up: run these tests through tools/vcan-run")
     net = canopen.Network()
     net.connect(interface="socketcan", channel=IFACE)
     yield net

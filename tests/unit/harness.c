@@ -8,18 +8,6 @@
 #include "co_filter.h"
 #include "co_port.h"
 
-int h_failures;
-int h_checks;
-int h_tests;
-int h_failed_tests;
-
-int h_finish(void)
-{
-    printf("%d checks\n", h_checks);
-    printf("%d passed, %d failed\n", h_tests - h_failed_tests, h_failed_tests);
-    return h_failures == 0 ? 0 : 1;
-}
-
 /* ---- the fake port ------------------------------------------------- */
 
 void fake_port_init(fake_port_t *p)
