@@ -43,6 +43,16 @@ static void sdo_abort(co_node_t *node, const uint8_t *mux, co_res_t r)
     reply_head(node, 0x80, mux, co_res_abort_code(r));
 }
 
+/* Command byte placeholder and multiplexer of the transfer in progress,
+ * laid out like a request so that abort replies can echo it. */
+static void transfer_mux(const co_sdo_t *sdo, uint8_t mux[4])
+{
+    mux[0] = 0;
+    mux[1] = (uint8_t)sdo->e->index;
+    mux[2] = (uint8_t)(sdo->e->index >> 8);
+    mux[3] = sdo->e->sub;
+}
+
 static void start_timer(co_sdo_t *sdo)
 {
     sdo->restart = true;
@@ -99,7 +109,8 @@ static void initiate_download(co_node_t *node, const uint8_t *d)
 static void download_segment(co_node_t *node, const uint8_t *d)
 {
     co_sdo_t *sdo = &node->sdo;
-    uint8_t mux[4] = {0, (uint8_t)sdo->e->index, (uint8_t)(sdo->e->index >> 8), sdo->e->sub};
+    uint8_t mux[4];
+    transfer_mux(sdo, mux);
     if ((d[0] & 0x10u) != sdo->toggle) {
         sdo_abort(node, mux, CO_E_TOGGLE);
         return;
@@ -166,7 +177,8 @@ static void initiate_upload(co_node_t *node, const uint8_t *d)
 static void upload_segment(co_node_t *node, const uint8_t *d)
 {
     co_sdo_t *sdo = &node->sdo;
-    uint8_t mux[4] = {0, (uint8_t)sdo->e->index, (uint8_t)(sdo->e->index >> 8), sdo->e->sub};
+    uint8_t mux[4];
+    transfer_mux(sdo, mux);
     if ((d[0] & 0x10u) != sdo->toggle) {
         sdo_abort(node, mux, CO_E_TOGGLE);
         return;
@@ -210,19 +222,18 @@ bool co_sdo_receive(co_node_t *node, const co_frame_t *f)
         initiate_upload(node, d);
         break;
     case CCS_DOWNLOAD_SEGMENT:
-        if (sdo->state == SDO_DOWNLOAD) {
+    case CCS_UPLOAD_SEGMENT: {
+        /* A segment belongs to the transfer in progress, of the same direction. */
+        bool download = (d[0] >> 5) == CCS_DOWNLOAD_SEGMENT;
+        if (sdo->state != (download ? SDO_DOWNLOAD : SDO_UPLOAD)) {
+            sdo_abort(node, d, CO_E_CMD);
+        } else if (download) {
             download_segment(node, d);
         } else {
-            sdo_abort(node, d, CO_E_CMD);
-        }
-        break;
-    case CCS_UPLOAD_SEGMENT:
-        if (sdo->state == SDO_UPLOAD) {
             upload_segment(node, d);
-        } else {
-            sdo_abort(node, d, CO_E_CMD);
         }
         break;
+    }
     case CCS_ABORT:
         sdo->state = SDO_IDLE; /* the client gave up; no answer */
         break;
@@ -244,7 +255,8 @@ uint32_t co_sdo_poll(co_node_t *node, uint32_t now)
         sdo->deadline = now + CO_SDO_TIMEOUT_US;
     }
     if (!co_time_before(now, sdo->deadline)) {
-        uint8_t mux[4] = {0, (uint8_t)sdo->e->index, (uint8_t)(sdo->e->index >> 8), sdo->e->sub};
+        uint8_t mux[4];
+        transfer_mux(sdo, mux);
         sdo_abort(node, mux, CO_E_TIMEOUT);
         return CO_NEVER;
     }

@@ -86,32 +86,23 @@ class Bus(can.Listener):
         while not self.q.empty():
             self.q.get_nowait()
 
-    def wait_for(self, can_id, timeout=2.0, pred=None):
-        end = time.monotonic() + timeout
-        while True:
-            left = end - time.monotonic()
-            if left <= 0:
-                return None
+    def frames(self, seconds):
+        """Frames as they arrive, for at most this many seconds."""
+        end = time.monotonic() + seconds
+        while (left := end - time.monotonic()) > 0:
             try:
-                m = self.q.get(timeout=left)
+                yield self.q.get(timeout=left)
             except queue.Empty:
-                return None
+                return
+
+    def wait_for(self, can_id, timeout=2.0, pred=None):
+        for m in self.frames(timeout):
             if m.arbitration_id == can_id and (pred is None or pred(m)):
                 return m
+        return None
 
     def collect(self, can_id, seconds):
-        end = time.monotonic() + seconds
-        out = []
-        while True:
-            left = end - time.monotonic()
-            if left <= 0:
-                return out
-            try:
-                m = self.q.get(timeout=left)
-            except queue.Empty:
-                return out
-            if m.arbitration_id == can_id:
-                out.append(m)
+        return [m for m in self.frames(seconds) if m.arbitration_id == can_id]
 
 
 @pytest.fixture
