@@ -63,6 +63,7 @@ typedef struct co_node_cfg {
     uint8_t default_node_id;
     uint8_t default_bitrate;    /* product's code for its default bit rate */
     uint8_t tpdo_dlc;           /* 0: DLC = mapped bytes; 8: pad with zeros */
+    uint16_t inhibit_unit_us;   /* unit of 0x1800+n sub 3; 0: CiA 301's 100 us */
     uint32_t store_write_limit; /* 0: unlimited */
 } co_node_cfg_t;
 

@@ -6,7 +6,7 @@
  * of them through co_tpdo_write_hook) and cached here, with the mapped
  * entries resolved to table pointers so that sending is a straight copy.
  * Transmission types: 1..240 every n-th SYNC; 254/255 event-driven with the
- * event timer (ms) and inhibit time (100 us). Others are refused by the
+ * event timer (ms) and inhibit time (100 us, or the product's unit). Others are refused by the
  * dictionary's limits or the product's write hooks.
  */
 #ifndef CO_TPDO_H
@@ -27,7 +27,7 @@ typedef struct co_tpdo {
     bool inhibited;      /* waiting for the inhibit time to pass */
     uint16_t cob_id;
     uint16_t event_ms;
-    uint16_t inhibit_100us;
+    uint16_t inhibit;      /* inhibit time, in the product's unit (co_node_cfg_t) */
     uint32_t next_event;   /* time of the next event-timer send */
     uint32_t inhibit_end;  /* earliest time of the next send */
     const co_od_entry_t *map[CO_PDO_MAP_MAX];

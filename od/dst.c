@@ -135,7 +135,8 @@ static void dst_reset(co_node_t *n, co_reset_t kind)
     /* Both copies read the active values after a reset (B-46). */
     d->vol.id[0] = d->vol.id[1] = n->node_id;
     d->vol.br[0] = d->vol.br[1] = d->lss.bitrate;
-    n->pdo_msb_first = d->para.pdo_coding == 0u;
+    /* Big-endian PDOs only where 0x5001 exists and says so (the X710 has none). */
+    n->pdo_msb_first = co_node_entry(n, 0x5001, 0) != NULL && d->para.pdo_coding == 0u;
     n->autostart = d->para.autostart == 1u; /* B-11: after any reset */
     apply_filter(d);
     /* Errors are re-evaluated and re-reported after every boot-up. */

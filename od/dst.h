@@ -1,7 +1,7 @@
 /*
- * dst.h - the Danfoss DST inclinometer family (DST X730; X710 later).
+ * dst.h - the Danfoss DST inclinometer family: DST X730 and DST X710.
  * Behaviour shared by the family lives in dst.c; each model's dictionary
- * table in its own file (dst_x730.c).
+ * table in its own file (dst_x730.c, dst_x710.c).
  */
 #ifndef DST_H
 #define DST_H
@@ -31,11 +31,12 @@ typedef struct dst_para {
     uint32_t emcy_cobid;   /* 0x1014 */
     uint16_t hb_ms;        /* 0x1017 */
     uint16_t event_ms;     /* 0x1800 sub 5 */
+    uint16_t inhibit_ms;   /* 0x1800 sub 3, X710 only (X730: fixed 0) */
     uint8_t tx_type;       /* 0x1800 sub 2 */
     uint8_t filter;        /* 0x2001 */
     uint8_t err_behaviour; /* 0x4000 */
     uint8_t autostart;     /* 0x5000 */
-    uint8_t pdo_coding;    /* 0x5001: 0 big endian, 1 little endian */
+    uint8_t pdo_coding;    /* 0x5001 (X730 only): 0 big endian, 1 little endian */
     co_incl_para_t incl;   /* 0x6000..0x6024 */
 } dst_para_t;
 
@@ -75,10 +76,30 @@ co_res_t dst_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v);
 co_res_t dst_read_errors(co_node_t *n, const co_od_entry_t *e, uint32_t *v);
 co_res_t dst_read_slope(co_node_t *n, const co_od_entry_t *e, uint32_t *v);
 
-/* Node config of the DST X730 (its dictionary and hooks). */
+/* Node configs (dictionary and hooks) of the two models. */
 extern const co_node_cfg_t dst_x730_cfg;
+extern const co_node_cfg_t dst_x710_cfg;
 
 extern const product_t dst_x730_xy10, dst_x730_xy15, dst_x730_xy20, dst_x730_xy30,
     dst_x730_xy45, dst_x730_xy60, dst_x730_xy90, dst_x730_z360;
+extern const product_t dst_x710_xy10, dst_x710_xy15, dst_x710_xy20, dst_x710_xy30,
+    dst_x710_xy45, dst_x710_xy60, dst_x710_xy90, dst_x710_z360;
+
+/* The error limit of each variant; shared by both models (X710 C-8, X730 C-8). */
+#define DST_LIMIT_XY10 11000
+#define DST_LIMIT_XY15 16500
+#define DST_LIMIT_XY20 22000
+#define DST_LIMIT_XY30 33000
+#define DST_LIMIT_XY45 49500
+#define DST_LIMIT_XY60 66000
+#define DST_LIMIT_XY90 87000
+
+/* A product of the family: symbol, ID, description, variant, input names. */
+#define DST_PRODUCT(sym, idstr, text, var, ins)                                        \
+    const product_t sym = {.id = idstr, .summary = text, .inputs = ins, .units = "deg", \
+                           .nodes = 1, .inst_size = sizeof(dst_dev_t), .create = dst_create, \
+                           .sample = dst_sample, .variant = &(var)}
+#define DST_XY_INPUTS {"x", "y", NULL, NULL}
+#define DST_Z_INPUTS {"z", NULL, NULL, NULL}
 
 #endif /* DST_H */

@@ -98,23 +98,17 @@ const co_node_cfg_t dst_x730_cfg = {
 
 /* Error limits: 110 % of the range, but +-87 deg on the +-90 variant (C-8). */
 #define XY(lim) {.cfg = &dst_x730_cfg, .axes = 2, .wrap = false, .limit_mdeg = (lim)}
-static const dst_variant_t v_xy10 = XY(11000), v_xy15 = XY(16500), v_xy20 = XY(22000),
-                           v_xy30 = XY(33000), v_xy45 = XY(49500), v_xy60 = XY(66000),
-                           v_xy90 = XY(87000);
+static const dst_variant_t v_xy10 = XY(DST_LIMIT_XY10), v_xy15 = XY(DST_LIMIT_XY15),
+                           v_xy20 = XY(DST_LIMIT_XY20), v_xy30 = XY(DST_LIMIT_XY30),
+                           v_xy45 = XY(DST_LIMIT_XY45), v_xy60 = XY(DST_LIMIT_XY60),
+                           v_xy90 = XY(DST_LIMIT_XY90);
 static const dst_variant_t v_z360 = {.cfg = &dst_x730_cfg, .axes = 1, .wrap = true, .limit_mdeg = 0};
 
-#define X730(sym, idstr, text, var, ins)                                                  \
-    const product_t sym = {.id = idstr, .summary = text, .inputs = ins, .units = "deg",   \
-                           .nodes = 1, .inst_size = sizeof(dst_dev_t), .create = dst_create, \
-                           .sample = dst_sample, .variant = &(var)}
-#define XY_IN {"x", "y", NULL, NULL}
-#define Z_IN {"z", NULL, NULL, NULL}
-
-X730(dst_x730_xy10, "dst-x730-xy10", "Danfoss DST X730 dual axis +-10 deg (CiA 410)", v_xy10, XY_IN);
-X730(dst_x730_xy15, "dst-x730-xy15", "Danfoss DST X730 dual axis +-15 deg (CiA 410)", v_xy15, XY_IN);
-X730(dst_x730_xy20, "dst-x730-xy20", "Danfoss DST X730 dual axis +-20 deg (CiA 410)", v_xy20, XY_IN);
-X730(dst_x730_xy30, "dst-x730-xy30", "Danfoss DST X730 dual axis +-30 deg (CiA 410)", v_xy30, XY_IN);
-X730(dst_x730_xy45, "dst-x730-xy45", "Danfoss DST X730 dual axis +-45 deg (CiA 410)", v_xy45, XY_IN);
-X730(dst_x730_xy60, "dst-x730-xy60", "Danfoss DST X730 dual axis +-60 deg (CiA 410)", v_xy60, XY_IN);
-X730(dst_x730_xy90, "dst-x730-xy90", "Danfoss DST X730 dual axis +-90 deg, stops at +-87 (CiA 410)", v_xy90, XY_IN);
-X730(dst_x730_z360, "dst-x730-z360", "Danfoss DST X730 single axis Z, -180..+180 deg (CiA 410)", v_z360, Z_IN);
+DST_PRODUCT(dst_x730_xy10, "dst-x730-xy10", "Danfoss DST X730 dual axis +-10 deg (CiA 410)", v_xy10, DST_XY_INPUTS);
+DST_PRODUCT(dst_x730_xy15, "dst-x730-xy15", "Danfoss DST X730 dual axis +-15 deg (CiA 410)", v_xy15, DST_XY_INPUTS);
+DST_PRODUCT(dst_x730_xy20, "dst-x730-xy20", "Danfoss DST X730 dual axis +-20 deg (CiA 410)", v_xy20, DST_XY_INPUTS);
+DST_PRODUCT(dst_x730_xy30, "dst-x730-xy30", "Danfoss DST X730 dual axis +-30 deg (CiA 410)", v_xy30, DST_XY_INPUTS);
+DST_PRODUCT(dst_x730_xy45, "dst-x730-xy45", "Danfoss DST X730 dual axis +-45 deg (CiA 410)", v_xy45, DST_XY_INPUTS);
+DST_PRODUCT(dst_x730_xy60, "dst-x730-xy60", "Danfoss DST X730 dual axis +-60 deg (CiA 410)", v_xy60, DST_XY_INPUTS);
+DST_PRODUCT(dst_x730_xy90, "dst-x730-xy90", "Danfoss DST X730 dual axis +-90 deg, stops at +-87 (CiA 410)", v_xy90, DST_XY_INPUTS);
+DST_PRODUCT(dst_x730_z360, "dst-x730-z360", "Danfoss DST X730 single axis Z, -180..+180 deg (CiA 410)", v_z360, DST_Z_INPUTS);

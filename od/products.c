@@ -9,7 +9,9 @@
 
 const product_t *const product_list[] = {
     &dst_x730_xy10, &dst_x730_xy15, &dst_x730_xy20, &dst_x730_xy30, &dst_x730_xy45,
-    &dst_x730_xy60, &dst_x730_xy90, &dst_x730_z360, NULL,
+    &dst_x730_xy60, &dst_x730_xy90, &dst_x730_z360, &dst_x710_xy10, &dst_x710_xy15,
+    &dst_x710_xy20, &dst_x710_xy30, &dst_x710_xy45, &dst_x710_xy60, &dst_x710_xy90,
+    &dst_x710_z360, NULL,
 };
 
 const product_t *product_find(const char *id)

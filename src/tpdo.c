@@ -42,7 +42,7 @@ void co_tpdo_reconfig(co_node_t *node, unsigned n)
     }
     uint32_t cob = get_or(node, comm, 1, 0x80000000u);
     t->type = (uint8_t)get_or(node, comm, 2, 254);
-    t->inhibit_100us = (uint16_t)get_or(node, comm, 3, 0);
+    t->inhibit = (uint16_t)get_or(node, comm, 3, 0);
     t->event_ms = (uint16_t)get_or(node, comm, 5, 0);
     t->cob_id = (uint16_t)(cob & 0x7FFu);
     uint32_t count = get_or(node, mapi, 0, 0);
@@ -158,8 +158,9 @@ uint32_t co_tpdo_poll(co_node_t *node, uint32_t now)
                 continue;
             }
             send(node, n);
-            t->inhibited = t->inhibit_100us != 0u;
-            t->inhibit_end = now + (uint32_t)t->inhibit_100us * 100u;
+            t->inhibited = t->inhibit != 0u;
+            uint32_t unit = node->cfg->inhibit_unit_us != 0u ? node->cfg->inhibit_unit_us : 100u;
+            t->inhibit_end = now + (uint32_t)t->inhibit * unit;
             t->next_event += period;
             if (!co_time_before(now, t->next_event)) {
                 t->next_event = now + period; /* late by a period: no burst */

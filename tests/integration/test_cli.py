@@ -3,8 +3,8 @@ import subprocess
 
 from conftest import BINARY
 
-X730_IDS = ["dst-x730-xy10", "dst-x730-xy15", "dst-x730-xy20", "dst-x730-xy30",
-            "dst-x730-xy45", "dst-x730-xy60", "dst-x730-xy90", "dst-x730-z360"]
+VARIANTS = ["xy10", "xy15", "xy20", "xy30", "xy45", "xy60", "xy90", "z360"]
+PRODUCT_IDS = [f"dst-{m}-{v}" for m in ("x730", "x710") for v in VARIANTS]
 
 
 def run(*args, stdin=None):
@@ -16,7 +16,7 @@ def test_list_products():
     r = run("--list-products")
     assert r.returncode == 0
     ids = [line.split()[0] for line in r.stdout.splitlines()]
-    for pid in X730_IDS:
+    for pid in PRODUCT_IDS:
         assert pid in ids
     assert all(len(line.split(None, 1)) == 2 for line in r.stdout.splitlines())
 

@@ -1,5 +1,6 @@
-"""DST X730 end to end: the real canopen-sensor on vcan0 against the canopen
-master. Node-ID 0x7F (the factory default) unless a test changes it."""
+"""DST X730 and DST X710 end to end: the real canopen-sensor on vcan0 against
+the canopen master, every test once per model. Node-ID 0x7F (the factory
+default) unless a test changes it."""
 import struct
 import time
 
@@ -10,6 +11,13 @@ from canopen.objectdictionary import (INTEGER16, UNSIGNED8, UNSIGNED16, UNSIGNED
 from canopen.sdo.exceptions import SdoAbortedError
 
 NODE = 0x7F
+SW_VERSION = {"dst-x730": b"1.24", "dst-x710": b"1.10"}
+
+
+@pytest.fixture(params=["dst-x730", "dst-x710"])
+def model(request):
+    """The product family prefix; tests add the variant ("-xy30")."""
+    return request.param
 
 
 def master_od():
@@ -60,19 +68,19 @@ def abort_code(fn):
     return e.value.code
 
 
-def test_identity_and_strings(sensor_factory, network, bus):
-    node = boot(sensor_factory("dst-x730-xy30"), network, bus)
+def test_identity_and_strings(model, sensor_factory, network, bus):
+    node = boot(sensor_factory(f"{model}-xy30"), network, bus)
     assert u32(node, 0x1000, 0) == 0x0008019A
     assert u32(node, 0x1018, 1) == 0x93
     assert u32(node, 0x1018, 2) == 0x64
     assert node.sdo.upload(0x1008, 0) == b"GIB"
     assert node.sdo.upload(0x1009, 0) == b"1.00"
-    assert node.sdo.upload(0x100A, 0) == b"1.24"
+    assert node.sdo.upload(0x100A, 0) == SW_VERSION[model]
     assert u32(node, 0x1200, 1) == 0x67F
 
 
-def test_sdo_aborts(sensor_factory, network, bus):
-    node = boot(sensor_factory("dst-x730-xy30"), network, bus)
+def test_sdo_aborts(model, sensor_factory, network, bus):
+    node = boot(sensor_factory(f"{model}-xy30"), network, bus)
     assert abort_code(lambda: node.sdo.upload(0x2106, 6)) == 0x06020000
     assert abort_code(lambda: node.sdo.upload(0x1800, 4)) == 0x06090011
     assert abort_code(lambda: node.sdo.upload(0x1010, 1)) == 0x06010001
@@ -84,8 +92,8 @@ def test_sdo_aborts(sensor_factory, network, bus):
         == 0x06070012
 
 
-def test_nmt_and_heartbeat(sensor_factory, network, bus):
-    node = boot(sensor_factory("dst-x730-xy30"), network, bus)
+def test_nmt_and_heartbeat(model, sensor_factory, network, bus):
+    node = boot(sensor_factory(f"{model}-xy30"), network, bus)
     node.sdo.download(0x1017, 0, struct.pack("<H", 100))
     assert node.nmt.wait_for_heartbeat(timeout=1) == "PRE-OPERATIONAL"
     node.nmt.state = "OPERATIONAL"
@@ -113,8 +121,8 @@ def test_nmt_and_heartbeat(sensor_factory, network, bus):
     assert bus.wait_for(0x700 + NODE, timeout=0.5) is None
 
 
-def test_pdo_decoding_follows_tilt(sensor_factory, network, bus):
-    sensor = sensor_factory("dst-x730-xy45")
+def test_pdo_decoding_follows_tilt(model, sensor_factory, network, bus):
+    sensor = sensor_factory(f"{model}-xy45")
     node = boot(sensor, network, bus)
     node.tpdo.read()  # mapping read back over SDO by the master
     node.tpdo.subscribe()
@@ -141,8 +149,8 @@ def test_pdo_decoding_follows_tilt(sensor_factory, network, bus):
     assert all(len(f.data) == 8 for f in frames)
 
 
-def test_sync_transmission(sensor_factory, network, bus):
-    node = boot(sensor_factory("dst-x730-xy30"), network, bus)
+def test_sync_transmission(model, sensor_factory, network, bus):
+    node = boot(sensor_factory(f"{model}-xy30"), network, bus)
     node.sdo.download(0x1800, 2, b"\x02")  # every 2nd SYNC
     node.nmt.state = "OPERATIONAL"
     time.sleep(0.3)
@@ -154,8 +162,8 @@ def test_sync_transmission(sensor_factory, network, bus):
     assert len(bus.collect(0x1FF, 0.3)) == 3
 
 
-def test_save_power_cut_and_load(sensor_factory, network, bus):
-    sensor = sensor_factory("dst-x730-xy30")
+def test_save_power_cut_and_load(model, sensor_factory, network, bus):
+    sensor = sensor_factory(f"{model}-xy30")
     node = boot(sensor, network, bus)
     node.sdo.download(0x1800, 5, struct.pack("<H", 20))
     node.sdo.download(0x5000, 0, b"\x01")  # start operational by itself
@@ -176,8 +184,8 @@ def test_save_power_cut_and_load(sensor_factory, network, bus):
     assert bus.wait_for(0x1FF, timeout=0.5) is None
 
 
-def test_node_id_change(sensor_factory, network, bus):
-    sensor = sensor_factory("dst-x730-xy30")
+def test_node_id_change(model, sensor_factory, network, bus):
+    sensor = sensor_factory(f"{model}-xy30")
     node = boot(sensor, network, bus)
     node.sdo.download(0x20F0, 0, b"\x06")
     node.sdo.download(0x20F1, 0, b"\x06")
@@ -190,8 +198,8 @@ def test_node_id_change(sensor_factory, network, bus):
     assert node.sdo.upload(0x20F1, 0) == b"\x06"
 
 
-def test_emcy_on_angle_limit(sensor_factory, network, bus):
-    sensor = sensor_factory("dst-x730-xy10")
+def test_emcy_on_angle_limit(model, sensor_factory, network, bus):
+    sensor = sensor_factory(f"{model}-xy10")
     node = boot(sensor, network, bus)
     sensor.send("set x=15 y=0")
     err = node.emcy.wait(0x1000, timeout=5)
@@ -208,9 +216,9 @@ def test_emcy_on_angle_limit(sensor_factory, network, bus):
     assert "LED green" in sensor.log_text()
 
 
-def test_bad_input_is_answered_and_harmless(sensor_factory, network, bus, raw):
+def test_bad_input_is_answered_and_harmless(model, sensor_factory, network, bus, raw):
     import can
-    sensor = sensor_factory("dst-x730-xy30")
+    sensor = sensor_factory(f"{model}-xy30")
     node = boot(sensor, network, bus)
     sensor.send("set x=banana")
     sensor.send("tilt 5")

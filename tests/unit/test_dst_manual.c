@@ -1,16 +1,30 @@
 /*
- * test_x730_manual.c - every CAN exchange of the DST X730 manual, as listed
- * in shared/specs/danfoss-dst-x730.md section 4 (N, H, P, E vectors), and
- * the spec's derived vectors (D). Node-ID 0x7F as in the manual.
+ * test_dst_manual.c - every CAN exchange of the DST X730 and DST X710
+ * manuals, as listed in shared/specs/danfoss-dst-x730.md and
+ * danfoss-dst-x710.md section 4 (N, H, P, E vectors), and the specs'
+ * derived vectors (D, X). Node-ID 0x7F as in the manuals. The two manuals
+ * show the same frames for the shared examples, so those tests run once per
+ * model; each model's own vectors follow.
  *
- * Where the manual's bytes are wrong the corrected bytes are tested and the
- * line says so (C-n: the spec's contradiction number).
+ * Where a manual's bytes are wrong the corrected bytes are tested and the
+ * line says so (C-n: the spec's contradiction number, the same in both).
  */
 #include "dst.h"
 #include "harness.h"
 
 static h_dev_t dev;
 static h_dev_t *const d = &dev;
+
+typedef struct model {
+    const char *name;
+    const product_t *xy10, *xy30, *xy45, *xy90, *z360;
+} model_t;
+
+static const model_t x730 = {"DST X730", &dst_x730_xy10, &dst_x730_xy30, &dst_x730_xy45,
+                             &dst_x730_xy90, &dst_x730_z360};
+static const model_t x710 = {"DST X710", &dst_x710_xy10, &dst_x710_xy30, &dst_x710_xy45,
+                             &dst_x710_xy90, &dst_x710_z360};
+static const model_t *M = &x730;
 
 #define SAVE() SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00")
 
@@ -45,7 +59,7 @@ static void expect_tpdo(const char *hex, int line)
     unsigned n = h_hex(hex, want, 8);
     if (f == NULL || f->dlc != n || memcmp(f->data, want, n) != 0) {
         h_failures++;
-        fprintf(stderr, "test_x730_manual.c:%d: TPDO1 differs from %s\n", line, hex);
+        fprintf(stderr, "test_dst_manual.c:%d: %s TPDO1 differs from %s\n", line, M->name, hex);
         if (f != NULL) {
             fprintf(stderr, "    got %02X %02X %02X %02X %02X %02X %02X %02X\n", f->data[0],
                     f->data[1], f->data[2], f->data[3], f->data[4], f->data[5], f->data[6],
@@ -59,7 +73,7 @@ static void expect_tpdo(const char *hex, int line)
 
 static void test_nmt_n1_to_n5(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     SDO(d, "2B 17 10 00 E8 03 00 00", "60 17 10 00 00 00 00 00"); /* D11 */
     h_advance(d, 1000000);
     EXPECT(d, 0x77F, "7F"); /* D2: heartbeat in pre-operational */
@@ -103,7 +117,7 @@ static void set_res_001(void)
 
 static void test_tpdo_p1_to_p6(void)
 {
-    boot(&dst_x730_xy90);
+    boot(M->xy90);
     set_res_001();
     operational_settled();
     EXPECT_TPDO("00 00 00 00 00 00 00 00"); /* P1 */
@@ -128,7 +142,7 @@ static void test_tpdo_p1_to_p6(void)
 
 static void test_tpdo_p7_to_p10_z360(void)
 {
-    boot(&dst_x730_z360);
+    boot(M->z360);
     set_res_001();
     d->truth[0] = -180000;
     operational_settled();
@@ -153,7 +167,7 @@ static void test_tpdo_p7_to_p10_z360(void)
 
 static void test_e1_bitrate(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     SDO(d, "2F F2 20 00 02 00 00 00", "60 F2 20 00 00 00 00 00"); /* E1.1/E1.2 */
     SDO(d, "2F F3 20 00 02 00 00 00", "60 F3 20 00 00 00 00 00"); /* E1.3/E1.4 */
     dst_dev_t *x = (dst_dev_t *)d->mem;
@@ -168,7 +182,7 @@ static void test_e1_bitrate(void)
 
 static void test_e2_node_id(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     SDO(d, "2F F0 20 00 06 00 00 00", "60 F0 20 00 00 00 00 00"); /* E2.1/E2.2 */
     SDO(d, "2F F1 20 00 06 00 00 00", "60 F1 20 00 00 00 00 00"); /* E2.3/E2.4 */
     CHECK_EQ(d->node->node_id, 0x7F); /* old ID until reset (B-44) */
@@ -191,7 +205,7 @@ static void test_e2_node_id(void)
 
 static void test_e3_event_timer(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     SDO(d, "2B 00 18 05 14 00 00 00", "60 00 18 05 00 00 00 00"); /* E3.1/E3.2 */
     SAVE();                                                        /* E3.3/E3.4 */
     h_power_cycle(d);
@@ -208,7 +222,7 @@ static void test_e3_event_timer(void)
 
 static void test_e4_autostart(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     SDO(d, "2F 00 50 00 01 00 00 00", "60 00 50 00 00 00 00 00"); /* E4.1/E4.2 */
     SAVE();
     h_power_cycle(d);
@@ -221,7 +235,7 @@ static void test_e4_autostart(void)
 
 static void test_e5_e6_preset_xy(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     set_res_001();
     d->truth[0] = 12340;
     d->truth[1] = -5000;
@@ -244,7 +258,7 @@ static void test_e5_e6_preset_xy(void)
 
 static void test_e7_e8_z_preset_and_direction(void)
 {
-    boot(&dst_x730_z360);
+    boot(M->z360);
     set_res_001();
     d->truth[0] = 30000;
     operational_settled();
@@ -262,7 +276,7 @@ static void test_e7_e8_z_preset_and_direction(void)
 
 static void test_e9_resolution(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     d->truth[0] = 10000;
     operational_settled();
     EXPECT_TPDO("C8 00 00 00 00 00 00 00"); /* 10 deg at 0.05 = 200 (D18 style) */
@@ -277,7 +291,7 @@ static void test_e9_resolution(void)
 
 static void test_e10_filter_after_save(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     dst_dev_t *x = (dst_dev_t *)d->mem;
     SDO(d, "2F 01 20 00 02 00 00 00", "60 01 20 00 00 00 00 00");
     CHECK_EQ(x->filter_active, 0); /* not yet: only after STORE (B-81) */
@@ -293,7 +307,7 @@ static void test_e10_filter_after_save(void)
 
 static void test_e11_restore_defaults(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     SDO(d, "2B 00 18 05 14 00 00 00", "60 00 18 05 00 00 00 00");
     SDO(d, "2F F0 20 00 06 00 00 00", "60 F0 20 00 00 00 00 00");
     SDO(d, "2F F1 20 00 06 00 00 00", "60 F1 20 00 00 00 00 00");
@@ -314,7 +328,7 @@ static void test_e11_restore_defaults(void)
 
 static void test_e12_event_timer_off(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* E12.1/E12.2 */
     SAVE();                                                        /* E12.3/E12.4 */
     h_rx(d, 0x000, "01 7F");
@@ -325,7 +339,7 @@ static void test_e12_event_timer_off(void)
 
 static void test_e13_sync(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     SDO(d, "2F 00 18 02 01 00 00 00", "60 00 18 02 00 00 00 00"); /* E13.1/E13.2 */
     SAVE();                                                        /* E13.3/E13.4 */
     h_rx(d, 0x000, "01 7F");
@@ -353,13 +367,12 @@ static void test_e13_sync(void)
 
 static void test_derived_reads(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     SDO(d, "40 00 10 00 00 00 00 00", "43 00 10 00 9A 01 08 00"); /* D3 */
     SDO(d, "40 18 10 01 00 00 00 00", "43 18 10 01 93 00 00 00"); /* D4 */
     SDO(d, "40 18 10 02 00 00 00 00", "43 18 10 02 64 00 00 00"); /* D5 */
     SDO(d, "40 08 10 00 00 00 00 00", "47 08 10 00 47 49 42 00"); /* D6 */
     SDO(d, "40 09 10 00 00 00 00 00", "43 09 10 00 31 2E 30 30");
-    SDO(d, "40 0A 10 00 00 00 00 00", "43 0A 10 00 31 2E 32 34"); /* D7 */
     SDO(d, "40 00 60 00 00 00 00 00", "4B 00 60 00 32 00 00 00"); /* D8 */
     SDO(d, "40 00 1A 02 00 00 00 00", "43 00 1A 02 10 00 20 60"); /* D9, C-4 */
     SDO(d, "40 01 10 00 00 00 00 00", "4F 01 10 00 00 00 00 00");
@@ -368,12 +381,11 @@ static void test_derived_reads(void)
     SDO(d, "40 00 18 00 00 00 00 00", "4F 00 18 00 05 00 00 00");
     SDO(d, "40 00 18 05 00 00 00 00", "4B 00 18 05 64 00 00 00");
     SDO(d, "40 11 60 00 00 00 00 00", "4F 11 60 00 02 00 00 00"); /* C-3 */
-    SDO(d, "40 01 50 00 00 00 00 00", "4F 01 50 00 01 00 00 00");
 }
 
 static void test_derived_rejections(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     SDO(d, "2B 17 10 00 0A 00 00 00", "80 17 10 00 30 00 09 06"); /* D10 */
     SDO(d, "2B 17 10 00 13 00 00 00", "80 17 10 00 30 00 09 06"); /* 19 */
     SDO(d, "2B 17 10 00 14 00 00 00", "60 17 10 00 00 00 00 00"); /* 20 */
@@ -407,7 +419,6 @@ static void test_derived_rejections(void)
     SDO(d, "40 06 21 06 00 00 00 00", "80 06 21 06 00 00 02 06"); /* "2106h sub 6" */
     SDO(d, "40 05 10 00 00 00 00 00", "80 05 10 00 00 00 02 06");
     SDO(d, "2F 00 40 00 FF 00 00 00", "60 00 40 00 00 00 00 00"); /* 0x4000 0..255 */
-    SDO(d, "2F 01 50 00 02 00 00 00", "80 01 50 00 31 00 09 06");
     SDO(d, "23 14 10 00 FF 00 00 40", "80 14 10 00 30 00 09 06"); /* bit 30 */
     SDO(d, "22 01 20 00 01 00 00 00", "60 01 20 00 00 00 00 00"); /* B-39 */
     SDO(d, "2B 01 20 00 01 00 00 00", "80 01 20 00 12 00 07 06"); /* length high */
@@ -415,7 +426,7 @@ static void test_derived_rejections(void)
 
 static void test_derived_pdo_coding(void)
 {
-    boot(&dst_x730_xy90);
+    boot(M->xy90);
     d->truth[0] = 45000;
     operational_settled();
     EXPECT_TPDO("84 03 00 00 00 00 00 00"); /* D18: 900 at 0.05 */
@@ -426,7 +437,7 @@ static void test_derived_pdo_coding(void)
 
 static void test_derived_preset_and_diff(void)
 {
-    boot(&dst_x730_xy30);
+    boot(M->xy30);
     set_res_001();
     d->truth[0] = 12340;
     operational_settled();
@@ -442,7 +453,7 @@ static void test_derived_preset_and_diff(void)
 
 static void test_derived_limits_and_emcy(void)
 {
-    boot(&dst_x730_xy10);
+    boot(M->xy10);
     set_res_001();
     operational_settled();
     d->truth[0] = 15000;
@@ -477,7 +488,7 @@ static void test_derived_limits_and_emcy(void)
     CHECK(emcy);
     CHECK_EQ(h_read(d, 0x4001, 0), 0x00);
     /* Negative side, the +-90 variant stops at -87 (C-8). */
-    boot(&dst_x730_xy90);
+    boot(M->xy90);
     set_res_001();
     d->truth[1] = -89000;
     operational_settled();
@@ -486,14 +497,14 @@ static void test_derived_limits_and_emcy(void)
 
 static void test_error_behaviour(void)
 {
-    boot(&dst_x730_xy10);
+    boot(M->xy10);
     SDO(d, "2F 00 40 00 02 00 00 00", "60 00 40 00 00 00 00 00"); /* stopped */
     operational_settled();
     d->fault = true;
     h_advance(d, 100000);
     CHECK_EQ(d->node->nmt.state, CO_NMT_STOPPED);
     CHECK_EQ(((dst_dev_t *)d->mem)->errors, DST_ERR_SENSOR);
-    boot(&dst_x730_xy10);
+    boot(M->xy10);
     SDO(d, "2F 00 40 00 00 00 00 00", "60 00 40 00 00 00 00 00"); /* pre-op */
     operational_settled();
     d->fault = true;
@@ -504,7 +515,7 @@ static void test_error_behaviour(void)
 
 static void test_emcy_cobid(void)
 {
-    boot(&dst_x730_xy10);
+    boot(M->xy10);
     SDO(d, "23 14 10 00 85 00 00 00", "60 14 10 00 00 00 00 00");
     d->fault = true;
     h_advance(d, 10000);
@@ -515,28 +526,88 @@ static void test_emcy_cobid(void)
     EXPECT_NONE(d);
 }
 
+/* ---- DST X730 only ----------------------------------------------------- */
+
+static void test_x730_own_vectors(void)
+{
+    boot(&dst_x730_xy30);
+    SDO(d, "40 0A 10 00 00 00 00 00", "43 0A 10 00 31 2E 32 34"); /* D7 */
+    SDO(d, "40 01 50 00 00 00 00 00", "4F 01 50 00 01 00 00 00");
+    SDO(d, "2F 01 50 00 02 00 00 00", "80 01 50 00 31 00 09 06");
+    SDO(d, "40 00 18 03 00 00 00 00", "4B 00 18 03 00 00 00 00"); /* inhibit ro 0 */
+    SDO(d, "2B 00 18 03 04 00 00 00", "80 00 18 03 02 00 01 06");
+}
+
+/* ---- DST X710 only ----------------------------------------------------- */
+
+static void test_x710_own_vectors(void)
+{
+    boot(&dst_x710_xy30);
+    SDO(d, "40 0A 10 00 00 00 00 00", "43 0A 10 00 31 2E 31 30"); /* X1 */
+    SDO(d, "40 01 50 00 00 00 00 00", "80 01 50 00 00 00 02 06"); /* X2: no 0x5001 */
+    SDO(d, "40 00 18 03 00 00 00 00", "4B 00 18 03 04 00 00 00"); /* X3 */
+    /* X4: the spec suggests 0x06090030; below a plain minimum is "too low". */
+    SDO(d, "2B 00 18 03 02 00 00 00", "80 00 18 03 32 00 09 06");
+    /* Always little-endian (no D19). */
+    boot(&dst_x710_xy90);
+    SDO(d, "2B 00 60 00 0A 00 00 00", "60 00 60 00 00 00 00 00");
+    d->truth[0] = 45000;
+    operational_settled();
+    EXPECT_TPDO("94 11 00 00 00 00 00 00");
+}
+
+static void test_x710_inhibit_time(void)
+{
+    /* Inhibit time in 1 ms (C-19): event timer 4 ms, inhibit 10 ms. */
+    boot(&dst_x710_xy30);
+    SDO(d, "2B 00 18 05 04 00 00 00", "60 00 18 05 00 00 00 00");
+    SDO(d, "2B 00 18 03 0A 00 00 00", "60 00 18 03 00 00 00 00");
+    h_rx(d, 0x000, "01 7F");
+    h_drain(d);
+    h_advance(d, 1000000);
+    unsigned n = 0;
+    const co_frame_t *f;
+    while ((f = h_next(d)) != NULL) {
+        n += f->id == 0x1FF;
+    }
+    CHECK(n >= 95 && n <= 101); /* one per 10 ms, not one per 4 ms */
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_power_cycle(d);
+    CHECK_EQ(h_read(d, 0x1800, 3), 10);
+}
+
 int main(void)
 {
-    RUN(test_nmt_n1_to_n5);
-    RUN(test_tpdo_p1_to_p6);
-    RUN(test_tpdo_p7_to_p10_z360);
-    RUN(test_e1_bitrate);
-    RUN(test_e2_node_id);
-    RUN(test_e3_event_timer);
-    RUN(test_e4_autostart);
-    RUN(test_e5_e6_preset_xy);
-    RUN(test_e7_e8_z_preset_and_direction);
-    RUN(test_e9_resolution);
-    RUN(test_e10_filter_after_save);
-    RUN(test_e11_restore_defaults);
-    RUN(test_e12_event_timer_off);
-    RUN(test_e13_sync);
-    RUN(test_derived_reads);
-    RUN(test_derived_rejections);
-    RUN(test_derived_pdo_coding);
-    RUN(test_derived_preset_and_diff);
-    RUN(test_derived_limits_and_emcy);
-    RUN(test_error_behaviour);
-    RUN(test_emcy_cobid);
+    static const model_t *const models[] = {&x730, &x710};
+    for (unsigned i = 0; i < 2; i++) {
+        M = models[i];
+        printf("-- %s\n", M->name);
+        RUN(test_nmt_n1_to_n5);
+        RUN(test_tpdo_p1_to_p6);
+        RUN(test_tpdo_p7_to_p10_z360);
+        RUN(test_e1_bitrate);
+        RUN(test_e2_node_id);
+        RUN(test_e3_event_timer);
+        RUN(test_e4_autostart);
+        RUN(test_e5_e6_preset_xy);
+        RUN(test_e7_e8_z_preset_and_direction);
+        RUN(test_e9_resolution);
+        RUN(test_e10_filter_after_save);
+        RUN(test_e11_restore_defaults);
+        RUN(test_e12_event_timer_off);
+        RUN(test_e13_sync);
+        RUN(test_derived_reads);
+        RUN(test_derived_rejections);
+        RUN(test_derived_preset_and_diff);
+        RUN(test_derived_limits_and_emcy);
+        RUN(test_error_behaviour);
+        RUN(test_emcy_cobid);
+    }
+    M = &x730;
+    RUN(test_derived_pdo_coding); /* D19: X730 only */
+    RUN(test_x730_own_vectors);
+    M = &x710;
+    RUN(test_x710_own_vectors);
+    RUN(test_x710_inhibit_time);
     return h_finish();
 }

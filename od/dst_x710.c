@@ -1,0 +1,114 @@
+/*
+ * dst_x710.c - Danfoss DST X710 "entry level" inclination sensor.
+ * Manual: shared/seeds/001_5c118913644527d4.txt; spec:
+ * shared/specs/danfoss-dst-x710.md (section 2 is this table, section 6 its
+ * differences from the X730; C-n are its contradictions and the
+ * resolution taken). Behaviour is the family's (dst.c).
+ *
+ * The table must stay sorted by (index, sub-index).
+ */
+#include "dst.h"
+
+#define RO (CO_A_R)
+#define RW (CO_A_RW)
+#define WO (CO_A_W)
+#define CONST (CO_A_R | CO_A_CONST)
+#define PARA(f) CO_AT(CO_CLS_PARA, dst_para_t, f)
+#define VOL(f) CO_AT(CO_CLS_VOL, dst_vol_t, f)
+
+static const co_od_entry_t x710_entries[] = {
+    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = 0x0008019Au, .name = "Device type"},
+    /* "Always ZERO", also inside the EMCY frame (C-14). */
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, .def = 0, .name = "Error register"},
+    {.index = 0x1008, .sub = 0, CO_TYPE_STR("GIB"), .attr = CONST, .name = "Manufacturer device name"},
+    {.index = 0x1009, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, .name = "Manufacturer hardware version"},
+    {.index = 0x100A, .sub = 0, CO_TYPE_STR("1.10"), .attr = CONST, .name = "Manufacturer software version"},
+    {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, .name = "Store parameters"},
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, .write = co_store_save_hook, .name = "Save all parameters"},
+    {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, .name = "Restore default parameters"},
+    /* rw, reads 1 = "restores on command" (C-5, C-36). */
+    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_load_hook, .name = "Restore all default parameters"},
+    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, .write = dst_write_emcy_cobid, .name = "COB-ID EMCY"},
+    /* 0 or 20..65535 ms; 1..19 "NOT ACCEPTED". */
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, .write = dst_write_hb, .name = "Producer heartbeat time"},
+    {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, .name = "Identity object"},
+    {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x00000093u, .name = "Vendor-ID"},
+    {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x00000064u, .name = "Product code"},
+    {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x00000001u, .name = "Revision number"},
+    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0x00000000u, .name = "Serial number"},
+    {.index = 0x1200, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, .name = "SDO server parameter"},
+    {.index = 0x1200, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x600, .name = "COB-ID client to server"},
+    {.index = 0x1200, .sub = 2, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x580, .name = "COB-ID server to client"},
+    /* Highest sub-index 5; sub 4 (reserved) does not exist (C-19). */
+    {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, .name = "TPDO1 communication parameter"},
+    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x180, .name = "COB-ID TPDO1"},
+    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RW, PARA(tx_type), .def = 254, .write = dst_write_tx_type, .name = "Transmission type"},
+    /* Main table: rw, default 4, 4..65535, unit 1 ms (C-19; Example 3 says ro 0). */
+    {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit_ms), .def = 4, .min = 4, .max = 65535, .write = co_tpdo_write_hook, .name = "Inhibit time"},
+    /* 0 = inactive, 4..65535 ms; default 100 = 0x64 (C-16, C-17). */
+    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 100, .write = dst_write_event, .name = "Event timer"},
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, .name = "TPDO1 mapping parameter"},
+    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x60100010u, .name = "1st mapped object"},
+    /* The manual prints 0x60200020; 0x6020 is 16 bits (C-4). */
+    {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x60200010u, .name = "2nd mapped object"},
+    /* 0 slow, 1 medium, 2 fast; active after "save". Default 0 (C-2). */
+    {.index = 0x2001, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(filter), .def = 0, .min = 0, .max = 2, .name = "Filter setting"},
+    {.index = 0x20F0, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(id[0]), .def = 0x7F, .min = 1, .max = 127, .write = dst_write_id, .name = "Node-ID setting copy 1"},
+    {.index = 0x20F1, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(id[1]), .def = 0x7F, .min = 1, .max = 127, .write = dst_write_id, .name = "Node-ID setting copy 2"},
+    /* 0 1000k, 1 800k, 2 500k, 3 250k, 4 125k, 5 100k, 6 50k, 7 20k. */
+    {.index = 0x20F2, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(br[0]), .def = 3, .min = 0, .max = 7, .write = dst_write_bitrate, .name = "Bit rate setting copy 1"},
+    {.index = 0x20F3, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(br[1]), .def = 3, .min = 0, .max = 7, .write = dst_write_bitrate, .name = "Bit rate setting copy 2"},
+    /* 0 pre-operational, 1 no change, 2 stopped; 3..255 accepted as 1. */
+    {.index = 0x4000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(err_behaviour), .def = 1, .name = "Error behaviour"},
+    {.index = 0x4001, .sub = 0, CO_TYPE_U8, .attr = RO, .read = dst_read_errors, .name = "Error code"},
+    {.index = 0x5000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(autostart), .def = 0, .min = 0, .max = 1, .name = "Automatic NMT start"},
+    /* No 0x5001: PDOs are always little-endian on the X710. */
+    /* 10, 50, 100, 500, 1000 (x 0.001 deg); needs scaling on both axes. */
+    {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(incl.resolution), .def = 50, .write = dst_write_resolution, .name = "Resolution"},
+    {.index = 0x6010, .sub = 0, CO_TYPE_I16, .attr = RO | CO_A_PDO, .read = dst_read_slope, .name = "Slope longitudinal"},
+    /* bit0 invert, bit1 scaling; default 0x02 (C-3). */
+    {.index = 0x6011, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(incl.op[0]), .def = 0x02, .min = 0, .max = 3, .name = "Slope longitudinal operating parameter"},
+    {.index = 0x6012, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.preset[0]), .def = 0, .write = dst_write_preset, .name = "Slope longitudinal preset value"},
+    {.index = 0x6013, .sub = 0, CO_TYPE_I16, .attr = RO, PARA(incl.offset[0]), .def = 0, .name = "Slope longitudinal offset"},
+    {.index = 0x6014, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.diff[0]), .def = 0, .name = "Differential slope longitudinal offset"},
+    {.index = 0x6020, .sub = 0, CO_TYPE_I16, .attr = RO | CO_A_PDO, .read = dst_read_slope, .name = "Slope lateral"},
+    {.index = 0x6021, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(incl.op[1]), .def = 0x02, .min = 0, .max = 3, .name = "Slope lateral operating parameter"},
+    {.index = 0x6022, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.preset[1]), .def = 0, .write = dst_write_preset, .name = "Slope lateral preset value"},
+    {.index = 0x6023, .sub = 0, CO_TYPE_I16, .attr = RO, PARA(incl.offset[1]), .def = 0, .name = "Slope lateral offset"},
+    {.index = 0x6024, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.diff[1]), .def = 0, .name = "Differential slope lateral offset"},
+};
+
+static const co_od_t x710_od = {
+    .entries = x710_entries,
+    .count = (uint16_t)(sizeof(x710_entries) / sizeof(x710_entries[0])),
+};
+
+
+const co_node_cfg_t dst_x710_cfg = {
+    .od = &x710_od,
+    .ops = &dst_ops,
+    .led = NULL, /* the manual describes no LED: CiA 303-3 patterns */
+    .ram_size = {0, sizeof(dst_vol_t), sizeof(dst_para_t), sizeof(co_lss_para_t)},
+    .default_node_id = 0x7F,
+    .default_bitrate = 3, /* 250 kbit/s */
+    .tpdo_dlc = 8,        /* the manual's frames are always 8 bytes (C-4) */
+    .inhibit_unit_us = 1000, /* "unit 1 ms" as printed (C-19) */
+    .store_write_limit = DST_WRITE_LIMIT,
+};
+
+/* Error limits: 110 % of the range, but +-87 deg on the +-90 variant (C-8). */
+#define XY(lim) {.cfg = &dst_x710_cfg, .axes = 2, .wrap = false, .limit_mdeg = (lim)}
+static const dst_variant_t v_xy10 = XY(DST_LIMIT_XY10), v_xy15 = XY(DST_LIMIT_XY15),
+                           v_xy20 = XY(DST_LIMIT_XY20), v_xy30 = XY(DST_LIMIT_XY30),
+                           v_xy45 = XY(DST_LIMIT_XY45), v_xy60 = XY(DST_LIMIT_XY60),
+                           v_xy90 = XY(DST_LIMIT_XY90);
+static const dst_variant_t v_z360 = {.cfg = &dst_x710_cfg, .axes = 1, .wrap = true, .limit_mdeg = 0};
+
+DST_PRODUCT(dst_x710_xy10, "dst-x710-xy10", "Danfoss DST X710 dual axis +-10 deg (CiA 410)", v_xy10, DST_XY_INPUTS);
+DST_PRODUCT(dst_x710_xy15, "dst-x710-xy15", "Danfoss DST X710 dual axis +-15 deg (CiA 410)", v_xy15, DST_XY_INPUTS);
+DST_PRODUCT(dst_x710_xy20, "dst-x710-xy20", "Danfoss DST X710 dual axis +-20 deg (CiA 410)", v_xy20, DST_XY_INPUTS);
+DST_PRODUCT(dst_x710_xy30, "dst-x710-xy30", "Danfoss DST X710 dual axis +-30 deg (CiA 410)", v_xy30, DST_XY_INPUTS);
+DST_PRODUCT(dst_x710_xy45, "dst-x710-xy45", "Danfoss DST X710 dual axis +-45 deg (CiA 410)", v_xy45, DST_XY_INPUTS);
+DST_PRODUCT(dst_x710_xy60, "dst-x710-xy60", "Danfoss DST X710 dual axis +-60 deg (CiA 410)", v_xy60, DST_XY_INPUTS);
+DST_PRODUCT(dst_x710_xy90, "dst-x710-xy90", "Danfoss DST X710 dual axis +-90 deg, stops at +-87 (CiA 410)", v_xy90, DST_XY_INPUTS);
+DST_PRODUCT(dst_x710_z360, "dst-x710-z360", "Danfoss DST X710 single axis Z, -180..+180 deg (CiA 410)", v_z360, DST_Z_INPUTS);
