@@ -105,6 +105,7 @@ typedef enum co_res {
     CO_E_STORE = 0x08000020,       /* data cannot be transferred or stored */
     CO_E_LOCAL = 0x08000021,       /* ... because of local control */
     CO_E_STATE = 0x08000022,       /* ... because of the present device state */
+    CO_E_NO_DATA = 0x08000024,     /* no data available */
 } co_res_t;
 
 /* The SDO abort code of a result (CO_OK gives 0). */

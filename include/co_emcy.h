@@ -1,10 +1,14 @@
 /*
- * co_emcy.h - EMCY producer (CiA 301 7.2.7).
+ * co_emcy.h - EMCY producer (CiA 301 7.2.7): the raw frame, and an error
+ * table for products that follow CiA 301's error model (error register
+ * 0x1001 as the OR of the active errors' bits, an error-reset EMCY when the
+ * last one clears, the pre-defined error field 0x1003).
  */
 #ifndef CO_EMCY_H
 #define CO_EMCY_H
 
 #include "co_common.h"
+#include "co_od.h"
 
 typedef struct co_node co_node_t;
 
@@ -12,14 +16,65 @@ typedef struct co_node co_node_t;
 enum {
     CO_EMCY_NO_ERROR = 0x0000,
     CO_EMCY_GENERIC = 0x1000,
+    CO_EMCY_VOLTAGE_LOW = 0x3100,
+    CO_EMCY_DATA_SET = 0x6300,
+    CO_EMCY_LIFE_GUARD = 0x8130,   /* life guard or heartbeat consumer event */
 };
+
+/* Error register (0x1001) bits. */
+enum {
+    CO_ER_GENERIC = 0x01,
+    CO_ER_CURRENT = 0x02,
+    CO_ER_VOLTAGE = 0x04,
+    CO_ER_TEMPERATURE = 0x08,
+    CO_ER_COMM = 0x10,
+    CO_ER_PROFILE = 0x20,
+    CO_ER_MANUFACTURER = 0x80,
+};
+
+#define CO_EMCY_ACTIVE_MAX 8u
+#define CO_EMCY_HIST_MAX 8u
+
+typedef struct co_emcy {
+    uint8_t nactive;
+    uint16_t code[CO_EMCY_ACTIVE_MAX];
+    uint8_t bits[CO_EMCY_ACTIVE_MAX];
+    uint8_t nhist;                     /* entries in hist, newest first */
+    uint32_t hist[CO_EMCY_HIST_MAX];   /* 0x1003: code | additional info << 16 */
+} co_emcy_t;
 
 /*
  * Send an EMCY frame: COB-ID from 0x1014 (nothing is sent while its bit 31
  * is set), bytes 0-1 code, byte 2 error register, bytes 3-7 manufacturer
  * bytes (msef may be NULL: zeros). Only in pre-operational and operational
- * (CiA 301: not in stopped). Returns true if a frame was queued.
+ * (CiA 301: not in stopped). A non-zero code is entered in the 0x1003
+ * history. Returns true if a frame was queued.
  */
 bool co_emcy_send(co_node_t *node, uint16_t code, uint8_t er, const uint8_t msef[5]);
+
+/*
+ * Raise (active) or clear an error of the error table. Raising a new code
+ * sends its EMCY with the updated error register; clearing the last one
+ * sends the error-reset EMCY (code 0, register 0). Raising an active code
+ * again or clearing an inactive one does nothing. Returns true if the
+ * error table changed.
+ */
+bool co_emcy_error(co_node_t *node, uint16_t code, uint8_t er_bits, bool active,
+                   const uint8_t msef[5]);
+
+/* Error register from the error table: OR of the bits, bit 0 while any is active. */
+uint8_t co_emcy_register(const co_node_t *node);
+
+/* Whether an error code is active. */
+bool co_emcy_active(const co_node_t *node, uint16_t code);
+
+/* Read hook for 0x1001 (error register from the error table). */
+co_res_t co_emcy_register_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
+/* Hooks for 0x1003: sub 0 count (write 0 clears), sub n the n-th newest. */
+co_res_t co_emcy_hist_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
+co_res_t co_emcy_hist_write(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+/* Write hook for 0x1014: CiA 301 rules (bits 30..11 zero, CAN-ID changes
+ * only while bit 31 is set). */
+co_res_t co_emcy_cobid_write(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 #endif /* CO_EMCY_H */

@@ -17,6 +17,7 @@
 
 #include "co_common.h"
 #include "co_emcy.h"
+#include "co_guard.h"
 #include "co_hb.h"
 #include "co_led.h"
 #include "co_nmt.h"
@@ -84,6 +85,8 @@ struct co_node {
     co_hb_t hb;
     co_sync_t sync;
     co_store_t store;
+    co_emcy_t emcy;
+    co_guard_t guard;
     co_tpdo_t tpdo[CO_TPDO_MAX];
 };
 

@@ -2,12 +2,22 @@
  * co_tpdo.h - transmit PDOs (CiA 301 7.2.2).
  *
  * Communication parameters (0x1800 + n) and mapping (0x1A00 + n) are read
- * from the dictionary when a TPDO is configured (reset, or a write to one
- * of them through co_tpdo_write_hook) and cached here, with the mapped
- * entries resolved to table pointers so that sending is a straight copy.
- * Transmission types: 1..240 every n-th SYNC; 254/255 event-driven with the
- * event timer (ms) and inhibit time (100 us, or the product's unit). Others are refused by the
- * dictionary's limits or the product's write hooks.
+ * from the dictionary when a TPDO is configured (reset, or a write through
+ * one of the hooks below) and cached here, with the mapped entries
+ * resolved to table pointers so that sending is a straight copy.
+ *
+ * Transmission types:
+ *   0        acyclic synchronous: at a SYNC, if the data changed since the
+ *            last transmission
+ *   1..240   every n-th SYNC
+ *   252      sampled at SYNC, sent on a remote request (RTR)
+ *   253      sent on a remote request, with data of that moment
+ *   254, 255 event-driven: the event timer (ms) and application events
+ *            (co_tpdo_event), never closer than the inhibit time (100 us,
+ *            or the product's unit); an event inside the inhibit time is
+ *            sent once when it ends.
+ * A remote request on the COB-ID (bit 30 of sub 1 clear) sends any valid
+ * TPDO in operational.
  */
 #ifndef CO_TPDO_H
 #define CO_TPDO_H
@@ -20,19 +30,22 @@
 
 typedef struct co_tpdo {
     bool valid;          /* exists, COB-ID bit 31 clear, mapping usable */
+    bool rtr_allowed;    /* COB-ID bit 30 clear */
     uint8_t type;        /* transmission type */
     uint8_t nmap;
     uint8_t sync_count;  /* SYNCs since the last synchronous send */
     bool timer_armed;    /* event timer running (operational, type 254/255) */
-    bool inhibited;      /* waiting for the inhibit time to pass */
+    bool pending;        /* an application event waits for the inhibit time */
+    bool have_last;      /* last[] holds the last data sent (type 0) or sampled (252) */
     uint16_t cob_id;
     uint16_t event_ms;
     uint16_t inhibit;      /* inhibit time, in the product's unit (co_node_cfg_t) */
     uint32_t next_event;   /* time of the next event-timer send */
-    uint32_t inhibit_end;  /* earliest time of the next send */
+    uint32_t inhibit_end;  /* earliest time of the next event-driven send */
     const co_od_entry_t *map[CO_PDO_MAP_MAX];
     uint8_t map_bytes[CO_PDO_MAP_MAX];
     uint8_t len;           /* mapped bytes */
+    uint8_t last[8];
 } co_tpdo_t;
 
 /* Re-read parameters and mapping of TPDO n (0-based) from the dictionary. */
@@ -45,13 +58,41 @@ void co_tpdo_stop(co_node_t *node);
 /* One SYNC received in operational. */
 void co_tpdo_sync(co_node_t *node);
 
+/* A remote frame: sends the TPDO it asks for. Returns true if it was one. */
+bool co_tpdo_rtr(co_node_t *node, const co_frame_t *f);
+
+/*
+ * An application event for TPDO n (new value, change of state): types
+ * 254/255 send it now or when the inhibit time ends. Other types ignore it.
+ */
+void co_tpdo_event(co_node_t *node, unsigned n);
+
 /* Event-driven sends; returns the delay until the next one. */
 uint32_t co_tpdo_poll(co_node_t *node, uint32_t now);
 
-/* Build TPDO n into f (exposed for tests and RTR). */
+/* Build TPDO n into f (exposed for tests). */
 void co_tpdo_build(co_node_t *node, unsigned n, co_frame_t *f);
 
-/* Write hook for 0x1800..0x1803 sub-entries: store, then reconfigure. */
+/*
+ * Write hook for 0x1800.. sub-entries: store, then reconfigure. Checks
+ * only what every product shares: transmission types 241..251 are invalid.
+ */
 co_res_t co_tpdo_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+
+/*
+ * Stricter write hook for a writable COB-ID (sub 1), CiA 301: bits 29 and
+ * 11..28 zero, the CAN-ID changes only while the PDO is invalid (bit 31),
+ * and not to a restricted CAN-ID. Abort 0x06090030 otherwise.
+ */
+co_res_t co_tpdo_cobid_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+
+/*
+ * Write hook for a writable mapping (0x1A00 + n), CiA 301 dynamic mapping:
+ * sub 0 only while the PDO is invalid (0x06010000), at most as many
+ * entries as the table has, at most 64 bits (0x06040042); sub 1..8 only
+ * while sub 0 is 0 (0x06010000), naming an existing (0x06020000) mappable
+ * (0x06040041) object.
+ */
+co_res_t co_tpdo_map_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 #endif /* CO_TPDO_H */

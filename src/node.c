@@ -59,6 +59,7 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
         node->cfg->ops->reset(node, kind);
     }
     co_hb_reconfig(node);
+    co_guard_reset(node);
     co_sync_reconfig(node);
     for (unsigned n = 0; n < CO_TPDO_MAX; n++) {
         co_tpdo_reconfig(node, n);
@@ -82,7 +83,8 @@ void co_node_receive(co_node_t *node, const co_frame_t *f)
     if (node->nmt.state == CO_NMT_INIT) {
         return;
     }
-    if (co_nmt_receive(node, f) || co_sync_receive(node, f) || co_sdo_receive(node, f)) {
+    if (co_nmt_receive(node, f) || co_sync_receive(node, f) || co_sdo_receive(node, f) ||
+        co_guard_receive(node, f) || co_tpdo_rtr(node, f)) {
         return;
     }
     /* Anything else (other nodes' traffic, RTRs nobody serves) is ignored. */
@@ -93,6 +95,7 @@ uint32_t co_node_poll(co_node_t *node, uint32_t now)
     node->now = now;
     uint32_t next = co_sdo_poll(node, now);
     next = co_min_u32(next, co_hb_poll(node, now));
+    next = co_min_u32(next, co_guard_poll(node, now));
     if (node->cfg->ops != NULL && node->cfg->ops->poll != NULL) {
         next = co_min_u32(next, node->cfg->ops->poll(node, now));
     }

@@ -7,6 +7,14 @@
 
 #include "co_node.h"
 
+enum {
+    TYPE_ACYCLIC = 0,
+    TYPE_SYNC_MAX = 240,
+    TYPE_RTR_SYNC = 252,
+    TYPE_RTR = 253,
+    TYPE_EVENT_MFR = 254,
+};
+
 static uint32_t get_or(co_node_t *node, uint16_t index, uint8_t sub, uint32_t dflt)
 {
     const co_od_entry_t *e = co_node_entry(node, index, sub);
@@ -19,16 +27,35 @@ static uint32_t get_or(co_node_t *node, uint16_t index, uint8_t sub, uint32_t df
 
 static bool event_driven(const co_tpdo_t *t)
 {
-    return t->type >= 254u;
+    return t->type >= TYPE_EVENT_MFR;
 }
 
 static void start_one(co_node_t *node, co_tpdo_t *t)
 {
     t->sync_count = 0;
-    t->inhibited = false;
+    t->pending = false;
+    t->have_last = false;
     /* The first event-driven PDO goes out at the next poll. */
     t->timer_armed = t->valid && event_driven(t) && t->event_ms != 0u;
     t->next_event = node->now;
+    t->inhibit_end = node->now;
+}
+
+/* Resolve one mapping entry; CO_OK with *e and *bytes, or why not. */
+static co_res_t resolve_map(co_node_t *node, uint32_t m, const co_od_entry_t **e, uint8_t *bytes)
+{
+    co_res_t r;
+    *e = co_od_find(node->cfg->od, (uint16_t)(m >> 16), (uint8_t)(m >> 8), &r);
+    uint32_t bits = m & 0xFFu;
+    if (*e == NULL) {
+        return CO_E_NO_OBJ;
+    }
+    if (((*e)->attr & CO_A_PDO) == 0u || bits == 0u || (bits % 8u) != 0u ||
+        bits / 8u > co_od_size(*e)) {
+        return CO_E_NO_MAP;
+    }
+    *bytes = (uint8_t)(bits / 8u);
+    return CO_OK;
 }
 
 void co_tpdo_reconfig(co_node_t *node, unsigned n)
@@ -45,22 +72,18 @@ void co_tpdo_reconfig(co_node_t *node, unsigned n)
     t->inhibit = (uint16_t)get_or(node, comm, 3, 0);
     t->event_ms = (uint16_t)get_or(node, comm, 5, 0);
     t->cob_id = (uint16_t)(cob & 0x7FFu);
+    t->rtr_allowed = (cob & 0x40000000u) == 0u;
     uint32_t count = get_or(node, mapi, 0, 0);
-    if (count > CO_PDO_MAP_MAX) {
+    if (count == 0u || count > CO_PDO_MAP_MAX) {
         return;
     }
     uint32_t len = 0;
     for (uint8_t i = 0; i < count; i++) {
         uint32_t m = get_or(node, mapi, (uint8_t)(i + 1u), 0);
-        const co_od_entry_t *e = co_node_entry(node, (uint16_t)(m >> 16), (uint8_t)(m >> 8));
-        uint32_t bits = m & 0xFFu;
-        if (e == NULL || (e->attr & CO_A_PDO) == 0u || bits == 0u || (bits % 8u) != 0u ||
-            bits / 8u > co_od_size(e)) {
+        if (resolve_map(node, m, &t->map[i], &t->map_bytes[i]) != CO_OK) {
             return; /* unusable mapping: the PDO stays invalid */
         }
-        t->map[i] = e;
-        t->map_bytes[i] = (uint8_t)(bits / 8u);
-        len += bits / 8u;
+        len += t->map_bytes[i];
     }
     if (len > 8u) {
         return;
@@ -73,14 +96,83 @@ void co_tpdo_reconfig(co_node_t *node, unsigned n)
     }
 }
 
+static unsigned tpdo_number(const co_od_entry_t *e)
+{
+    return (unsigned)(e->index & 0x1FFu);
+}
+
 co_res_t co_tpdo_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
+    if (e->sub == 2u && value > TYPE_SYNC_MAX && value < TYPE_RTR_SYNC) {
+        return CO_E_VAL; /* reserved transmission types */
+    }
     co_res_t r = co_od_store(node, e, value);
-    if (r == CO_OK) {
-        unsigned n = (unsigned)(e->index & 0x1FFu);
-        if (n < CO_TPDO_MAX) {
-            co_tpdo_reconfig(node, n);
+    if (r == CO_OK && tpdo_number(e) < CO_TPDO_MAX) {
+        co_tpdo_reconfig(node, tpdo_number(e));
+    }
+    return r;
+}
+
+/* CiA 301 restricted CAN-IDs: NMT, SYNC/EMCY/TIME range, SDO, LSS, NMT error control. */
+static bool restricted(uint32_t id)
+{
+    return id <= 0x07Fu || (id >= 0x101u && id <= 0x180u) || (id >= 0x581u && id <= 0x5FFu) ||
+           (id >= 0x601u && id <= 0x67Fu) || (id >= 0x6E0u && id <= 0x6FFu) || id >= 0x701u;
+}
+
+co_res_t co_tpdo_cobid_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+{
+    if ((value & 0x3FFFF800u) != 0u || restricted(value & 0x7FFu)) {
+        return CO_E_VAL;
+    }
+    uint32_t cur;
+    (void)co_od_get(node, e, &cur);
+    bool cur_valid = (cur & 0x80000000u) == 0u;
+    if (cur_valid && (value & 0x80000000u) == 0u && (value & 0x7FFu) != (cur & 0x7FFu)) {
+        return CO_E_VAL; /* the CAN-ID changes only while the PDO is invalid */
+    }
+    return co_tpdo_write_hook(node, e, value);
+}
+
+co_res_t co_tpdo_map_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+{
+    unsigned n = (unsigned)(e->index & 0x1FFu);
+    uint16_t comm = (uint16_t)(0x1800u + n);
+    uint16_t mapi = e->index;
+    if ((get_or(node, comm, 1, 0x80000000u) & 0x80000000u) == 0u) {
+        return CO_E_UNSUPP; /* CiA 301: invalidate the PDO first */
+    }
+    if (e->sub == 0u) {
+        if (value > CO_PDO_MAP_MAX || co_node_entry(node, mapi, (uint8_t)value) == NULL) {
+            return CO_E_VAL_HIGH; /* more entries than the mapping has */
         }
+        uint32_t bytes = 0;
+        for (uint8_t i = 1; i <= value; i++) {
+            const co_od_entry_t *m;
+            uint8_t b;
+            co_res_t r = resolve_map(node, get_or(node, mapi, i, 0), &m, &b);
+            if (r != CO_OK) {
+                return CO_E_NO_MAP;
+            }
+            bytes += b;
+        }
+        if (bytes > 8u) {
+            return CO_E_MAP_LEN;
+        }
+    } else {
+        if (get_or(node, mapi, 0, 0) != 0u) {
+            return CO_E_UNSUPP; /* CiA 301: set sub 0 to 0 first */
+        }
+        const co_od_entry_t *m;
+        uint8_t b;
+        co_res_t r = resolve_map(node, value, &m, &b);
+        if (r != CO_OK) {
+            return r;
+        }
+    }
+    co_res_t r = co_od_store(node, e, value);
+    if (r == CO_OK && n < CO_TPDO_MAX) {
+        co_tpdo_reconfig(node, n);
     }
     return r;
 }
@@ -96,7 +188,7 @@ void co_tpdo_stop(co_node_t *node)
 {
     for (unsigned n = 0; n < CO_TPDO_MAX; n++) {
         node->tpdo[n].timer_armed = false;
-        node->tpdo[n].inhibited = false;
+        node->tpdo[n].pending = false;
     }
 }
 
@@ -119,25 +211,89 @@ void co_tpdo_build(co_node_t *node, unsigned n, co_frame_t *f)
     f->dlc = node->cfg->tpdo_dlc != 0u ? node->cfg->tpdo_dlc : t->len;
 }
 
+static void send_frame(co_node_t *node, co_tpdo_t *t, const co_frame_t *f)
+{
+    (void)co_node_send(node, f);
+    memcpy(t->last, f->data, sizeof(t->last));
+    t->have_last = true;
+}
+
 static void send(co_node_t *node, unsigned n)
 {
     co_frame_t f;
     co_tpdo_build(node, n, &f);
-    (void)co_node_send(node, &f);
+    send_frame(node, &node->tpdo[n], &f);
 }
 
 void co_tpdo_sync(co_node_t *node)
 {
     for (unsigned n = 0; n < CO_TPDO_MAX; n++) {
         co_tpdo_t *t = &node->tpdo[n];
-        if (!t->valid || t->type == 0u || t->type > 240u) {
+        if (!t->valid) {
             continue;
         }
-        if (++t->sync_count >= t->type) {
-            t->sync_count = 0;
-            send(node, n);
+        if (t->type == TYPE_ACYCLIC) {
+            co_frame_t f;
+            co_tpdo_build(node, n, &f);
+            if (!t->have_last || memcmp(f.data, t->last, sizeof(t->last)) != 0) {
+                send_frame(node, t, &f);
+            }
+        } else if (t->type <= TYPE_SYNC_MAX) {
+            if (++t->sync_count >= t->type) {
+                t->sync_count = 0;
+                send(node, n);
+            }
+        } else if (t->type == TYPE_RTR_SYNC) {
+            co_frame_t f;
+            co_tpdo_build(node, n, &f);
+            memcpy(t->last, f.data, sizeof(t->last)); /* sampled now, sent on request */
+            t->have_last = true;
         }
     }
+}
+
+bool co_tpdo_rtr(co_node_t *node, const co_frame_t *f)
+{
+    if (!f->rtr) {
+        return false;
+    }
+    for (unsigned n = 0; n < CO_TPDO_MAX; n++) {
+        co_tpdo_t *t = &node->tpdo[n];
+        if (!t->valid || f->id != t->cob_id) {
+            continue;
+        }
+        if (!t->rtr_allowed || node->nmt.state != CO_NMT_OPERATIONAL) {
+            return true;
+        }
+        co_frame_t out;
+        co_tpdo_build(node, n, &out);
+        if (t->type == TYPE_RTR_SYNC) {
+            if (!t->have_last) {
+                return true; /* nothing sampled yet: no SYNC since operational */
+            }
+            memcpy(out.data, t->last, sizeof(out.data));
+        }
+        (void)co_node_send(node, &out);
+        return true;
+    }
+    return false;
+}
+
+void co_tpdo_event(co_node_t *node, unsigned n)
+{
+    if (n >= CO_TPDO_MAX) {
+        return;
+    }
+    co_tpdo_t *t = &node->tpdo[n];
+    if (t->valid && event_driven(t) && node->nmt.state == CO_NMT_OPERATIONAL) {
+        t->pending = true; /* sent by the next poll, or when the inhibit time ends */
+    }
+}
+
+static uint32_t inhibit_us(const co_node_t *node, const co_tpdo_t *t)
+{
+    uint32_t unit = node->cfg->inhibit_unit_us != 0u ? node->cfg->inhibit_unit_us : 100u;
+    return (uint32_t)t->inhibit * unit;
 }
 
 uint32_t co_tpdo_poll(co_node_t *node, uint32_t now)
@@ -148,25 +304,31 @@ uint32_t co_tpdo_poll(co_node_t *node, uint32_t now)
     }
     for (unsigned n = 0; n < CO_TPDO_MAX; n++) {
         co_tpdo_t *t = &node->tpdo[n];
-        if (!t->timer_armed) {
+        if (!t->valid || !event_driven(t)) {
             continue;
         }
         uint32_t period = (uint32_t)t->event_ms * 1000u;
-        if (!co_time_before(now, t->next_event)) {
-            if (t->inhibited && co_time_before(now, t->inhibit_end)) {
+        bool timer_due = t->timer_armed && !co_time_before(now, t->next_event);
+        if (timer_due || t->pending) {
+            if (co_time_before(now, t->inhibit_end)) {
+                t->pending = true; /* keep the event until the inhibit time ends */
                 next = co_min_u32(next, t->inhibit_end - now);
                 continue;
             }
             send(node, n);
-            t->inhibited = t->inhibit != 0u;
-            uint32_t unit = node->cfg->inhibit_unit_us != 0u ? node->cfg->inhibit_unit_us : 100u;
-            t->inhibit_end = now + (uint32_t)t->inhibit * unit;
-            t->next_event += period;
-            if (!co_time_before(now, t->next_event)) {
-                t->next_event = now + period; /* late by a period: no burst */
+            t->pending = false;
+            t->inhibit_end = now + inhibit_us(node, t);
+            if (t->timer_armed) {
+                /* A timer send keeps the cadence; an event send restarts it. */
+                t->next_event = timer_due ? t->next_event + period : now + period;
+                if (!co_time_before(now, t->next_event)) {
+                    t->next_event = now + period; /* late by a period: no burst */
+                }
             }
         }
-        next = co_min_u32(next, t->next_event - now);
+        if (t->timer_armed) {
+            next = co_min_u32(next, t->next_event - now);
+        }
     }
     return next;
 }

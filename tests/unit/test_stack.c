@@ -16,6 +16,10 @@ typedef struct t_para {
     uint16_t event[2];
     uint32_t u32;
     int16_t i16;
+    uint16_t guard_ms;
+    uint8_t life_factor;
+    uint8_t map1_count;
+    uint32_t map1[2];
 } t_para_t;
 
 typedef struct t_vol {
@@ -36,13 +40,19 @@ typedef struct t_dev {
 
 static const co_od_entry_t t_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x12345678u},
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .read = co_emcy_register_read},
+    {.index = 0x1003, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, .read = co_emcy_hist_read, .write = co_emcy_hist_write},
+    {.index = 0x1003, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .read = co_emcy_hist_read},
+    {.index = 0x1003, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, .read = co_emcy_hist_read},
     {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(sync_cob), .def = 0x80, .write = co_sync_write_hook},
     {.index = 0x1008, .sub = 0, CO_TYPE_STR("A long device name for segmented transfer"), .attr = CO_A_R | CO_A_CONST},
+    {.index = 0x100C, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(guard_ms), .def = 0},
+    {.index = 0x100D, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, P(life_factor), .def = 0},
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
     {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = CO_A_W, .write = co_store_save_hook},
     {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
     {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, .def = 1, .write = co_store_load_hook},
-    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, P(emcy_cob), .def = 0x80},
+    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, P(emcy_cob), .def = 0x80, .write = co_emcy_cobid_write},
     {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(hb), .def = 0, .write = co_hb_write_hook},
     {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 5},
     {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, TPW, P(cob[0]), .def = 0x180},
@@ -50,15 +60,16 @@ static const co_od_entry_t t_entries[] = {
     {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = CO_A_RW, TPW, P(inhibit[0]), .def = 0},
     {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = CO_A_RW, TPW, P(event[0]), .def = 100},
     {.index = 0x1801, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 5},
-    {.index = 0x1801, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, TPW, P(cob[1]), .def = 0x280},
+    {.index = 0x1801, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, .write = co_tpdo_cobid_write_hook, P(cob[1]), .def = 0x280},
     {.index = 0x1801, .sub = 2, CO_TYPE_U8, .attr = CO_A_RW, TPW, P(type[1]), .def = 1},
     {.index = 0x1801, .sub = 3, CO_TYPE_U16, .attr = CO_A_RW, TPW, P(inhibit[1]), .def = 0},
     {.index = 0x1801, .sub = 5, CO_TYPE_U16, .attr = CO_A_RW, TPW, P(event[1]), .def = 0},
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 2},
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21000020u},
     {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, .def = 0x20010010u},
-    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
-    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x20020020u}, /* not mappable */
+    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, P(map1_count), .def = 1, .write = co_tpdo_map_write_hook},
+    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, P(map1[0]), .def = 0x20020020u, .write = co_tpdo_map_write_hook}, /* not mappable */
+    {.index = 0x1A01, .sub = 2, CO_TYPE_U32, .attr = CO_A_RW, P(map1[1]), .def = 0, .write = co_tpdo_map_write_hook},
     {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(u32), .def = 100, .min = 10, .max = 1000},
     {.index = 0x2001, .sub = 0, CO_TYPE_I16, .attr = CO_A_RW | CO_A_PDO, P(i16), .def = (uint32_t)-5, .min = -100, .max = 100},
     {.index = 0x2002, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, V(scratch), .def = 7},
@@ -421,6 +432,196 @@ static void test_two_nodes_one_process(void)
     CHECK_EQ(h_read(&a, 0x2001, 0), 5);
 }
 
+static void test_node_guarding(void)
+{
+    boot();
+    h_drain(d);
+    co_frame_t rtr = {.id = 0x710, .rtr = true, .dlc = 1};
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x710, "7F"); /* toggle 0 first */
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x710, "FF");
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x710, "05");
+    h_rx(d, 0x000, "82 10"); /* reset communication: toggle back to 0 */
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* TPDO1 quiet */
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x710, "7F");
+    /* Life guarding: 100 ms x 3. */
+    SDO(d, "2B 0C 10 00 64 00 00 00", "60 0C 10 00 00 00 00 00");
+    SDO(d, "2F 0D 10 00 03 00 00 00", "60 0D 10 00 00 00 00 00");
+    h_rx(d, 0x000, "01 10");
+    h_rx_frame(d, &rtr);
+    h_drain(d);
+    h_advance(d, 299000);
+    EXPECT_NONE(d);
+    h_advance(d, 2000);
+    EXPECT(d, 0x90, "30 81 11 00 00 00 00 00"); /* life guard event */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
+    CHECK_EQ(h_read(d, 0x1001, 0), 0x11);
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x710, "7F"); /* toggles on from the answer before the loss */
+    EXPECT(d, 0x90, "00 00 00 00 00 00 00 00"); /* error reset */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP); /* no way back by itself */
+    /* With the heartbeat on, guard requests get no answer (CiA 301). */
+    SDO(d, "2B 17 10 00 E8 03 00 00", "60 17 10 00 00 00 00 00");
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT_NONE(d);
+}
+
+static void test_emcy_table_and_history(void)
+{
+    boot();
+    h_drain(d);
+    uint8_t info[5] = {0x34, 0x12, 0, 0, 0};
+    CHECK(co_emcy_error(d->node, 0x5010, CO_ER_COMM, true, info));
+    EXPECT(d, 0x90, "10 50 11 34 12 00 00 00");
+    CHECK(!co_emcy_error(d->node, 0x5010, CO_ER_COMM, true, NULL)); /* already active */
+    EXPECT_NONE(d);
+    CHECK(co_emcy_error(d->node, 0x3100, CO_ER_VOLTAGE, true, NULL));
+    EXPECT(d, 0x90, "00 31 15 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x1001, 0), 0x15);
+    CHECK(co_emcy_error(d->node, 0x5010, 0, false, NULL));
+    EXPECT_NONE(d); /* 0x3100 still active */
+    CHECK_EQ(h_read(d, 0x1001, 0), 0x05);
+    CHECK(co_emcy_error(d->node, 0x3100, 0, false, NULL));
+    EXPECT(d, 0x90, "00 00 00 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x1001, 0), 0);
+    /* History: newest first; code in the low word, info in the high word. */
+    SDO(d, "40 03 10 00 00 00 00 00", "4F 03 10 00 02 00 00 00");
+    SDO(d, "40 03 10 01 00 00 00 00", "43 03 10 01 00 31 00 00");
+    SDO(d, "40 03 10 02 00 00 00 00", "43 03 10 02 10 50 34 12");
+    SDO(d, "2F 03 10 00 01 00 00 00", "80 03 10 00 30 00 09 06");
+    SDO(d, "2F 03 10 00 00 00 00 00", "60 03 10 00 00 00 00 00");
+    SDO(d, "40 03 10 01 00 00 00 00", "80 03 10 01 24 00 00 08"); /* empty */
+    /* EMCY COB-ID: the CAN-ID changes only while disabled. */
+    SDO(d, "23 14 10 00 A0 00 00 00", "80 14 10 00 30 00 09 06");
+    SDO(d, "23 14 10 00 90 00 00 80", "60 14 10 00 00 00 00 00"); /* disable */
+    SDO(d, "23 14 10 00 A0 00 00 80", "60 14 10 00 00 00 00 00"); /* new ID, still off */
+    SDO(d, "23 14 10 00 A0 00 00 00", "60 14 10 00 00 00 00 00"); /* enable */
+    SDO(d, "23 14 10 00 B0 00 00 00", "80 14 10 00 30 00 09 06"); /* valid: no change */
+    CHECK(co_emcy_send(d->node, 0x1234, 0, NULL));
+    EXPECT(d, 0xA0, "34 12 00 00 00 00 00 00");
+}
+
+static void test_tpdo_rtr_and_types(void)
+{
+    boot();
+    h_rx(d, 0x000, "01 10");
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00");
+    co_frame_t rtr = {.id = 0x190, .rtr = true, .dlc = 6};
+    h_drain(d);
+    h_rx_frame(d, &rtr); /* type 254: an RTR is an extra trigger */
+    const co_frame_t *f = h_next(d);
+    CHECK(f != NULL && f->id == 0x190 && !f->rtr && f->dlc == 6);
+    /* 253: only on request. */
+    SDO(d, "2F 00 18 02 FD 00 00 00", "60 00 18 02 00 00 00 00");
+    h_rx(d, 0x080, "");
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 10000);
+    EXPECT_NONE(d);
+    h_rx_frame(d, &rtr);
+    f = h_next(d);
+    CHECK(f != NULL && f->id == 0x190);
+    /* 252: sampled at SYNC, sent on request with the sampled data. */
+    SDO(d, "2F 00 18 02 FC 00 00 00", "60 00 18 02 00 00 00 00");
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT_NONE(d); /* nothing sampled yet */
+    h_rx(d, 0x080, "");
+    uint32_t sampled = ((t_dev_t *)d->mem)->vol.counter;
+    h_advance(d, 50000); /* the counter moves on */
+    EXPECT_NONE(d);
+    h_rx_frame(d, &rtr);
+    f = h_next(d);
+    CHECK(f != NULL && co_get_u32(f->data) == sampled);
+    /* 0: at a SYNC, only if the data changed. */
+    SDO(d, "2F 00 18 02 00 00 00 00", "60 00 18 02 00 00 00 00");
+    SDO(d, "2F 00 18 02 F1 00 00 00", "80 00 18 02 30 00 09 06"); /* reserved */
+    h_drain(d);
+    h_rx(d, 0x080, "");
+    CHECK(h_next(d) != NULL);
+    h_rx(d, 0x080, "");
+    EXPECT_NONE(d); /* no sample in between: same data */
+    h_advance(d, 5000);
+    h_rx(d, 0x080, "");
+    CHECK(h_next(d) != NULL);
+    /* RTR not allowed (bit 30), and not outside operational. */
+    SDO(d, "2F 00 18 02 FD 00 00 00", "60 00 18 02 00 00 00 00");
+    SDO(d, "23 00 18 01 90 01 00 40", "60 00 18 01 00 00 00 00");
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT_NONE(d);
+    SDO(d, "23 00 18 01 90 01 00 00", "60 00 18 01 00 00 00 00");
+    h_rx(d, 0x000, "80 10");
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT_NONE(d);
+}
+
+static void test_tpdo_events_and_inhibit(void)
+{
+    boot();
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* no timer */
+    SDO(d, "2B 00 18 03 E8 03 00 00", "60 00 18 03 00 00 00 00"); /* 100 ms */
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    h_advance(d, 500000);
+    EXPECT_NONE(d); /* no event, no timer: silence */
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 1);
+    CHECK(h_next(d) != NULL);
+    uint32_t t0 = d->now;
+    co_tpdo_event(d->node, 0); /* inside the inhibit time: deferred, not lost */
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 99000);
+    EXPECT_NONE(d);
+    h_advance(d, 2000);
+    CHECK(h_next(d) != NULL);
+    EXPECT_NONE(d); /* the two events went out as one */
+    CHECK(d->now - t0 >= 100000);
+    co_tpdo_event(d->node, 5); /* no such TPDO: ignored */
+}
+
+static void test_tpdo_cobid_and_mapping_rules(void)
+{
+    boot();
+    /* TPDO2 (0x1801): strict COB-ID; mapping 0x1A01 writable. */
+    SDO(d, "23 01 18 01 85 02 00 00", "80 01 18 01 30 00 09 06"); /* valid: no change */
+    SDO(d, "23 01 18 01 90 02 00 80", "60 01 18 01 00 00 00 00"); /* invalidate */
+    SDO(d, "23 01 18 01 85 05 00 80", "80 01 18 01 30 00 09 06"); /* SDO range */
+    SDO(d, "23 01 18 01 00 00 00 A0", "80 01 18 01 30 00 09 06"); /* bit 29 */
+    SDO(d, "2F 01 1A 00 01 00 00 00", "80 01 1A 00 41 00 04 06"); /* sub 0 = 1 with bad entry */
+    SDO(d, "23 01 1A 01 20 00 00 21", "80 01 1A 01 00 00 01 06"); /* sub 0 != 0 */
+    SDO(d, "2F 01 1A 00 00 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 1A 01 20 00 00 20", "80 01 1A 01 41 00 04 06"); /* 0x2000 not mappable */
+    SDO(d, "23 01 1A 01 20 00 05 21", "80 01 1A 01 00 00 02 06"); /* no 0x2105 */
+    SDO(d, "23 01 1A 01 28 00 00 21", "80 01 1A 01 41 00 04 06"); /* 40 bits of a U32 */
+    SDO(d, "23 01 1A 01 20 00 00 21", "60 01 1A 01 00 00 00 00");
+    SDO(d, "23 01 1A 02 20 00 00 21", "60 01 1A 02 00 00 00 00");
+    SDO(d, "2F 01 1A 00 02 00 00 00", "60 01 1A 00 00 00 00 00"); /* 64 bits: ok */
+    SDO(d, "2F 01 1A 00 03 00 00 00", "80 01 1A 00 31 00 09 06"); /* no sub 3 */
+    SDO(d, "2F 01 1A 00 00 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 1A 02 10 00 01 20", "60 01 1A 02 00 00 00 00"); /* 0x2001, 16 bits */
+    SDO(d, "2F 01 1A 00 02 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 18 01 90 02 00 00", "60 01 18 01 00 00 00 00"); /* valid again */
+    SDO(d, "2F 01 1A 00 01 00 00 00", "80 01 1A 00 00 00 01 06"); /* valid: no mapping change */
+    h_rx(d, 0x000, "01 10");
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x080, ""); /* TPDO2 type 1 */
+    const co_frame_t *f = h_next(d);
+    CHECK(f != NULL && f->id == 0x290 && f->dlc == 6);
+    if (f != NULL) {
+        CHECK_EQ(f->data[4], 0xFB); /* 0x2001 = -5 after the counter */
+    }
+}
+
 int main(void)
 {
     RUN(test_od_find);
@@ -436,5 +637,10 @@ int main(void)
     RUN(test_emcy);
     RUN(test_tx_full_is_counted);
     RUN(test_two_nodes_one_process);
+    RUN(test_node_guarding);
+    RUN(test_emcy_table_and_history);
+    RUN(test_tpdo_rtr_and_types);
+    RUN(test_tpdo_events_and_inhibit);
+    RUN(test_tpdo_cobid_and_mapping_rules);
     return h_finish();
 }

@@ -1,0 +1,75 @@
+/*
+ * guard.c - node guarding and life guarding. See co_guard.h.
+ */
+#include "co_guard.h"
+
+#include "co_node.h"
+
+static uint32_t get(co_node_t *node, uint16_t index)
+{
+    uint32_t v = 0;
+    const co_od_entry_t *e = co_node_entry(node, index, 0);
+    if (e != NULL) {
+        (void)co_od_get(node, e, &v);
+    }
+    return v;
+}
+
+void co_guard_reset(co_node_t *node)
+{
+    co_guard_t *g = &node->guard;
+    g->enabled = co_node_entry(node, 0x100C, 0) != NULL;
+    g->toggle = 0;
+    g->seen = false;
+    g->kick = false;
+    if (g->lost) {
+        g->lost = false;
+        (void)co_emcy_error(node, CO_EMCY_LIFE_GUARD, CO_ER_COMM, false, NULL);
+    }
+}
+
+bool co_guard_receive(co_node_t *node, const co_frame_t *f)
+{
+    co_guard_t *g = &node->guard;
+    if (!f->rtr || f->id != 0x700u + node->node_id) {
+        return false;
+    }
+    if (!g->enabled || node->hb.period_ms != 0u) {
+        return true; /* not guarded, or the heartbeat is the protocol in use */
+    }
+    co_frame_t r = {.id = f->id, .dlc = 1, .data = {(uint8_t)(g->toggle | node->nmt.state)}};
+    (void)co_node_send(node, &r);
+    g->toggle ^= 0x80u;
+    g->seen = true;
+    g->kick = true;
+    if (g->lost) {
+        g->lost = false;
+        (void)co_emcy_error(node, CO_EMCY_LIFE_GUARD, CO_ER_COMM, false, NULL);
+    }
+    return true;
+}
+
+uint32_t co_guard_poll(co_node_t *node, uint32_t now)
+{
+    co_guard_t *g = &node->guard;
+    if (!g->enabled || !g->seen || g->lost || node->hb.period_ms != 0u) {
+        return CO_NEVER;
+    }
+    uint32_t life_ms = get(node, 0x100C) * get(node, 0x100D);
+    if (life_ms == 0u) {
+        return CO_NEVER;
+    }
+    if (g->kick) {
+        g->kick = false;
+        g->deadline = now + life_ms * 1000u;
+    }
+    if (co_time_before(now, g->deadline)) {
+        return g->deadline - now;
+    }
+    g->lost = true;
+    (void)co_emcy_error(node, CO_EMCY_LIFE_GUARD, CO_ER_COMM, true, NULL);
+    if (node->nmt.state == CO_NMT_OPERATIONAL) {
+        co_nmt_enter(node, CO_NMT_PREOP); /* CiA 301 default error behaviour */
+    }
+    return CO_NEVER;
+}
