@@ -11,6 +11,11 @@
  *   slope = s*m + offset + differential offset   (scaling on)
  *         = s*m                                  (scaling off)
  *   with s = -1 when the invert bit is set; clamped to INTEGER16.
+ *
+ * Circular mode (a full-turn sensor whose outputs are 0..359.9 deg): with
+ * F = one turn in resolution units, a1 = (F - m) mod F when inverted, and
+ *   slope = (a1 + offset + differential offset) mod F   (scaling on)
+ *   preset P: offset = (P - a1 - differential offset) mod F
  */
 #ifndef CO_INCL_H
 #define CO_INCL_H
@@ -33,7 +38,8 @@ typedef struct co_incl_para {
 typedef struct co_incl {
     co_incl_para_t *p;
     uint8_t axes;        /* 1 (single axis) or 2 */
-    bool wrap;           /* single-axis full turn: angle in [-180, 180) */
+    bool wrap;           /* full turn: the angle wraps at +-180 deg */
+    bool circular;       /* outputs 0..full turn - 1 LSB, modulo a full turn (P+F) */
     bool fault;          /* sensor element error: outputs hold */
     int32_t limit_mdeg;  /* output stops here, error beyond it; 0: none */
     uint8_t shift;       /* active filter shift */

@@ -66,6 +66,8 @@ typedef struct co_node_cfg {
     uint8_t tpdo_dlc;           /* 0: DLC = mapped bytes; 8: pad with zeros */
     uint16_t inhibit_unit_us;   /* unit of 0x1800+n sub 3; 0: CiA 301's 100 us */
     uint32_t store_write_limit; /* 0: unlimited */
+    bool autosave;              /* every SDO write to a stored entry is stored at once */
+    bool load_keeps_lss;        /* 0x1011 "load" leaves node-ID and bit rate alone */
 } co_node_cfg_t;
 
 struct co_node {

@@ -76,7 +76,8 @@ uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len);
 
 /*
  * Write hooks for 0x1010 sub 1 and 0x1011 sub 1. "save" stores PARA;
- * "load" requests defaults for PARA and LSS at the next reset. Wrong
+ * "load" requests defaults for PARA and LSS (unless the product keeps
+ * LSS, cfg->load_keeps_lss) at the next reset. Wrong
  * signature: CO_E_STORE. Both call the node's on_store op afterwards.
  */
 co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);

@@ -232,9 +232,10 @@ void dst_create(const product_t *p, void *mem, void *const ports[], co_node_t *n
     nodes[0] = &d->node;
 }
 
-void dst_sample(void *mem, const int32_t values[], bool fault)
+void dst_sample(void *mem, const int32_t values[], uint32_t faults)
 {
     dst_dev_t *d = mem;
+    bool fault = (faults & 1u) != 0u; /* "sensor" */
     d->sensor_fault = fault;
     d->incl.fault = fault;
     co_incl_sample(&d->incl, values);

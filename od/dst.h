@@ -63,7 +63,7 @@ typedef struct dst_dev {
 extern const co_node_ops_t dst_ops;
 extern const co_led_timing_t dst_led;
 void dst_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[]);
-void dst_sample(void *mem, const int32_t values[], bool fault);
+void dst_sample(void *mem, const int32_t values[], uint32_t faults);
 co_res_t dst_write_hb(co_node_t *n, const co_od_entry_t *e, uint32_t v);
 co_res_t dst_write_emcy_cobid(co_node_t *n, const co_od_entry_t *e, uint32_t v);
 co_res_t dst_write_tx_type(co_node_t *n, const co_od_entry_t *e, uint32_t v);
@@ -97,6 +97,7 @@ extern const product_t dst_x710_xy10, dst_x710_xy15, dst_x710_xy20, dst_x710_xy3
 /* A product of the family: symbol, ID, description, variant, input names. */
 #define DST_PRODUCT(sym, idstr, text, var, ins)                                        \
     const product_t sym = {.id = idstr, .summary = text, .inputs = ins, .units = "deg", \
+                           .faults = {"sensor", NULL, NULL, NULL},                 \
                            .nodes = 1, .inst_size = sizeof(dst_dev_t), .create = dst_create, \
                            .sample = dst_sample, .variant = &(var)}
 #define DST_XY_INPUTS {"x", "y", NULL, NULL}

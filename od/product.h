@@ -25,6 +25,7 @@ struct product {
     const char *summary;     /* one line for --list-products */
     const char *inputs[PRODUCT_MAX_INPUTS]; /* simulator input names, NULL-ended */
     const char *units;       /* unit of the inputs, for messages */
+    const char *faults[PRODUCT_MAX_INPUTS]; /* simulator fault names, NULL-ended */
     unsigned nodes;          /* nodes this product runs */
     size_t inst_size;        /* bytes create() needs */
     /*
@@ -35,10 +36,10 @@ struct product {
     void (*create)(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[]);
     /*
      * One sensor sample: values in thousandths of the input's unit
-     * (millidegrees), in the order of inputs[]; fault forces a sensor error.
-     * Call every CO_FILTER_PERIOD_US.
+     * (millidegrees), in the order of inputs[]; bit i of faults forces
+     * fault faults[i]. Call every CO_FILTER_PERIOD_US.
      */
-    void (*sample)(void *mem, const int32_t values[], bool fault);
+    void (*sample)(void *mem, const int32_t values[], uint32_t faults);
     const void *variant;     /* product-specific constants */
 };
 

@@ -90,10 +90,39 @@ static int32_t signed_measure(const co_incl_t *incl, unsigned axis)
     return (incl->p->op[axis] & CO_INCL_OP_INVERT) != 0u ? -m : m;
 }
 
+/* Non-negative a mod m (m > 0). */
+static int32_t mod_pos(int32_t a, int32_t m)
+{
+    int32_t r = a % m;
+    return r < 0 ? r + m : r;
+}
+
+/* Circular mode: one turn in LSB, and the direction-corrected angle a1. */
+static int32_t turn(const co_incl_t *incl)
+{
+    int32_t res = incl->p->resolution != 0u ? (int32_t)incl->p->resolution : 1;
+    return FULL_TURN_MDEG / res;
+}
+
+static int32_t circular_a1(const co_incl_t *incl, unsigned axis)
+{
+    int32_t res = incl->p->resolution != 0u ? (int32_t)incl->p->resolution : 1;
+    int32_t f = turn(incl);
+    int32_t m = mod_pos(co_div_round(mod_pos(incl->angle[axis], FULL_TURN_MDEG), res), f);
+    return (incl->p->op[axis] & CO_INCL_OP_INVERT) != 0u ? mod_pos(f - m, f) : m;
+}
+
 int16_t co_incl_slope(const co_incl_t *incl, unsigned axis)
 {
     if (axis >= incl->axes) {
         return 0;
+    }
+    if (incl->circular) {
+        int32_t a1 = circular_a1(incl, axis);
+        if ((incl->p->op[axis] & CO_INCL_OP_SCALING) != 0u) {
+            a1 = mod_pos(a1 + incl->p->offset[axis] + incl->p->diff[axis], turn(incl));
+        }
+        return (int16_t)a1;
     }
     int32_t v = signed_measure(incl, axis);
     if ((incl->p->op[axis] & CO_INCL_OP_SCALING) != 0u) {
@@ -126,6 +155,13 @@ co_res_t co_incl_set_resolution(co_incl_t *incl, uint16_t res)
 
 void co_incl_set_preset(co_incl_t *incl, unsigned axis, int16_t preset)
 {
+    if (incl->circular) {
+        int32_t a1 = circular_a1(incl, axis);
+        incl->p->preset[axis] = preset;
+        incl->p->offset[axis] =
+            (int16_t)mod_pos((int32_t)preset - a1 - incl->p->diff[axis], turn(incl));
+        return;
+    }
     int32_t off = (int32_t)preset - signed_measure(incl, axis);
     if (off > INT16_MAX) {
         off = INT16_MAX;

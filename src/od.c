@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "co_node.h"
+#include "co_store.h"
 
 static bool is_signed(const co_od_entry_t *e)
 {
@@ -202,10 +203,11 @@ co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf
             }
         }
     }
-    if (e->write != NULL) {
-        return e->write(node, e, v);
+    co_res_t r = e->write != NULL ? e->write(node, e, v) : co_od_store(node, e, v);
+    if (r == CO_OK && node->cfg->autosave && (e->cls == CO_CLS_PARA || e->cls == CO_CLS_LSS)) {
+        r = co_store_save(node, (co_cls_t)e->cls); /* the product stores every change */
     }
-    return co_od_store(node, e, v);
+    return r;
 }
 
 void co_od_defaults(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)

@@ -281,7 +281,7 @@ co_res_t co_store_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
         return CO_E_STORE;
     }
     co_res_t r = co_store_request_defaults(node, CO_CLS_PARA);
-    if (r == CO_OK && stored_class(node, CO_CLS_LSS)) {
+    if (r == CO_OK && stored_class(node, CO_CLS_LSS) && !node->cfg->load_keeps_lss) {
         r = co_store_request_defaults(node, CO_CLS_LSS);
     }
     if (r == CO_OK) {

@@ -43,7 +43,8 @@ static void usage(FILE *f)
             "Standard input, one command a line:\n"
             "  set x=<deg> y=<deg>      true inclination (dual axis)\n"
             "  set z=<deg>              true inclination (single axis)\n"
-            "  fault sensor on|off      force a sensor error\n"
+            "  fault NAME on|off        force a fault (DST: sensor; P+F: range-x,\n"
+            "                           range-y, undervoltage)\n"
             "  quit                     stop\n");
 }
 
@@ -261,7 +262,7 @@ int main(int argc, char **argv)
         return 1;
     }
     a.prod->create(a.prod, mem, ports, a.nodes);
-    a.prod->sample(mem, a.sim.values, a.sim.fault);
+    a.prod->sample(mem, a.sim.values, a.sim.faults);
     uint32_t t = now_us();
     for (unsigned i = 0; i < a.nnodes; i++) {
         co_node_start(a.nodes[i], t);
@@ -275,7 +276,7 @@ int main(int argc, char **argv)
     while (!a.sim.quit) {
         t = now_us();
         if (!co_time_before(t, next_sample)) {
-            a.prod->sample(mem, a.sim.values, a.sim.fault);
+            a.prod->sample(mem, a.sim.values, a.sim.faults);
             next_sample += CO_FILTER_PERIOD_US;
             if (!co_time_before(t, next_sample)) {
                 next_sample = t + CO_FILTER_PERIOD_US; /* we slept too long: no burst */

@@ -51,13 +51,25 @@ bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
     if (strcmp(cmd, "fault") == 0) {
         char *what = strtok_r(NULL, " \t\r", &save);
         char *onoff = strtok_r(NULL, " \t\r", &save);
-        if (what == NULL || strcmp(what, "sensor") != 0 || onoff == NULL ||
-            (strcmp(onoff, "on") != 0 && strcmp(onoff, "off") != 0) ||
+        int i = -1;
+        char list[96] = "";
+        for (int k = 0; k < (int)PRODUCT_MAX_INPUTS && s->prod->faults[k] != NULL; k++) {
+            size_t at = strlen(list);
+            snprintf(list + at, sizeof(list) - at, "%s%s", k ? "|" : "", s->prod->faults[k]);
+            if (what != NULL && strcmp(what, s->prod->faults[k]) == 0) {
+                i = k;
+            }
+        }
+        if (i < 0 || onoff == NULL || (strcmp(onoff, "on") != 0 && strcmp(onoff, "off") != 0) ||
             strtok_r(NULL, " \t\r", &save) != NULL) {
-            snprintf(err, errlen, "usage: fault sensor on|off");
+            snprintf(err, errlen, "usage: fault %s on|off", list);
             return false;
         }
-        s->fault = strcmp(onoff, "on") == 0;
+        if (strcmp(onoff, "on") == 0) {
+            s->faults |= 1u << i;
+        } else {
+            s->faults &= ~(1u << i);
+        }
         return true;
     }
     if (strcmp(cmd, "set") == 0) {

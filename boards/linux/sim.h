@@ -1,7 +1,7 @@
 /*
  * sim.h - the simulated physics, one command a line on standard input:
  *   set NAME=VALUE [NAME=VALUE...]   true value of inputs (product's names)
- *   fault sensor on|off              force a sensor error
+ *   fault NAME on|off                force a fault (product's names: sensor, ...)
  *   quit                             stop the program
  * A bad line gets a message on stderr and changes nothing.
  */
@@ -16,7 +16,7 @@
 typedef struct sim {
     const product_t *prod;
     int32_t values[PRODUCT_MAX_INPUTS]; /* thousandths of the input's unit */
-    bool fault;
+    uint32_t faults; /* bit i: the product's faults[i] is on */
     bool quit;
 } sim_t;
 

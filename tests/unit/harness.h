@@ -80,7 +80,7 @@ typedef struct h_dev {
     uint32_t now;          /* virtual time, us */
     uint32_t next_sample;  /* time of the next sensor sample */
     int32_t truth[PRODUCT_MAX_INPUTS]; /* true inputs, milli-units */
-    bool fault;
+    uint32_t fault; /* bit i: the product's fault i */
 } h_dev_t;
 
 /* Create (port and NVM fresh unless keep_nvm) and power on. */

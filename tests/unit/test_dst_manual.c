@@ -500,14 +500,14 @@ static void test_error_behaviour(void)
     boot(M->xy10);
     SDO(d, "2F 00 40 00 02 00 00 00", "60 00 40 00 00 00 00 00"); /* stopped */
     operational_settled();
-    d->fault = true;
+    d->fault = 1u; /* "sensor" */
     h_advance(d, 100000);
     CHECK_EQ(d->node->nmt.state, CO_NMT_STOPPED);
     CHECK_EQ(((dst_dev_t *)d->mem)->errors, DST_ERR_SENSOR);
     boot(M->xy10);
     SDO(d, "2F 00 40 00 00 00 00 00", "60 00 40 00 00 00 00 00"); /* pre-op */
     operational_settled();
-    d->fault = true;
+    d->fault = 1u; /* "sensor" */
     h_advance(d, 100000);
     CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
     EXPECT(d, 0xFF, "00 10 00 00 01 00 00 00");
@@ -517,11 +517,11 @@ static void test_emcy_cobid(void)
 {
     boot(M->xy10);
     SDO(d, "23 14 10 00 85 00 00 00", "60 14 10 00 00 00 00 00");
-    d->fault = true;
+    d->fault = 1u; /* "sensor" */
     h_advance(d, 10000);
     EXPECT(d, 0x85, "00 10 00 00 01 00 00 00");
     SDO(d, "23 14 10 00 FF 00 00 80", "60 14 10 00 00 00 00 00"); /* disabled */
-    d->fault = false;
+    d->fault = 0u;
     h_advance(d, 10000);
     EXPECT_NONE(d);
 }

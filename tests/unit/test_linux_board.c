@@ -36,9 +36,9 @@ static void test_sim_commands(void)
     CHECK(!sim_command(&s, "fault motor on", err, sizeof(err)));
     CHECK_EQ(s.values[0], 12345);
     CHECK_EQ(s.values[1], 3000);
-    CHECK(!s.fault && !s.quit);
-    CHECK(sim_command(&s, "fault sensor on", err, sizeof(err)) && s.fault);
-    CHECK(sim_command(&s, "fault sensor off", err, sizeof(err)) && !s.fault);
+    CHECK(s.faults == 0u && !s.quit);
+    CHECK(sim_command(&s, "fault sensor on", err, sizeof(err)) && s.faults == 1u);
+    CHECK(sim_command(&s, "fault sensor off", err, sizeof(err)) && s.faults == 0u);
     CHECK(sim_command(&s, "", err, sizeof(err)));
     CHECK(sim_command(&s, "# comment", err, sizeof(err)));
     CHECK(sim_command(&s, "quit", err, sizeof(err)) && s.quit);

@@ -94,7 +94,7 @@ static void t_create(const product_t *p, void *mem, void *const ports[], co_node
     nodes[0] = &t->node;
 }
 
-static void t_sample(void *mem, const int32_t v[], bool fault)
+static void t_sample(void *mem, const int32_t v[], uint32_t fault)
 {
     (void)v;
     (void)fault;

@@ -1,0 +1,111 @@
+/*
+ * pf.c - behaviour of the Pepperl+Fuchs INX360D / INY360D.
+ *
+ * The manual (shared/seeds/004_ce24af47702850aa.txt) lacks its object
+ * chapter; shared/specs/pf-inx-iny.md reconstructs it. R-n, C-n and G-n
+ * below are that spec's rules, contradictions and gaps.
+ */
+#include "pf.h"
+
+#include <string.h>
+
+static pf_dev_t *dev_of(co_node_t *n)
+{
+    return n->app;
+}
+
+co_res_t pf_write_bitrate(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    /* 01h 125k, 02h 250k, 04h 500k, 08h 1M; others "not adopted" (R47). */
+    if (v != PF_BR_125K && v != PF_BR_250K && v != PF_BR_500K && v != PF_BR_1M) {
+        return CO_E_VAL;
+    }
+    return co_od_store(n, e, v);
+}
+
+co_res_t pf_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    (void)n;
+    (void)e;
+    return v == 100u ? CO_OK : CO_E_VAL; /* fixed 0.1 deg (L760) */
+}
+
+co_res_t pf_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    /* Zero point: the output equals the preset at once when scaling is on (R56). */
+    co_incl_set_preset(&dev_of(n)->incl, e->index == 0x6012u ? 0u : 1u, (int16_t)v);
+    return CO_OK;
+}
+
+co_res_t pf_read_slope(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
+{
+    *v = (uint32_t)(int32_t)co_incl_slope(&dev_of(n)->incl, e->index == 0x6010u ? 0u : 1u);
+    return CO_OK;
+}
+
+static uint32_t pf_poll(co_node_t *n, uint32_t now)
+{
+    (void)now;
+    pf_dev_t *d = dev_of(n);
+    if (n->nmt.state == CO_NMT_INIT || n->nmt.state == CO_NMT_STOPPED) {
+        return CO_NEVER; /* no EMCY in stopped: errors are raised when allowed */
+    }
+    /* Error register bits as the manual's example (C12) and R35. */
+    (void)co_emcy_error(n, PF_EMCY_RANGE_X, CO_ER_COMM, (d->faults & PF_FAULT_RANGE_X) != 0u, NULL);
+    if (d->incl.axes > 1u) {
+        (void)co_emcy_error(n, PF_EMCY_RANGE_Y, CO_ER_COMM,
+                            (d->faults & PF_FAULT_RANGE_Y) != 0u, NULL);
+    }
+    (void)co_emcy_error(n, CO_EMCY_VOLTAGE_LOW, CO_ER_VOLTAGE,
+                        (d->faults & PF_FAULT_UNDERVOLTAGE) != 0u, NULL);
+    uint8_t st = n->store.status[CO_CLS_PARA];
+    bool bad = st == CO_STORE_CORRUPT || st == CO_STORE_HW ||
+               n->store.status[CO_CLS_LSS] == CO_STORE_CORRUPT;
+    (void)co_emcy_error(n, CO_EMCY_DATA_SET, 0, bad, NULL);
+    return CO_NEVER;
+}
+
+static void pf_leds(co_node_t *n, co_led_pattern_t *run, co_led_pattern_t *err)
+{
+    /* run (yellow) follows the NMT state; err per the manual's table (L212-227):
+     * bus-off / undervoltage on, EEPROM error 2x flash, warning 1x flash. */
+    pf_dev_t *d = dev_of(n);
+    bool undervoltage = (d->faults & PF_FAULT_UNDERVOLTAGE) != 0u;
+    if (n->can_state == CO_CAN_BUSOFF || undervoltage) {
+        *run = CO_LED_OFF;
+        *err = CO_LED_ON;
+    } else if (co_emcy_active(n, CO_EMCY_DATA_SET)) {
+        *err = CO_LED_FLASH2;
+    } else if (co_emcy_active(n, PF_EMCY_RANGE_X) || co_emcy_active(n, PF_EMCY_RANGE_Y)) {
+        *err = CO_LED_FLASH1;
+    }
+}
+
+/* A stored set that failed its checksum stays reported (6300h) until a
+ * good store (R52): the poll re-evaluates the error table every time. */
+const co_node_ops_t pf_ops = {
+    .poll = pf_poll,
+    .leds = pf_leds,
+};
+
+void pf_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
+{
+    pf_dev_t *d = mem;
+    const pf_variant_t *v = p->variant;
+    memset(d, 0, sizeof(*d));
+    co_incl_init(&d->incl, &d->para.incl, v->axes, 0, true);
+    d->incl.circular = true;
+    d->incl.shift = 0; /* no filter (R61): one sample, one calculation */
+    void *const ram[CO_CLS_COUNT] = {NULL, NULL, &d->para, &d->lss};
+    co_node_init(&d->node, v->cfg, ports[0], d, ram, 0);
+    nodes[0] = &d->node;
+}
+
+void pf_sample(void *mem, const int32_t values[], uint32_t faults)
+{
+    pf_dev_t *d = mem;
+    d->faults = faults;
+    co_incl_sample(&d->incl, values);
+    /* Type 254/255: a PDO "after each calculation" (R26), within the inhibit time. */
+    co_tpdo_event(&d->node, 0);
+}
