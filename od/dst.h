@@ -94,12 +94,17 @@ extern const product_t dst_x710_xy10, dst_x710_xy15, dst_x710_xy20, dst_x710_xy3
 #define DST_LIMIT_XY60 66000
 #define DST_LIMIT_XY90 87000
 
-/* A product of the family: symbol, ID, description, variant, input names. */
-#define DST_PRODUCT(sym, idstr, text, var, ins)                                        \
+/* A product of the family: symbol, ID, description, variant, input names, config. */
+#define DST_PRODUCT(sym, idstr, text, var, ins, cfgp)                                     \
     const product_t sym = {.id = idstr, .summary = text, .inputs = ins, .units = "deg", \
                            .faults = {"sensor", NULL, NULL, NULL},                 \
                            .nodes = 1, .inst_size = sizeof(dst_dev_t), .create = dst_create, \
-                           .sample = dst_sample, .variant = &(var)}
+                           .sample = dst_sample, .variant = &(var), .cfg = (cfgp),     \
+                           .vendor = "Danfoss A/S", .bitrates = DST_BITRATES}
+/* 0x20F2 codes 0..7: 1000, 800, 500, 250, 125, 100, 50, 20 kbit/s (100 has no EDS key). */
+#define DST_BITRATES                                                                    \
+    (PRODUCT_BR_20K | PRODUCT_BR_50K | PRODUCT_BR_125K | PRODUCT_BR_250K | PRODUCT_BR_500K | \
+     PRODUCT_BR_800K | PRODUCT_BR_1000K)
 #define DST_XY_INPUTS {"x", "y", NULL, NULL}
 #define DST_Z_INPUTS {"z", NULL, NULL, NULL}
 

@@ -104,11 +104,11 @@ static const dst_variant_t v_xy10 = XY(DST_LIMIT_XY10), v_xy15 = XY(DST_LIMIT_XY
                            v_xy90 = XY(DST_LIMIT_XY90);
 static const dst_variant_t v_z360 = {.cfg = &dst_x730_cfg, .axes = 1, .wrap = true, .limit_mdeg = 0};
 
-DST_PRODUCT(dst_x730_xy10, "dst-x730-xy10", "Danfoss DST X730 dual axis +-10 deg (CiA 410)", v_xy10, DST_XY_INPUTS);
-DST_PRODUCT(dst_x730_xy15, "dst-x730-xy15", "Danfoss DST X730 dual axis +-15 deg (CiA 410)", v_xy15, DST_XY_INPUTS);
-DST_PRODUCT(dst_x730_xy20, "dst-x730-xy20", "Danfoss DST X730 dual axis +-20 deg (CiA 410)", v_xy20, DST_XY_INPUTS);
-DST_PRODUCT(dst_x730_xy30, "dst-x730-xy30", "Danfoss DST X730 dual axis +-30 deg (CiA 410)", v_xy30, DST_XY_INPUTS);
-DST_PRODUCT(dst_x730_xy45, "dst-x730-xy45", "Danfoss DST X730 dual axis +-45 deg (CiA 410)", v_xy45, DST_XY_INPUTS);
-DST_PRODUCT(dst_x730_xy60, "dst-x730-xy60", "Danfoss DST X730 dual axis +-60 deg (CiA 410)", v_xy60, DST_XY_INPUTS);
-DST_PRODUCT(dst_x730_xy90, "dst-x730-xy90", "Danfoss DST X730 dual axis +-90 deg, stops at +-87 (CiA 410)", v_xy90, DST_XY_INPUTS);
-DST_PRODUCT(dst_x730_z360, "dst-x730-z360", "Danfoss DST X730 single axis Z, -180..+180 deg (CiA 410)", v_z360, DST_Z_INPUTS);
+DST_PRODUCT(dst_x730_xy10, "dst-x730-xy10", "Danfoss DST X730 dual axis +-10 deg (CiA 410)", v_xy10, DST_XY_INPUTS, &dst_x730_cfg);
+DST_PRODUCT(dst_x730_xy15, "dst-x730-xy15", "Danfoss DST X730 dual axis +-15 deg (CiA 410)", v_xy15, DST_XY_INPUTS, &dst_x730_cfg);
+DST_PRODUCT(dst_x730_xy20, "dst-x730-xy20", "Danfoss DST X730 dual axis +-20 deg (CiA 410)", v_xy20, DST_XY_INPUTS, &dst_x730_cfg);
+DST_PRODUCT(dst_x730_xy30, "dst-x730-xy30", "Danfoss DST X730 dual axis +-30 deg (CiA 410)", v_xy30, DST_XY_INPUTS, &dst_x730_cfg);
+DST_PRODUCT(dst_x730_xy45, "dst-x730-xy45", "Danfoss DST X730 dual axis +-45 deg (CiA 410)", v_xy45, DST_XY_INPUTS, &dst_x730_cfg);
+DST_PRODUCT(dst_x730_xy60, "dst-x730-xy60", "Danfoss DST X730 dual axis +-60 deg (CiA 410)", v_xy60, DST_XY_INPUTS, &dst_x730_cfg);
+DST_PRODUCT(dst_x730_xy90, "dst-x730-xy90", "Danfoss DST X730 dual axis +-90 deg, stops at +-87 (CiA 410)", v_xy90, DST_XY_INPUTS, &dst_x730_cfg);
+DST_PRODUCT(dst_x730_z360, "dst-x730-z360", "Danfoss DST X730 single axis Z, -180..+180 deg (CiA 410)", v_z360, DST_Z_INPUTS, &dst_x730_cfg);

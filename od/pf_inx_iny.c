@@ -92,6 +92,8 @@ _Static_assert(sizeof(pf_dev_t) <= PRODUCT_INST_MAX, "instance must fit PRODUCT_
 static const co_node_cfg_t inx_cfg = PF_CFG(&inx_od);
 static const co_node_cfg_t iny_cfg = PF_CFG(&iny_od);
 
+#define PF_EDS_BITRATES (PRODUCT_BR_125K | PRODUCT_BR_250K | PRODUCT_BR_500K | PRODUCT_BR_1000K)
+
 static const pf_variant_t v_inx = {.cfg = &inx_cfg, .axes = 1};
 static const pf_variant_t v_iny = {.cfg = &iny_cfg, .axes = 2};
 
@@ -100,10 +102,10 @@ const product_t pf_inx360d = {
     .inputs = {"x", NULL, NULL, NULL}, .units = "deg",
     .faults = {"range-x", "range-y", "undervoltage", NULL},
     .nodes = 1, .inst_size = sizeof(pf_dev_t), .create = pf_create, .sample = pf_sample,
-    .variant = &v_inx};
+    .variant = &v_inx, .cfg = &inx_cfg, .vendor = "Pepperl+Fuchs", .bitrates = PF_EDS_BITRATES};
 const product_t pf_iny360d = {
     .id = "iny360d", .summary = "Pepperl+Fuchs INY360D dual axis 0..359.9 deg (CiA 410)",
     .inputs = {"x", "y", NULL, NULL}, .units = "deg",
     .faults = {"range-x", "range-y", "undervoltage", NULL},
     .nodes = 1, .inst_size = sizeof(pf_dev_t), .create = pf_create, .sample = pf_sample,
-    .variant = &v_iny};
+    .variant = &v_iny, .cfg = &iny_cfg, .vendor = "Pepperl+Fuchs", .bitrates = PF_EDS_BITRATES};

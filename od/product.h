@@ -41,7 +41,22 @@ struct product {
      */
     void (*sample)(void *mem, const int32_t values[], uint32_t faults);
     const void *variant;     /* product-specific constants */
+    /* For the EDS (CiA 306), from the same tables the firmware runs: */
+    const co_node_cfg_t *cfg;    /* node 0's configuration and dictionary */
+    const char *vendor;          /* vendor name */
+    uint8_t bitrates;            /* supported bit rates, PRODUCT_BR_* bits */
+    bool lss;                    /* LSS slave (CiA 305) */
 };
+
+/* Bit rates an EDS can declare (CiA 306 [DeviceInfo] BaudRate_x). */
+#define PRODUCT_BR_10K 0x01u
+#define PRODUCT_BR_20K 0x02u
+#define PRODUCT_BR_50K 0x04u
+#define PRODUCT_BR_125K 0x08u
+#define PRODUCT_BR_250K 0x10u
+#define PRODUCT_BR_500K 0x20u
+#define PRODUCT_BR_800K 0x40u
+#define PRODUCT_BR_1000K 0x80u
 
 /* Every product, in --list-products order; NULL-terminated. */
 extern const product_t *const product_list[];

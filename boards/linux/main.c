@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "co_filter.h"
+#include "eds.h"
 #include "leds.h"
 #include "port.h"
 #include "product.h"
@@ -25,6 +26,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: canopen-sensor --product ID --iface IFACE [options]\n"
+            "       canopen-sensor --product ID --eds\n"
             "       canopen-sensor --list-products\n"
             "\n"
             "Runs a simulated CANopen sensor on a SocketCAN interface.\n"
@@ -37,6 +39,7 @@ static void usage(FILE *f)
             "  --led-chip CHIP    drive the LEDs on this GPIO chip (libgpiod), with\n"
             "  --led-green LINE   the green (run) LED line and\n"
             "  --led-red LINE     the red (error) LED line; without them LED changes are logged\n"
+            "  --eds              print the product's EDS (CiA 306) and exit\n"
             "  --list-products    print every product ID with a description\n"
             "  --help             this text\n"
             "\n"
@@ -143,11 +146,13 @@ int main(int argc, char **argv)
     const char *led_chip = NULL;
     int led_green = 0;
     int led_red = 1;
+    bool eds = false;
     static const struct option opts[] = {
         {"product", required_argument, NULL, 'p'}, {"iface", required_argument, NULL, 'i'},
         {"nvm", required_argument, NULL, 'n'},     {"log", required_argument, NULL, 'l'},
         {"led-chip", required_argument, NULL, 'c'}, {"led-green", required_argument, NULL, 'g'},
         {"led-red", required_argument, NULL, 'r'}, {"list-products", no_argument, NULL, 'L'},
+        {"eds", no_argument, NULL, 'E'},
         {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0},
     };
     int c;
@@ -165,6 +170,9 @@ int main(int argc, char **argv)
                 return 2;
             }
             break;
+        case 'E':
+            eds = true;
+            break;
         case 'L':
             for (size_t i = 0; product_list[i] != NULL; i++) {
                 printf("%-18s %s\n", product_list[i]->id, product_list[i]->summary);
@@ -177,6 +185,15 @@ int main(int argc, char **argv)
             usage(stderr);
             return 2;
         }
+    }
+    if (eds && product != NULL && optind == argc) {
+        const product_t *p = product_find(product);
+        if (p == NULL) {
+            fprintf(stderr, "canopen-sensor: unknown product '%s' (see --list-products)\n", product);
+            return 2;
+        }
+        eds_write(stdout, p);
+        return 0;
     }
     if (optind != argc || product == NULL || iface == NULL) {
         usage(stderr);

@@ -4,7 +4,8 @@ import subprocess
 from conftest import BINARY
 
 VARIANTS = ["xy10", "xy15", "xy20", "xy30", "xy45", "xy60", "xy90", "z360"]
-PRODUCT_IDS = [f"dst-{m}-{v}" for m in ("x730", "x710") for v in VARIANTS]
+PRODUCT_IDS = [f"dst-{m}-{v}" for m in ("x730", "x710") for v in VARIANTS] + [
+    "inx360d", "iny360d"]
 
 
 def run(*args, stdin=None):
@@ -25,7 +26,7 @@ def test_help():
     r = run("--help")
     assert r.returncode == 0
     for word in ("--product", "--iface", "--nvm", "--log", "--list-products", "--led-chip",
-                 "set x=<deg> y=<deg>", "fault sensor on|off", "quit"):
+                 "--eds", "set x=<deg> y=<deg>", "fault NAME on|off", "quit"):
         assert word in r.stdout
 
 

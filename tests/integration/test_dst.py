@@ -4,11 +4,13 @@ default) unless a test changes it."""
 import struct
 import time
 
+import subprocess
+
 import canopen
 import pytest
-from canopen.objectdictionary import (INTEGER16, UNSIGNED8, UNSIGNED16, UNSIGNED32,
-                                      ODArray, ODRecord, ODVariable)
 from canopen.sdo.exceptions import SdoAbortedError
+
+from conftest import BINARY
 
 NODE = 0x7F
 SW_VERSION = {"dst-x730": b"1.24", "dst-x710": b"1.10"}
@@ -20,31 +22,12 @@ def model(request):
     return request.param
 
 
-def master_od():
-    """What a master knows of the X730 from its manual: TPDO1 and the slopes."""
-    od = canopen.ObjectDictionary()
-
-    def var(name, index, sub, dtype, access="rw", pdo=False):
-        v = ODVariable(name, index, sub)
-        v.data_type = dtype
-        v.access_type = access
-        v.pdo_mappable = pdo
-        return v
-
-    com = ODRecord("TPDO1 communication parameter", 0x1800)
-    for sub, name, dtype in ((0, "Highest sub-index", UNSIGNED8), (1, "COB-ID", UNSIGNED32),
-                             (2, "Transmission type", UNSIGNED8), (3, "Inhibit time", UNSIGNED16),
-                             (5, "Event timer", UNSIGNED16)):
-        com.add_member(var(name, 0x1800, sub, dtype))
-    od.add_object(com)
-    mapping = ODArray("TPDO1 mapping parameter", 0x1A00)
-    mapping.add_member(var("Number of entries", 0x1A00, 0, UNSIGNED8))
-    for sub in (1, 2):
-        mapping.add_member(var(f"Mapped object {sub}", 0x1A00, sub, UNSIGNED32))
-    od.add_object(mapping)
-    od.add_object(var("Slope longitudinal", 0x6010, 0, INTEGER16, "ro", True))
-    od.add_object(var("Slope lateral", 0x6020, 0, INTEGER16, "ro", True))
-    return od
+def eds_od(product, tmp_path, node_id):
+    """The master's dictionary: the product's EDS, as canopen-sensor prints it."""
+    path = tmp_path / f"{product}.eds"
+    path.write_text(subprocess.run([BINARY, "--product", product, "--eds"], check=True,
+                                   capture_output=True, text=True).stdout)
+    return canopen.import_od(str(path), node_id)
 
 
 def boot(sensor, network, bus, node_id=NODE):
@@ -53,7 +36,7 @@ def boot(sensor, network, bus, node_id=NODE):
     m = bus.wait_for(0x700 + node_id, timeout=3)
     assert m is not None, f"no boot-up from node {node_id:#x}"
     assert bytes(m.data) == b"\x00"
-    node = canopen.RemoteNode(node_id, master_od())
+    node = canopen.RemoteNode(node_id, eds_od(sensor.product, sensor.log.parent, node_id))
     network.add_node(node)
     return node
 
@@ -135,6 +118,7 @@ def test_pdo_decoding_follows_tilt(model, sensor_factory, network, bus):
     node.nmt.state = "OPERATIONAL"
     time.sleep(3)  # slow filter
     pdo.wait_for_reception(timeout=1)
+    # Decoded through the EDS: names and types come from the firmware's table.
     assert pdo["Slope longitudinal"].raw == 1234
     assert pdo["Slope lateral"].raw == -750
     sensor.send("set x=-30 y=20")
