@@ -51,6 +51,8 @@ typedef struct co_node_ops {
     void (*stored)(co_node_t *node, uint32_t signature);
     /* Product work; returns the delay until it next needs to run. */
     uint32_t (*poll)(co_node_t *node, uint32_t now);
+    /* Complete a TPDO after its mapped bytes (fixed layouts, counters, checksums). */
+    void (*tpdo_fill)(co_node_t *node, unsigned n, co_frame_t *f);
     /* LED patterns; when NULL the CiA 303-3 mapping of co_node_leds() holds. */
     void (*leds)(co_node_t *node, co_led_pattern_t *green, co_led_pattern_t *red);
 } co_node_ops_t;
@@ -68,6 +70,8 @@ typedef struct co_node_cfg {
     uint32_t store_write_limit; /* 0: unlimited */
     bool autosave;              /* every SDO write to a stored entry is stored at once */
     bool load_keeps_lss;        /* 0x1011 "load" leaves node-ID and bit rate alone */
+    bool comm_reset_applies_id; /* reset communication also activates a new node-ID */
+    bool save_includes_lss;     /* 0x1010 "save" stores the node-ID / bit-rate set too */
 } co_node_cfg_t;
 
 struct co_node {

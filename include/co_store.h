@@ -75,7 +75,8 @@ uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls);
 uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len);
 
 /*
- * Write hooks for 0x1010 sub 1 and 0x1011 sub 1. "save" stores PARA;
+ * Write hooks for 0x1010 sub 1 and 0x1011 sub 1. "save" stores PARA (and
+ * LSS, if cfg->save_includes_lss and it changed);
  * "load" requests defaults for PARA and LSS (unless the product keeps
  * LSS, cfg->load_keeps_lss) at the next reset. Wrong
  * signature: CO_E_STORE. Both call the node's on_store op afterwards.

@@ -46,12 +46,17 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
         co_od_defaults(node, CO_CLS_VOL, 0x0000, 0xFFFF);
         (void)co_store_restore(node, CO_CLS_PARA, 0x0000, 0xFFFF);
         (void)co_store_restore(node, CO_CLS_LSS, 0x0000, 0xFFFF);
-        const co_lss_para_t *lss = node->ram[CO_CLS_LSS];
-        bool id_ok = lss != NULL && lss->node_id >= 1u && lss->node_id <= 127u;
-        node->node_id = id_ok ? lss->node_id : node->cfg->default_node_id;
     } else {
         co_od_defaults(node, CO_CLS_VOL, 0x1000, 0x1FFF);
         (void)co_store_restore(node, CO_CLS_PARA, 0x1000, 0x1FFF);
+        if (node->cfg->comm_reset_applies_id) {
+            (void)co_store_restore(node, CO_CLS_LSS, 0x0000, 0xFFFF);
+        }
+    }
+    const co_lss_para_t *lss = node->ram[CO_CLS_LSS];
+    if (kind == CO_RESET_NODE || node->cfg->comm_reset_applies_id) {
+        bool id_ok = lss != NULL && lss->node_id >= 1u && lss->node_id <= 127u;
+        node->node_id = id_ok ? lss->node_id : node->cfg->default_node_id;
     }
     co_sdo_init(&node->sdo);
     node->autostart = false;

@@ -254,6 +254,29 @@ co_res_t co_store_request_defaults(co_node_t *node, co_cls_t cls)
     return write_record(node, cls, FLAG_DEFAULTS);
 }
 
+/* The class's RAM struct equals its newest valid stored record. */
+static bool same_as_stored(co_node_t *node, co_cls_t cls)
+{
+    slot_info_t s[2];
+    bool hw = false;
+    s[0] = check_slot(node, cls, 0, &hw);
+    s[1] = check_slot(node, cls, 1, &hw);
+    int k = newest(s);
+    if (k < 0 || s[k].flags != 0u) {
+        return false;
+    }
+    uint32_t a = slot_addr(node, cls, (unsigned)k) + CO_STORE_HDR;
+    const uint8_t *ram = node->ram[cls];
+    uint8_t chunk[16];
+    for (uint32_t at = 0; at < s[k].len; at += sizeof(chunk)) {
+        uint32_t n = co_min_u32(sizeof(chunk), s[k].len - at);
+        if (!co_port_nvm_read(node->port, a + at, chunk, n) || memcmp(chunk, ram + at, n) != 0) {
+            return false;
+        }
+    }
+    return true;
+}
+
 static void notify(co_node_t *node, uint32_t sig)
 {
     if (node->cfg->ops != NULL && node->cfg->ops->stored != NULL) {
@@ -267,7 +290,13 @@ co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
     if (value != CO_SIG_SAVE) {
         return CO_E_STORE;
     }
+    /* "Save all parameters"; the LSS set too where the product keeps
+     * node-ID and bit rate among the saved parameters. */
     co_res_t r = co_store_save(node, CO_CLS_PARA);
+    if (r == CO_OK && node->cfg->save_includes_lss && stored_class(node, CO_CLS_LSS) &&
+        !same_as_stored(node, CO_CLS_LSS)) {
+        r = co_store_save(node, CO_CLS_LSS); /* unchanged: no write cycle spent */
+    }
     if (r == CO_OK) {
         notify(node, value);
     }

@@ -209,6 +209,9 @@ void co_tpdo_build(co_node_t *node, unsigned n, co_frame_t *f)
         pos = (uint8_t)(pos + nb);
     }
     f->dlc = node->cfg->tpdo_dlc != 0u ? node->cfg->tpdo_dlc : t->len;
+    if (node->cfg->ops != NULL && node->cfg->ops->tpdo_fill != NULL) {
+        node->cfg->ops->tpdo_fill(node, n, f);
+    }
 }
 
 static void send_frame(co_node_t *node, co_tpdo_t *t, const co_frame_t *f)
