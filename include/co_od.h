@@ -123,6 +123,9 @@ co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf
 /* Plain store of a numeric value into the entry's RAM (no checks, no hook). */
 co_res_t co_od_store(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
+/* The RAM bytes (native order, e->size of them) of value for entry e. */
+void co_od_native(const co_od_entry_t *e, uint32_t value, uint8_t *out);
+
 /* Set every entry of class cls whose index is in [lo, hi] to its default. */
 void co_od_defaults(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi);
 

@@ -62,6 +62,16 @@ co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, u
  */
 co_res_t co_store_save(co_node_t *node, co_cls_t cls);
 
+/*
+ * Save one CiA 301 group of class cls: entries with index in [lo, hi] from
+ * RAM (defaults = false) or as their defaults (true: a group "load"); the
+ * class's other entries keep their stored values. Same results as
+ * co_store_save(). Used by 0x1010 / 0x1011 sub 2 (0x1000-0x1FFF), sub 3
+ * (0x6000-0x9FFF) and sub 4 (0x2000-0x5FFF).
+ */
+co_res_t co_store_save_group(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi,
+                             bool defaults);
+
 /* Make the next restore of cls use defaults (0x1011 "load"). */
 co_res_t co_store_request_defaults(co_node_t *node, co_cls_t cls);
 
@@ -75,8 +85,9 @@ uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls);
 uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len);
 
 /*
- * Write hooks for 0x1010 sub 1 and 0x1011 sub 1. "save" stores PARA (and
- * LSS, if cfg->save_includes_lss and it changed);
+ * Write hooks for 0x1010 and 0x1011, sub 1 (all) or sub 2..4 (a group,
+ * see co_store_save_group). "save" stores PARA (and LSS, if
+ * cfg->save_includes_lss and it changed);
  * "load" requests defaults for PARA and LSS (unless the product keeps
  * LSS, cfg->load_keeps_lss) at the next reset. Wrong
  * signature: CO_E_STORE. Both call the node's on_store op afterwards.

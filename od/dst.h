@@ -96,7 +96,7 @@ extern const product_t dst_x710_xy10, dst_x710_xy15, dst_x710_xy20, dst_x710_xy3
 
 /* A product of the family: symbol, ID, description, variant, input names, config. */
 #define DST_PRODUCT(sym, idstr, text, var, ins, cfgp)                                     \
-    const product_t sym = {.id = idstr, .summary = text, .inputs = ins, .units = "deg", \
+    const product_t sym = {.id = idstr, .summary = text, .inputs = ins,                   \
                            .faults = {"sensor", NULL, NULL, NULL},                 \
                            .nodes = 1, .inst_size = sizeof(dst_dev_t), .create = dst_create, \
                            .sample = dst_sample, .variant = &(var), .cfg = (cfgp),     \
@@ -105,7 +105,7 @@ extern const product_t dst_x710_xy10, dst_x710_xy15, dst_x710_xy20, dst_x710_xy3
 #define DST_BITRATES                                                                    \
     (PRODUCT_BR_20K | PRODUCT_BR_50K | PRODUCT_BR_125K | PRODUCT_BR_250K | PRODUCT_BR_500K | \
      PRODUCT_BR_800K | PRODUCT_BR_1000K)
-#define DST_XY_INPUTS {"x", "y", NULL, NULL}
-#define DST_Z_INPUTS {"z", NULL, NULL, NULL}
+#define DST_XY_INPUTS {{"x", "deg", 0, 3600}, {"y", "deg", 0, 3600}}
+#define DST_Z_INPUTS {{"z", "deg", 0, 3600}}
 
 #endif /* DST_H */

@@ -99,13 +99,13 @@ static const pf_variant_t v_iny = {.cfg = &iny_cfg, .axes = 2};
 
 const product_t pf_inx360d = {
     .id = "inx360d", .summary = "Pepperl+Fuchs INX360D single axis 0..359.9 deg (CiA 410)",
-    .inputs = {"x", NULL, NULL, NULL}, .units = "deg",
+    .inputs = {{"x", "deg", 0, 3600}},
     .faults = {"range-x", "range-y", "undervoltage", NULL},
     .nodes = 1, .inst_size = sizeof(pf_dev_t), .create = pf_create, .sample = pf_sample,
     .variant = &v_inx, .cfg = &inx_cfg, .vendor = "Pepperl+Fuchs", .bitrates = PF_EDS_BITRATES};
 const product_t pf_iny360d = {
     .id = "iny360d", .summary = "Pepperl+Fuchs INY360D dual axis 0..359.9 deg (CiA 410)",
-    .inputs = {"x", "y", NULL, NULL}, .units = "deg",
+    .inputs = {{"x", "deg", 0, 3600}, {"y", "deg", 0, 3600}},
     .faults = {"range-x", "range-y", "undervoltage", NULL},
     .nodes = 1, .inst_size = sizeof(pf_dev_t), .create = pf_create, .sample = pf_sample,
     .variant = &v_iny, .cfg = &iny_cfg, .vendor = "Pepperl+Fuchs", .bitrates = PF_EDS_BITRATES};

@@ -20,11 +20,18 @@
 
 typedef struct product product_t;
 
+/* One simulated physical input. */
+typedef struct product_input {
+    const char *name;  /* "x", "length"; NULL ends the list */
+    const char *unit;  /* "deg", "mm", "%" */
+    int32_t initial;   /* value at power-on, thousandths of the unit */
+    int32_t limit;     /* largest magnitude accepted, in the unit */
+} product_input_t;
+
 struct product {
     const char *id;          /* e.g. "dst-x730-xy30" */
     const char *summary;     /* one line for --list-products */
-    const char *inputs[PRODUCT_MAX_INPUTS]; /* simulator input names, NULL-ended */
-    const char *units;       /* unit of the inputs, for messages */
+    product_input_t inputs[PRODUCT_MAX_INPUTS]; /* simulated inputs */
     const char *faults[PRODUCT_MAX_INPUTS]; /* simulator fault names, NULL-ended */
     unsigned nodes;          /* nodes this product runs */
     size_t inst_size;        /* bytes create() needs */

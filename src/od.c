@@ -111,6 +111,11 @@ static void store_value(const co_od_entry_t *e, uint8_t *p, uint32_t v)
     }
 }
 
+void co_od_native(const co_od_entry_t *e, uint32_t value, uint8_t *out)
+{
+    store_value(e, out, value);
+}
+
 co_res_t co_od_get(co_node_t *node, const co_od_entry_t *e, uint32_t *value)
 {
     if (e->read != NULL) {

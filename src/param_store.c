@@ -201,7 +201,52 @@ bool co_store_limit_reached(const co_node_t *node)
     return lim != 0u && node->store.writes >= lim;
 }
 
-static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags)
+/* A group write: entries of the class with index in [lo, hi] come from
+ * RAM (or their defaults, for a group restore), the others keep what the
+ * newest record holds (their defaults when there is none). */
+typedef struct group {
+    uint16_t lo, hi;
+    bool defaults;   /* the group's entries take their default values */
+    int from;        /* slot holding the record to keep the rest from; -1: defaults */
+} group_t;
+
+/* Bytes [at, at + n) of the record data for class cls. */
+static bool record_chunk(co_node_t *node, co_cls_t cls, const group_t *g, uint32_t at,
+                         uint8_t *out, uint32_t n)
+{
+    memcpy(out, (const uint8_t *)node->ram[cls] + at, n);
+    if (g == NULL) {
+        return true;
+    }
+    const co_od_t *od = node->cfg->od;
+    for (uint16_t i = 0; i < od->count; i++) {
+        const co_od_entry_t *e = &od->entries[i];
+        if (e->cls != cls || e->off + e->size <= at || e->off >= at + n) {
+            continue;
+        }
+        bool in_group = e->index >= g->lo && e->index <= g->hi;
+        if (in_group && !g->defaults) {
+            continue; /* RAM, already there */
+        }
+        uint8_t v[4];
+        if (in_group || g->from < 0) {
+            co_od_native(e, e->def, v); /* records hold the RAM image */
+        } else if (!co_port_nvm_read(node->port,
+                                     slot_addr(node, cls, (unsigned)g->from) + CO_STORE_HDR + e->off,
+                                     v, e->size)) {
+            return false;
+        }
+        for (uint16_t b = 0; b < e->size; b++) {
+            uint32_t pos = e->off + b;
+            if (pos >= at && pos < at + n) {
+                out[pos - at] = v[b];
+            }
+        }
+    }
+    return true;
+}
+
+static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags, group_t *g)
 {
     if (!stored_class(node, cls)) {
         return CO_E_STORE;
@@ -217,6 +262,9 @@ static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags)
     unsigned target = (k == 0) ? 1u : 0u;
     uint32_t seq = (k < 0) ? 1u : s[k].seq + 1u;
     uint32_t len = (flags & FLAG_DEFAULTS) != 0u ? 0u : node->cfg->ram_size[cls];
+    if (g != NULL) {
+        g->from = (k >= 0 && (s[k].flags & FLAG_DEFAULTS) == 0u) ? k : -1;
+    }
 
     uint8_t h[CO_STORE_HDR] = {0};
     co_put_u32(&h[0], STORE_MAGIC);
@@ -226,19 +274,27 @@ static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags)
     co_put_u16(&h[16], (uint16_t)len);
     h[18] = flags;
     h[19] = (uint8_t)cls;
+    uint32_t a = slot_addr(node, cls, target);
     uint32_t crc = co_crc32(0, h, sizeof(h));
-    crc = co_crc32(crc, node->ram[cls], len);
+    if (!co_port_nvm_write(node->port, a, h, sizeof(h))) {
+        return CO_E_HW;
+    }
+    uint8_t chunk[16];
+    for (uint32_t at = 0; at < len; at += sizeof(chunk)) {
+        uint32_t n = co_min_u32(sizeof(chunk), len - at);
+        if (!record_chunk(node, cls, g, at, chunk, n) ||
+            !co_port_nvm_write(node->port, a + CO_STORE_HDR + at, chunk, n)) {
+            return CO_E_HW;
+        }
+        crc = co_crc32(crc, chunk, n);
+    }
     uint8_t c[4];
     co_put_u32(c, crc);
-
-    uint32_t a = slot_addr(node, cls, target);
-    if (!co_port_nvm_write(node->port, a, h, sizeof(h)) ||
-        !co_port_nvm_write(node->port, a + CO_STORE_HDR, node->ram[cls], len) ||
-        !co_port_nvm_write(node->port, a + CO_STORE_HDR + len, c, sizeof(c))) {
+    if (!co_port_nvm_write(node->port, a + CO_STORE_HDR + len, c, sizeof(c))) {
         return CO_E_HW;
     }
     node->store.writes++;
-    if (node->store.status[cls] != CO_STORE_OK && flags == 0u) {
+    if (node->store.status[cls] != CO_STORE_OK && flags == 0u && g == NULL) {
         node->store.status[cls] = CO_STORE_OK; /* the stored set is sound again */
     }
     return CO_OK;
@@ -246,12 +302,19 @@ static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags)
 
 co_res_t co_store_save(co_node_t *node, co_cls_t cls)
 {
-    return write_record(node, cls, 0);
+    return write_record(node, cls, 0, NULL);
 }
 
 co_res_t co_store_request_defaults(co_node_t *node, co_cls_t cls)
 {
-    return write_record(node, cls, FLAG_DEFAULTS);
+    return write_record(node, cls, FLAG_DEFAULTS, NULL);
+}
+
+co_res_t co_store_save_group(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi,
+                             bool defaults)
+{
+    group_t g = {.lo = lo, .hi = hi, .defaults = defaults, .from = -1};
+    return write_record(node, cls, 0, &g);
 }
 
 /* The class's RAM struct equals its newest valid stored record. */
@@ -284,18 +347,37 @@ static void notify(co_node_t *node, uint32_t sig)
     }
 }
 
+/* CiA 301 groups of 0x1010 / 0x1011 sub 2, 3, 4. */
+static const uint16_t group_lo[5] = {0, 0, 0x1000, 0x6000, 0x2000};
+static const uint16_t group_hi[5] = {0, 0, 0x1FFF, 0x9FFF, 0x5FFF};
+
+/* Save or restore (defaults) the group of sub-index sub in PARA, and in
+ * LSS where the product keeps node-ID and bit rate among its parameters. */
+static co_res_t group_op(co_node_t *node, uint8_t sub, bool defaults)
+{
+    co_res_t r = co_store_save_group(node, CO_CLS_PARA, group_lo[sub], group_hi[sub], defaults);
+    if (r == CO_OK && node->cfg->save_includes_lss && stored_class(node, CO_CLS_LSS)) {
+        r = co_store_save_group(node, CO_CLS_LSS, group_lo[sub], group_hi[sub], defaults);
+    }
+    return r;
+}
+
 co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
-    (void)e;
     if (value != CO_SIG_SAVE) {
         return CO_E_STORE;
     }
-    /* "Save all parameters"; the LSS set too where the product keeps
-     * node-ID and bit rate among the saved parameters. */
-    co_res_t r = co_store_save(node, CO_CLS_PARA);
-    if (r == CO_OK && node->cfg->save_includes_lss && stored_class(node, CO_CLS_LSS) &&
-        !same_as_stored(node, CO_CLS_LSS)) {
-        r = co_store_save(node, CO_CLS_LSS); /* unchanged: no write cycle spent */
+    co_res_t r;
+    if (e->sub >= 2u && e->sub <= 4u) {
+        r = group_op(node, e->sub, false);
+    } else {
+        /* "Save all parameters"; the LSS set too where the product keeps
+         * node-ID and bit rate among the saved parameters. */
+        r = co_store_save(node, CO_CLS_PARA);
+        if (r == CO_OK && node->cfg->save_includes_lss && stored_class(node, CO_CLS_LSS) &&
+            !same_as_stored(node, CO_CLS_LSS)) {
+            r = co_store_save(node, CO_CLS_LSS); /* unchanged: no write cycle spent */
+        }
     }
     if (r == CO_OK) {
         notify(node, value);
@@ -305,13 +387,17 @@ co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
 
 co_res_t co_store_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
-    (void)e;
     if (value != CO_SIG_LOAD) {
         return CO_E_STORE;
     }
-    co_res_t r = co_store_request_defaults(node, CO_CLS_PARA);
-    if (r == CO_OK && stored_class(node, CO_CLS_LSS) && !node->cfg->load_keeps_lss) {
-        r = co_store_request_defaults(node, CO_CLS_LSS);
+    co_res_t r;
+    if (e->sub >= 2u && e->sub <= 4u) {
+        r = group_op(node, e->sub, true);
+    } else {
+        r = co_store_request_defaults(node, CO_CLS_PARA);
+        if (r == CO_OK && stored_class(node, CO_CLS_LSS) && !node->cfg->load_keeps_lss) {
+            r = co_store_request_defaults(node, CO_CLS_LSS);
+        }
     }
     if (r == CO_OK) {
         notify(node, value);

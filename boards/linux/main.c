@@ -215,7 +215,7 @@ int main(int argc, char **argv)
         lp_log_open(lf);
     }
     a.nnodes = a.prod->nodes;
-    a.sim.prod = a.prod;
+    sim_init(&a.sim, a.prod);
 
     /* Interfaces: one for all nodes, or one per node ("A,B"). */
     char ifbuf[128];

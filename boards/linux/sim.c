@@ -8,14 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Largest magnitude accepted for an input, in its unit (the angle filter
- * works on |x| < 8000 deg; nothing physical comes near this). */
-#define SIM_MAX 3600.0
-
 static int input_index(const product_t *p, const char *name, size_t len)
 {
-    for (int i = 0; i < (int)PRODUCT_MAX_INPUTS && p->inputs[i] != NULL; i++) {
-        if (strlen(p->inputs[i]) == len && strncmp(p->inputs[i], name, len) == 0) {
+    for (int i = 0; i < (int)PRODUCT_MAX_INPUTS && p->inputs[i].name != NULL; i++) {
+        if (strlen(p->inputs[i].name) == len && strncmp(p->inputs[i].name, name, len) == 0) {
             return i;
         }
     }
@@ -25,9 +21,19 @@ static int input_index(const product_t *p, const char *name, size_t len)
 static void names(const product_t *p, char *buf, size_t len)
 {
     buf[0] = '\0';
-    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && p->inputs[i] != NULL; i++) {
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && p->inputs[i].name != NULL; i++) {
         size_t at = strlen(buf);
-        snprintf(buf + at, len - at, "%s%s=<%s>", i ? " " : "", p->inputs[i], p->units);
+        snprintf(buf + at, len - at, "%s%s=<%s>", i ? " " : "", p->inputs[i].name,
+                 p->inputs[i].unit);
+    }
+}
+
+void sim_init(sim_t *s, const product_t *p)
+{
+    memset(s, 0, sizeof(*s));
+    s->prod = p;
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
+        s->values[i] = p->inputs[i].initial;
     }
 }
 
@@ -88,8 +94,9 @@ bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
             }
             char *end;
             double x = strtod(eq + 1, &end);
-            if (end == eq + 1 || *end != '\0' || !isfinite(x) || fabs(x) > SIM_MAX) {
-                snprintf(err, errlen, "'%s': not a number within +-%.0f", tok, SIM_MAX);
+            double lim = s->prod->inputs[i].limit;
+            if (end == eq + 1 || *end != '\0' || !isfinite(x) || fabs(x) > lim) {
+                snprintf(err, errlen, "'%s': not a number within +-%.0f", tok, lim);
                 return false;
             }
             v[i] = (int32_t)lround(x * 1000.0);

@@ -20,6 +20,9 @@ typedef struct sim {
     bool quit;
 } sim_t;
 
+/* Start with the product's initial input values, no fault. */
+void sim_init(sim_t *s, const product_t *p);
+
 /* Apply one line (without its newline). Returns false (and writes why to
  * err, errlen bytes) if the line was rejected; nothing changed then. */
 bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen);

@@ -83,6 +83,9 @@ void h_boot(h_dev_t *d, const product_t *p, bool keep_nvm)
         memset(d, 0, sizeof(*d));
         fake_port_init(&d->port);
         d->now = 1000000u;
+        for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
+            d->truth[i] = p->inputs[i].initial;
+        }
     }
     d->prod = p;
     create(d);

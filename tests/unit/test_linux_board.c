@@ -14,7 +14,8 @@
 
 static void test_sim_commands(void)
 {
-    sim_t s = {.prod = &dst_x730_xy30};
+    sim_t s;
+    sim_init(&s, &dst_x730_xy30);
     char err[200];
     CHECK(sim_command(&s, "set x=12.345 y=-0.5", err, sizeof(err)));
     CHECK_EQ(s.values[0], 12345);
@@ -42,7 +43,8 @@ static void test_sim_commands(void)
     CHECK(sim_command(&s, "", err, sizeof(err)));
     CHECK(sim_command(&s, "# comment", err, sizeof(err)));
     CHECK(sim_command(&s, "quit", err, sizeof(err)) && s.quit);
-    sim_t z = {.prod = &dst_x730_z360};
+    sim_t z;
+    sim_init(&z, &dst_x730_z360);
     CHECK(sim_command(&z, "set z=-179.99", err, sizeof(err)));
     CHECK_EQ(z.values[0], -179990);
     CHECK(!sim_command(&z, "set x=1", err, sizeof(err)));

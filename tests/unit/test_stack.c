@@ -101,7 +101,7 @@ static void t_sample(void *mem, const int32_t v[], uint32_t fault)
     ((t_dev_t *)mem)->vol.counter++;
 }
 
-static const product_t t_prod = {.id = "test", .inputs = {NULL}, .nodes = 1,
+static const product_t t_prod = {.id = "test", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
                                  .inst_size = sizeof(t_dev_t), .create = t_create,
                                  .sample = t_sample};
 
