@@ -68,12 +68,14 @@ bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
 static void create(h_dev_t *d)
 {
     void *ports[PRODUCT_MAX_NODES] = {&d->port, &d->port};
-    co_node_t *nodes[PRODUCT_MAX_NODES];
-    d->prod->create(d->prod, d->mem, ports, nodes);
-    d->node = nodes[0];
+    d->prod->create(d->prod, d->mem, ports, d->nodes);
+    d->nnodes = d->prod->nodes;
+    d->node = d->nodes[0];
     /* One sample before start, as a board reads its sensor before booting. */
     d->prod->sample(d->mem, d->truth, d->fault);
-    co_node_start(d->node, d->now);
+    for (unsigned i = 0; i < d->nnodes; i++) {
+        co_node_start(d->nodes[i], d->now);
+    }
     d->next_sample = d->now + CO_FILTER_PERIOD_US;
 }
 
@@ -104,7 +106,10 @@ void h_advance(h_dev_t *d, uint32_t us)
 {
     uint32_t end = d->now + us;
     for (;;) {
-        uint32_t delay = co_node_poll(d->node, d->now);
+        uint32_t delay = CO_NEVER;
+        for (unsigned i = 0; i < d->nnodes; i++) {
+            delay = co_min_u32(delay, co_node_poll(d->nodes[i], d->now));
+        }
         uint32_t step = co_min_u32(co_time_until(d->now, end), co_time_until(d->now, d->next_sample));
         step = co_min_u32(step, delay);
         if (step == 0u && !co_time_before(d->now, d->next_sample)) {
@@ -141,9 +146,11 @@ unsigned h_hex(const char *hex, uint8_t *out, unsigned cap)
 
 void h_rx_frame(h_dev_t *d, const co_frame_t *f)
 {
-    co_node_poll(d->node, d->now);
-    co_node_receive(d->node, f);
-    co_node_poll(d->node, d->now);
+    for (unsigned i = 0; i < d->nnodes; i++) {
+        co_node_poll(d->nodes[i], d->now);
+        co_node_receive(d->nodes[i], f);
+        co_node_poll(d->nodes[i], d->now);
+    }
 }
 
 void h_rx(h_dev_t *d, uint16_t id, const char *hex)
@@ -211,11 +218,20 @@ void h_expect_none(h_dev_t *d, const char *file, int line)
     }
 }
 
+void h_expect_id(h_dev_t *d, uint16_t id, const char *hex, const char *file, int line)
+{
+    /* Skip other traffic (PDOs of an operational node) up to the frame wanted. */
+    while (d->port.rd < d->port.ntx && d->port.tx[d->port.rd].id != id) {
+        d->port.rd++;
+    }
+    h_expect(d, id, hex, file, line);
+}
+
 void h_sdo(h_dev_t *d, const char *req, const char *resp, const char *file, int line)
 {
     h_drain(d);
     h_rx(d, (uint16_t)(0x600u + d->node->node_id), req);
-    h_expect(d, (uint16_t)(0x580u + d->node->node_id), resp, file, line);
+    h_expect_id(d, (uint16_t)(0x580u + d->node->node_id), resp, file, line);
 }
 
 long long h_read(h_dev_t *d, uint16_t index, uint8_t sub)

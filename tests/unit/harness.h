@@ -76,7 +76,9 @@ typedef struct h_dev {
     _Alignas(max_align_t) unsigned char mem[PRODUCT_INST_MAX];
     const product_t *prod;
     fake_port_t port;
-    co_node_t *node;
+    co_node_t *node;       /* node 0 (SDO helpers talk to it) */
+    co_node_t *nodes[PRODUCT_MAX_NODES];
+    unsigned nnodes;
     uint32_t now;          /* virtual time, us */
     uint32_t next_sample;  /* time of the next sensor sample */
     int32_t truth[PRODUCT_MAX_INPUTS]; /* true inputs, milli-units */
@@ -105,6 +107,9 @@ unsigned h_pending(const h_dev_t *d);
 /* Check the next sent frame against id and hex bytes (DLC = byte count). */
 #define EXPECT(d, id, hex) h_expect((d), (id), (hex), __FILE__, __LINE__)
 void h_expect(h_dev_t *d, uint16_t id, const char *hex, const char *file, int line);
+/* Like EXPECT, skipping frames with other identifiers first. */
+#define EXPECT_ID(d, id, hex) h_expect_id((d), (id), (hex), __FILE__, __LINE__)
+void h_expect_id(h_dev_t *d, uint16_t id, const char *hex, const char *file, int line);
 /* Check that nothing more was sent. */
 #define EXPECT_NONE(d) h_expect_none((d), __FILE__, __LINE__)
 void h_expect_none(h_dev_t *d, const char *file, int line);
