@@ -121,12 +121,15 @@ def test_node_id_and_bitrate_objects(sensor_factory, network, bus):
 def test_emcy_codes(sensor_factory, network, bus):
     sensor = sensor_factory("iny360d")
     node = boot(sensor, network, bus)
+    bus.clear()
     sensor.send("fault range-y on")
-    err = node.emcy.wait(0x5020, timeout=2)
-    assert err is not None and err.register == 0x11
+    m = bus.wait_for(0x81, timeout=2)
+    assert m is not None and bytes(m.data) == bytes.fromhex("2050110000000000")
     sensor.send("fault undervoltage on")
-    err = node.emcy.wait(0x3100, timeout=2)
-    assert err is not None and err.register == 0x15
+    m = bus.wait_for(0x81, timeout=2)
+    assert m is not None and bytes(m.data) == bytes.fromhex("0031150000000000")
+    # The canopen master's EMCY consumer saw both.
+    assert {e.code for e in node.emcy.active} >= {0x5020, 0x3100}
     assert node.sdo[0x1001].raw == 0x15
     sensor.send("fault range-y off")
     sensor.send("fault undervoltage off")
