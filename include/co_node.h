@@ -19,7 +19,9 @@
 #include "co_emcy.h"
 #include "co_guard.h"
 #include "co_hb.h"
+#include "co_hbc.h"
 #include "co_led.h"
+#include "co_lss.h"
 #include "co_nmt.h"
 #include "co_od.h"
 #include "co_sdo.h"
@@ -53,6 +55,12 @@ typedef struct co_node_ops {
     uint32_t (*poll)(co_node_t *node, uint32_t now);
     /* Complete a TPDO after its mapped bytes (fixed layouts, counters, checksums). */
     void (*tpdo_fill)(co_node_t *node, unsigned n, co_frame_t *f);
+    /*
+     * LSS "store configuration": keep node-ID id and CiA 305 bit-timing
+     * index br (0xFF: unchanged). Returns the LSS error code (0 ok,
+     * 1 not supported, 2 storage error). NULL: the LSS class is stored.
+     */
+    uint8_t (*lss_store)(co_node_t *node, uint8_t id, uint8_t br);
     /* LED patterns; when NULL the CiA 303-3 mapping of co_node_leds() holds. */
     void (*leds)(co_node_t *node, co_led_pattern_t *green, co_led_pattern_t *red);
 } co_node_ops_t;
@@ -72,6 +80,8 @@ typedef struct co_node_cfg {
     bool load_keeps_lss;        /* 0x1011 "load" leaves node-ID and bit rate alone */
     bool comm_reset_applies_id; /* reset communication also activates a new node-ID */
     bool save_includes_lss;     /* 0x1010 "save" stores the node-ID / bit-rate set too */
+    bool lss;                   /* LSS slave (CiA 305) */
+    uint16_t lss_bitrates;      /* CiA 305 bit-timing indices supported (bit n = index n) */
 } co_node_cfg_t;
 
 struct co_node {
@@ -93,6 +103,8 @@ struct co_node {
     co_store_t store;
     co_emcy_t emcy;
     co_guard_t guard;
+    co_lss_t lss;
+    co_hbc_t hbc;
     co_tpdo_t tpdo[CO_TPDO_MAX];
 };
 

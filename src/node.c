@@ -61,10 +61,20 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
     co_sdo_init(&node->sdo);
     node->autostart = false;
     if (node->cfg->ops != NULL && node->cfg->ops->reset != NULL) {
-        node->cfg->ops->reset(node, kind);
+        node->cfg->ops->reset(node, kind); /* may set the node-ID from its own objects */
+    }
+    if (node->lss.pending_id != 0u) {
+        /* CiA 305: an LSS-configured node-ID is active from reset communication on. */
+        node->node_id = node->lss.pending_id;
+        node->lss.pending_id = 0;
+    }
+    co_lss_init(node);
+    if (node->node_id == CO_LSS_UNCONFIGURED) {
+        return; /* no node-ID: silent but for LSS until one is configured */
     }
     co_hb_reconfig(node);
     co_guard_reset(node);
+    co_hbc_reconfig(node);
     co_sync_reconfig(node);
     for (unsigned n = 0; n < CO_TPDO_MAX; n++) {
         co_tpdo_reconfig(node, n);
@@ -85,11 +95,14 @@ void co_node_start(co_node_t *node, uint32_t now)
 
 void co_node_receive(co_node_t *node, const co_frame_t *f)
 {
+    if (co_lss_receive(node, f)) {
+        return; /* LSS works in every state, and without a node-ID */
+    }
     if (node->nmt.state == CO_NMT_INIT) {
         return;
     }
     if (co_nmt_receive(node, f) || co_sync_receive(node, f) || co_sdo_receive(node, f) ||
-        co_guard_receive(node, f) || co_tpdo_rtr(node, f)) {
+        co_guard_receive(node, f) || co_hbc_receive(node, f) || co_tpdo_rtr(node, f)) {
         return;
     }
     /* Anything else (other nodes' traffic, RTRs nobody serves) is ignored. */
@@ -101,6 +114,7 @@ uint32_t co_node_poll(co_node_t *node, uint32_t now)
     uint32_t next = co_sdo_poll(node, now);
     next = co_min_u32(next, co_hb_poll(node, now));
     next = co_min_u32(next, co_guard_poll(node, now));
+    next = co_min_u32(next, co_hbc_poll(node, now));
     if (node->cfg->ops != NULL && node->cfg->ops->poll != NULL) {
         next = co_min_u32(next, node->cfg->ops->poll(node, now));
     }

@@ -1,0 +1,37 @@
+/*
+ * co_hbc.h - heartbeat consumer (CiA 301 0x1016, one monitored node).
+ *
+ * 0x1016 sub 1: bits 23..16 node-ID, bits 15..0 time in ms (0: off).
+ * Monitoring starts with the first heartbeat from that node; a missing one
+ * for longer than the time is a heartbeat event: EMCY 8130h in the error
+ * table and, from operational, pre-operational. The next heartbeat clears it.
+ */
+#ifndef CO_HBC_H
+#define CO_HBC_H
+
+#include "co_common.h"
+#include "co_od.h"
+
+typedef struct co_node co_node_t;
+
+typedef struct co_hbc {
+    uint8_t node_id;   /* monitored node; 0: off */
+    uint16_t time_ms;
+    bool started;      /* a heartbeat came since configuration */
+    bool kick;         /* one came: restart the time at the next poll */
+    bool lost;         /* heartbeat event active */
+    uint32_t deadline;
+} co_hbc_t;
+
+/* Re-read 0x1016 sub 1 (after a reset or a write). */
+void co_hbc_reconfig(co_node_t *node);
+
+/* A frame on 0x700 + the monitored node-ID. Returns true if consumed. */
+bool co_hbc_receive(co_node_t *node, const co_frame_t *f);
+
+uint32_t co_hbc_poll(co_node_t *node, uint32_t now);
+
+/* Write hook for 0x1016 sub n: reserved bits 31..24 must be 0. */
+co_res_t co_hbc_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+
+#endif /* CO_HBC_H */

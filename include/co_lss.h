@@ -1,0 +1,42 @@
+/*
+ * co_lss.h - LSS slave (CiA 305): layer setting services on 0x7E5 (master
+ * to slave) and 0x7E4 (slave to master), 8-byte frames.
+ *
+ * Services: switch state global (04h) and selective (40h-43h -> 44h),
+ * configure node-ID (11h) and bit timing (13h), activate bit timing (15h),
+ * store configuration (17h), inquire vendor / product / revision / serial /
+ * node-ID (5Ah-5Eh), identify remote slave (46h-4Bh -> 4Fh), identify
+ * non-configured slave (4Ch -> 50h) and Fastscan (51h -> 4Fh).
+ *
+ * The LSS address is 0x1018 sub 1..4. Node-ID 0xFF is "not configured": such
+ * a node is silent but for LSS; when it gets a node-ID and is switched back
+ * to waiting it resets communication with it (CiA 305). A configured
+ * node-ID becomes active at the next reset communication; "store" keeps it
+ * (and the bit rate) through the product's store hook, or the LSS class.
+ */
+#ifndef CO_LSS_H
+#define CO_LSS_H
+
+#include "co_common.h"
+
+typedef struct co_node co_node_t;
+
+#define CO_LSS_UNCONFIGURED 0xFFu
+
+typedef struct co_lss {
+    uint8_t state;       /* 0 waiting, 1 configuration */
+    uint8_t selective;   /* switch-state-selective progress (matched parts) */
+    uint8_t pending_id;  /* node-ID for the next reset communication; 0: none */
+    uint8_t pending_br;  /* CiA 305 bit-timing index configured; 0xFF: none */
+    uint8_t identify;    /* identify-remote-slave progress */
+    uint8_t fs_sub;      /* Fastscan: which LSS address part is checked next */
+    bool fs_active;      /* Fastscan: confirmed so far */
+} co_lss_t;
+
+void co_lss_init(co_node_t *node);
+
+/* Handle a frame on 0x7E5. Returns true if it was one. Works in every NMT
+ * state, and while the node has no node-ID. */
+bool co_lss_receive(co_node_t *node, const co_frame_t *f);
+
+#endif /* CO_LSS_H */
