@@ -95,6 +95,7 @@ struct co_node {
     uint8_t can_state;          /* co_can_state_t */
     bool autostart;             /* set by the reset op: go operational after boot-up */
     bool pdo_msb_first;         /* PDO values big-endian (DST 0x5001 = 0) */
+    uint8_t reset_request;      /* co_reset_t to perform at the next poll (0: none) */
     uint32_t tx_dropped;        /* frames the board could not queue */
     co_nmt_t nmt;
     co_sdo_t sdo;
@@ -118,6 +119,12 @@ void co_node_init(co_node_t *node, const co_node_cfg_t *cfg, void *port, void *a
 
 /* Power-on: reset node (load the store, boot-up, pre-operational). */
 void co_node_start(co_node_t *node, uint32_t now);
+
+/* Reset at the next poll, after the answer to the current request went out. */
+static inline void co_node_request_reset(co_node_t *node, co_reset_t kind)
+{
+    node->reset_request = (uint8_t)kind;
+}
 
 /* Reset node or communication now (what the NMT commands do). */
 void co_node_reset(co_node_t *node, co_reset_t kind);

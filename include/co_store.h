@@ -22,7 +22,7 @@
 #include "co_od.h"
 
 /* Bytes of one slot in NVM; a class's RAM struct must fit with the header. */
-#define CO_STORE_SLOT 128u
+#define CO_STORE_SLOT 192u
 #define CO_STORE_HDR 24u
 #define CO_STORE_MAX_DATA (CO_STORE_SLOT - CO_STORE_HDR - 4u)
 /* NVM bytes one node needs (2 classes x 2 slots). */

@@ -67,6 +67,12 @@ bool co_tpdo_rtr(co_node_t *node, const co_frame_t *f);
  */
 void co_tpdo_event(co_node_t *node, unsigned n);
 
+/*
+ * Change of state: whether event-driven TPDO n's mapped data differ from
+ * what it last sent (true before its first send). No side effects.
+ */
+bool co_tpdo_changed(co_node_t *node, unsigned n);
+
 /* Event-driven sends; returns the delay until the next one. */
 uint32_t co_tpdo_poll(co_node_t *node, uint32_t now);
 

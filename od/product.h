@@ -16,7 +16,7 @@
 /* Largest number of simulated inputs ("x", "y", ...). */
 #define PRODUCT_MAX_INPUTS 4u
 /* Bytes of the largest product instance; checked by each product. */
-#define PRODUCT_INST_MAX 2048u
+#define PRODUCT_INST_MAX 4096u
 
 typedef struct product product_t;
 

@@ -111,6 +111,11 @@ void co_node_receive(co_node_t *node, const co_frame_t *f)
 uint32_t co_node_poll(co_node_t *node, uint32_t now)
 {
     node->now = now;
+    if (node->reset_request != 0u) {
+        co_reset_t kind = (co_reset_t)node->reset_request;
+        node->reset_request = 0;
+        co_node_reset(node, kind);
+    }
     uint32_t next = co_sdo_poll(node, now);
     next = co_min_u32(next, co_hb_poll(node, now));
     next = co_min_u32(next, co_guard_poll(node, now));

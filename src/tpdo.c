@@ -192,7 +192,8 @@ void co_tpdo_stop(co_node_t *node)
     }
 }
 
-void co_tpdo_build(co_node_t *node, unsigned n, co_frame_t *f)
+/* The mapped part of TPDO n, without the product's fill hook. */
+static void build_mapped(co_node_t *node, unsigned n, co_frame_t *f)
 {
     const co_tpdo_t *t = &node->tpdo[n];
     memset(f, 0, sizeof(*f));
@@ -209,6 +210,11 @@ void co_tpdo_build(co_node_t *node, unsigned n, co_frame_t *f)
         pos = (uint8_t)(pos + nb);
     }
     f->dlc = node->cfg->tpdo_dlc != 0u ? node->cfg->tpdo_dlc : t->len;
+}
+
+void co_tpdo_build(co_node_t *node, unsigned n, co_frame_t *f)
+{
+    build_mapped(node, n, f);
     if (node->cfg->ops != NULL && node->cfg->ops->tpdo_fill != NULL) {
         node->cfg->ops->tpdo_fill(node, n, f);
     }
@@ -280,6 +286,20 @@ bool co_tpdo_rtr(co_node_t *node, const co_frame_t *f)
         return true;
     }
     return false;
+}
+
+bool co_tpdo_changed(co_node_t *node, unsigned n)
+{
+    if (n >= CO_TPDO_MAX) {
+        return false;
+    }
+    co_tpdo_t *t = &node->tpdo[n];
+    if (!t->valid || !event_driven(t) || node->nmt.state != CO_NMT_OPERATIONAL) {
+        return false;
+    }
+    co_frame_t f;
+    build_mapped(node, n, &f);
+    return !t->have_last || memcmp(f.data, t->last, t->len) != 0;
 }
 
 void co_tpdo_event(co_node_t *node, unsigned n)

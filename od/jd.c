@@ -1,0 +1,375 @@
+/*
+ * jd.c - behaviour of the ifm JD1xxx / JD2xxx (shared/specs/ifm-jd.md).
+ * Integer arithmetic only (the target MCUs have no FPU).
+ */
+#include "jd.h"
+
+#include <string.h>
+
+#include "co_incl.h"
+
+#define TURN 360000 /* mdeg */
+
+static jd_dev_t *dev_of(co_node_t *n)
+{
+    return n->app;
+}
+
+/* sin(deg) x 1000, one entry a degree over a quarter turn. */
+static const int16_t sin_q[91] = {
+    0,   17,  35,  52,  70,  87,  105, 122, 139, 156, 174, 191, 208, 225, 242, 259,
+    276, 292, 309, 326, 342, 358, 375, 391, 407, 423, 438, 454, 469, 485, 500, 515,
+    530, 545, 559, 574, 588, 602, 616, 629, 643, 656, 669, 682, 695, 707, 719, 731,
+    743, 755, 766, 777, 788, 799, 809, 819, 829, 839, 848, 857, 866, 875, 883, 891,
+    899, 906, 914, 921, 927, 934, 940, 946, 951, 956, 961, 966, 970, 974, 978, 982,
+    985, 988, 990, 993, 995, 996, 998, 999, 999, 1000, 1000};
+
+static int32_t wrap180(int32_t a)
+{
+    a %= TURN;
+    if (a >= TURN / 2) {
+        a -= TURN;
+    } else if (a < -TURN / 2) {
+        a += TURN;
+    }
+    return a;
+}
+
+/* sin of an angle in mdeg, x 1000, linear between whole degrees. */
+static int32_t isin(int32_t mdeg)
+{
+    int32_t a = wrap180(mdeg);
+    int32_t sign = a < 0 ? -1 : 1;
+    a = a < 0 ? -a : a;
+    if (a > 90000) {
+        a = 180000 - a;
+    }
+    int32_t d = a / 1000;
+    int32_t f = a % 1000;
+    int32_t lo = sin_q[d];
+    int32_t hi = sin_q[d < 90 ? d + 1 : 90];
+    return sign * (lo + (hi - lo) * f / 1000);
+}
+
+static int32_t mod_pos(int32_t a, int32_t m)
+{
+    int32_t r = a % m;
+    return r < 0 ? r + m : r;
+}
+
+/* One turn in resolution units (JD1 wrap). */
+static int32_t turn_lsb(const jd_dev_t *d)
+{
+    return TURN / (int32_t)d->para.resolution;
+}
+
+/* Physical angle in resolution units, rounded (R57). */
+static int32_t measure(const jd_dev_t *d, unsigned axis)
+{
+    return co_div_round(d->raw[axis], (int32_t)d->para.resolution);
+}
+
+/* JD1 offsets live in (-N/2, N/2] (R54). */
+static int32_t norm_offset(const jd_dev_t *d, int32_t off)
+{
+    if (d->axes != 1u) {
+        return off;
+    }
+    int32_t n = turn_lsb(d);
+    int32_t r = mod_pos(off, n);
+    return r > n / 2 ? r - n : r;
+}
+
+static int32_t clamp16(int32_t v)
+{
+    return v > INT16_MAX ? INT16_MAX : (v < INT16_MIN ? INT16_MIN : v);
+}
+
+/* The slope of one axis, 16- or 32-bit flavour (R51, R53, R54, R56). */
+static int32_t slope(const jd_dev_t *d, unsigned axis, bool wide)
+{
+    if (axis >= d->axes) {
+        return 0; /* JD1: 6020h / 6120h read 0 (L1671) */
+    }
+    const jd_para_t *p = &d->para;
+    uint8_t op = wide ? p->op32[axis] : p->op16[axis];
+    int32_t v = measure(d, axis);
+    if ((op & CO_INCL_OP_INVERT) != 0u) {
+        v = -v;
+    }
+    if ((op & CO_INCL_OP_SCALING) != 0u) {
+        v += wide ? p->off32[axis] + p->diff32[axis] : p->off16[axis] + p->diff16[axis];
+    }
+    if (d->axes == 1u) {
+        return mod_pos(v, turn_lsb(d)); /* 0..N-1 */
+    }
+    return wide ? v : clamp16(v);
+}
+
+/* ---- dictionary hooks ------------------------------------------------ */
+
+co_res_t jd_read_slope(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
+{
+    unsigned axis = (e->index & 0x00F0u) == 0x0020u ? 1u : 0u;
+    bool wide = (e->index & 0x0100u) != 0u;
+    *v = (uint32_t)slope(dev_of(n), axis, wide);
+    return CO_OK;
+}
+
+co_res_t jd_read_preset(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
+{
+    /* 0x2600/0x2601 and 0x6012/0x6022 show the one preset (L1121, L1141). */
+    unsigned axis = (e->index == 0x2601u || e->index == 0x6022u) ? 1u : 0u;
+    *v = (uint32_t)dev_of(n)->para.preset[axis];
+    return CO_OK;
+}
+
+co_res_t jd_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    jd_dev_t *d = dev_of(n);
+    unsigned axis = (e->index == 0x2601u || e->index == 0x6022u || e->index == 0x6122u) ? 1u : 0u;
+    int32_t p = e->size == 2u ? (int32_t)(int16_t)v : (int32_t)v;
+    if (d->axes == 1u) {
+        if (e->size == 2u) {
+            p = (int32_t)(uint16_t)v; /* 0..N-1, an unsigned bit pattern (2600h) */
+        }
+        if (p < 0 || p >= turn_lsb(d)) {
+            return CO_E_VAL;
+        }
+    } else {
+        int32_t lim = 90000 / (int32_t)d->para.resolution;
+        if (p < -lim || p > lim) {
+            return CO_E_VAL; /* +-90 deg (C7, C8) */
+        }
+    }
+    int32_t m = measure(d, axis);
+    int32_t m16 = (d->para.op16[axis] & CO_INCL_OP_INVERT) != 0u ? -m : m;
+    int32_t m32 = (d->para.op32[axis] & CO_INCL_OP_INVERT) != 0u ? -m : m;
+    d->para.preset[axis] = p;
+    d->para.off16[axis] = (int16_t)clamp16(norm_offset(d, p - m16));
+    d->para.off32[axis] = norm_offset(d, p - m32);
+    return CO_OK;
+}
+
+co_res_t jd_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    (void)e;
+    if (v != 10u && v != 100u && v != 1000u) {
+        return CO_E_VAL;
+    }
+    jd_para_t *p = &dev_of(n)->para;
+    int32_t old = (int32_t)p->resolution;
+    int32_t now = (int32_t)v;
+    /* Every preset and offset follows into the new unit (R55). */
+    for (unsigned a = 0; a < 2u; a++) {
+        p->preset[a] = co_div_round(p->preset[a] * old, now);
+        p->off16[a] = (int16_t)clamp16(co_div_round(p->off16[a] * old, now));
+        p->off32[a] = co_div_round(p->off32[a] * old, now);
+        p->diff16[a] = (int16_t)clamp16(co_div_round(p->diff16[a] * old, now));
+        p->diff32[a] = co_div_round(p->diff32[a] * old, now);
+    }
+    p->resolution = (uint16_t)v;
+    return CO_OK;
+}
+
+co_res_t jd_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    /* 0x1800:05, 0x1801:05 and 0x2200 are one value (R20). */
+    co_res_t r = co_od_store(n, e, v);
+    co_tpdo_reconfig(n, 0);
+    co_tpdo_reconfig(n, 1);
+    return r;
+}
+
+co_res_t jd_write_inhibit(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    const co_od_entry_t *cob = co_node_entry(n, e->index, 1);
+    uint32_t c = 0;
+    (void)co_od_get(n, cob, &c);
+    if ((c & 0x80000000u) == 0u) {
+        return CO_E_VAL; /* only while the PDO is invalid (R21) */
+    }
+    return co_tpdo_write_hook(n, e, v);
+}
+
+co_res_t jd_write_save_reset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    (void)e;
+    if (v != JD_SAVE_RESET_CODE) {
+        return CO_E_STORE;
+    }
+    co_res_t r = co_store_save(n, CO_CLS_PARA);
+    if (r == CO_OK) {
+        co_node_request_reset(n, CO_RESET_NODE); /* after the confirmation (R38) */
+    }
+    return r;
+}
+
+co_res_t jd_read_sensor(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
+{
+    jd_dev_t *d = dev_of(n);
+    if (e->index == 0x3411u) {
+        *v = d->temp;
+    } else if (e->index <= 0x3402u) {
+        *v = (uint32_t)(int32_t)d->gyro[e->index - 0x3400u];
+    } else {
+        *v = (uint32_t)(int32_t)d->accel[e->index - 0x3403u];
+    }
+    return CO_OK;
+}
+
+/* ---- node ops --------------------------------------------------------- */
+
+static void jd_reset(co_node_t *n, co_reset_t kind)
+{
+    jd_dev_t *d = dev_of(n);
+    if (kind == CO_RESET_NODE && d->para.node_number <= 126u) {
+        n->node_id = (uint8_t)(d->para.node_number + 1u); /* 3000h + 1 (R41) */
+    }
+    n->autostart = d->para.autostart == 1u; /* 3005h, after every boot-up (C33) */
+}
+
+/* CiA 305 bit-timing index to 0x3001 code (R46): 20k..1M are codes 0..7. */
+static const uint8_t lss_to_code[8] = {7, 6, 5, 4, 3, 0xFF, 1, 0};
+
+static uint8_t jd_lss_store(co_node_t *n, uint8_t id, uint8_t br)
+{
+    jd_dev_t *d = dev_of(n);
+    if (id >= 1u && id <= 127u) {
+        d->para.node_number = (uint8_t)(id - 1u);
+    }
+    if (br < 8u && lss_to_code[br] != 0xFFu) {
+        d->para.bitrate = lss_to_code[br];
+    }
+    /* 3000h/3001h are manufacturer parameters (R47). */
+    return co_store_save_group(n, CO_CLS_PARA, 0x2000, 0x5FFF, false) == CO_OK ? 0u : 2u;
+}
+
+static void jd_leds(co_node_t *n, co_led_pattern_t *g, co_led_pattern_t *r)
+{
+    /* Green: on in pre-operational, flashing in operational (C20). */
+    if (n->nmt.state == CO_NMT_PREOP) {
+        *g = CO_LED_ON;
+    } else if (n->nmt.state == CO_NMT_OPERATIONAL) {
+        *g = CO_LED_BLINK;
+    }
+    if (n->can_state == CO_CAN_BUSOFF) {
+        *r = CO_LED_ON;
+    } else if (co_emcy_active(n, CO_EMCY_LIFE_GUARD)) {
+        *r = CO_LED_FLASH2; /* guard or heartbeat event */
+    } else if (n->store.status[CO_CLS_PARA] == CO_STORE_CORRUPT) {
+        *r = CO_LED_BLINK; /* general configuration error (R11) */
+    }
+    if (*r != CO_LED_OFF) {
+        *g = CO_LED_OFF; /* "only red is shown" (L376-378) */
+    }
+}
+
+const co_node_ops_t jd_ops = {
+    .reset = jd_reset,
+    .lss_store = jd_lss_store,
+    .leds = jd_leds,
+};
+
+void jd_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
+{
+    jd_dev_t *d = mem;
+    memset(d, 0, sizeof(*d));
+    d->axes = *(const uint8_t *)p->variant;
+    void *const ram[CO_CLS_COUNT] = {NULL, NULL, &d->para, NULL};
+    co_node_init(&d->node, p->cfg, ports[0], d, ram, 0);
+    nodes[0] = &d->node;
+}
+
+/* Moving average over the last para.maf samples (R59), on continuous angles. */
+static void maf(jd_dev_t *d, const int32_t in[2])
+{
+    uint16_t len = d->para.maf <= JD_MAF_MAX ? d->para.maf : (uint16_t)JD_MAF_MAX;
+    if (len != d->maf_len) {
+        d->maf_len = len;
+        d->maf_pos = 0;
+        d->maf_fill = 0;
+        d->maf_sum[0] = d->maf_sum[1] = 0;
+    }
+    for (unsigned a = 0; a < d->axes; a++) {
+        if (len == 0u) {
+            d->raw[a] = in[a];
+            continue;
+        }
+        if (d->maf_fill == len) {
+            d->maf_sum[a] -= d->maf_buf[a][d->maf_pos];
+        }
+        d->maf_buf[a][d->maf_pos] = in[a];
+        d->maf_sum[a] += in[a];
+        uint16_t n = d->maf_fill < len ? (uint16_t)(d->maf_fill + 1u) : len;
+        d->raw[a] = d->maf_sum[a] / (int32_t)n;
+    }
+    if (len != 0u) {
+        d->maf_pos = (uint16_t)((d->maf_pos + 1u) % len);
+        if (d->maf_fill < len) {
+            d->maf_fill++;
+        }
+    }
+}
+
+void jd_sample(void *mem, const int32_t values[], uint32_t faults)
+{
+    (void)faults;
+    jd_dev_t *d = mem;
+    int32_t in[2] = {0, 0};
+    for (unsigned a = 0; a < d->axes; a++) {
+        int32_t t = wrap180(values[a]);
+        if (d->axes == 2u) {
+            /* +-90 deg, folded back beyond: the output of a gravity sensor (R49). */
+            if (t > 90000) {
+                t = 180000 - t;
+            } else if (t < -90000) {
+                t = -180000 - t;
+            }
+        } else {
+            t = mod_pos(t, TURN);
+            /* Average across 0/360 on the side of the last value. */
+            if (d->maf_fill > 0u && t - d->raw[0] > TURN / 2) {
+                t -= TURN;
+            } else if (d->maf_fill > 0u && d->raw[0] - t > TURN / 2) {
+                t += TURN;
+            }
+        }
+        in[a] = t;
+    }
+    maf(d, in);
+    if (d->axes == 1u) {
+        d->raw[0] = mod_pos(d->raw[0], TURN);
+    }
+    /* Rates (0.1 deg/s) from the 5 ms sample period, accelerations (mg). */
+    int32_t x = values[0];
+    int32_t y = d->axes == 2u ? values[1] : 0;
+    for (unsigned a = 0; a < 2u; a++) {
+        int32_t now = a == 0u ? x : y;
+        int32_t rate = wrap180(now - d->prev[a]) * 2; /* mdeg per 5 ms -> 0.1 deg/s */
+        rate = rate > 5000 ? 5000 : (rate < -5000 ? -5000 : rate);
+        d->prev[a] = now;
+        if (d->axes == 2u) {
+            d->gyro[a] = (int16_t)rate;
+        } else if (a == 0u) {
+            d->gyro[2] = (int16_t)rate; /* JD1 turns about Z */
+        }
+    }
+    if (d->axes == 2u) {
+        d->accel[0] = (int16_t)isin(x);
+        d->accel[1] = (int16_t)isin(y);
+        d->accel[2] = (int16_t)(isin(x + 90000) * isin(y + 90000) / 1000);
+    } else {
+        d->accel[0] = (int16_t)isin(x);
+        d->accel[1] = (int16_t)(-isin(x + 90000));
+        d->accel[2] = 0;
+    }
+    int32_t temp = values[d->axes]; /* the input after the angles: degC x 1000 */
+    d->temp = (uint16_t)(int16_t)co_div_round(temp, 100);
+    /* Types 254/255: a PDO whenever its data changed (R18), within the inhibit time. */
+    for (unsigned n = 0; n < 2u; n++) {
+        if (co_tpdo_changed(&d->node, n)) {
+            co_tpdo_event(&d->node, n);
+        }
+    }
+}
