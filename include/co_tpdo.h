@@ -88,7 +88,7 @@ co_res_t co_tpdo_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
 /*
  * Stricter write hook for a writable COB-ID (sub 1), CiA 301: bits 29 and
  * 11..28 zero, the CAN-ID changes only while the PDO is invalid (bit 31),
- * and not to a restricted CAN-ID. Abort 0x06090030 otherwise.
+ * and a valid one not to a restricted CAN-ID. Abort 0x06090030 otherwise.
  */
 co_res_t co_tpdo_cobid_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 

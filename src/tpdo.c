@@ -122,8 +122,9 @@ static bool restricted(uint32_t id)
 
 co_res_t co_tpdo_cobid_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
-    if ((value & 0x3FFFF800u) != 0u || restricted(value & 0x7FFu)) {
-        return CO_E_VAL;
+    bool valid = (value & 0x80000000u) == 0u;
+    if ((value & 0x3FFFF800u) != 0u || (valid && restricted(value & 0x7FFu))) {
+        return CO_E_VAL; /* an invalid COB-ID may name any CAN-ID (0x80000000) */
     }
     uint32_t cur;
     (void)co_od_get(node, e, &cur);

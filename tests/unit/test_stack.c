@@ -594,7 +594,8 @@ static void test_tpdo_cobid_and_mapping_rules(void)
     /* TPDO2 (0x1801): strict COB-ID; mapping 0x1A01 writable. */
     SDO(d, "23 01 18 01 85 02 00 00", "80 01 18 01 30 00 09 06"); /* valid: no change */
     SDO(d, "23 01 18 01 90 02 00 80", "60 01 18 01 00 00 00 00"); /* invalidate */
-    SDO(d, "23 01 18 01 85 05 00 80", "80 01 18 01 30 00 09 06"); /* SDO range */
+    SDO(d, "23 01 18 01 85 05 00 00", "80 01 18 01 30 00 09 06"); /* valid in the SDO range */
+    SDO(d, "23 01 18 01 00 00 00 80", "60 01 18 01 00 00 00 00"); /* invalid: any CAN-ID */
     SDO(d, "23 01 18 01 00 00 00 A0", "80 01 18 01 30 00 09 06"); /* bit 29 */
     SDO(d, "2F 01 1A 00 01 00 00 00", "80 01 1A 00 41 00 04 06"); /* sub 0 = 1 with bad entry */
     SDO(d, "23 01 1A 01 20 00 00 21", "80 01 1A 01 00 00 01 06"); /* sub 0 != 0 */
