@@ -92,6 +92,7 @@ struct co_node {
     uint32_t nvm_base;          /* where this node's records start in NVM */
     uint32_t now;               /* time of the latest co_node_poll() */
     uint8_t node_id;            /* active node-ID */
+    uint8_t bitrate;            /* active bit-rate code (the product's table) */
     uint8_t can_state;          /* co_can_state_t */
     bool autostart;             /* set by the reset op: go operational after boot-up */
     bool pdo_msb_first;         /* PDO values big-endian (DST 0x5001 = 0) */

@@ -226,6 +226,9 @@ static void jd_reset(co_node_t *n, co_reset_t kind)
     if (kind == CO_RESET_NODE && d->para.node_number <= 126u) {
         n->node_id = (uint8_t)(d->para.node_number + 1u); /* 3000h + 1 (R41) */
     }
+    if (kind == CO_RESET_NODE) {
+        n->bitrate = d->para.bitrate; /* 3001h, read at power-on and reset node */
+    }
     n->autostart = d->para.autostart == 1u; /* 3005h, after every boot-up (C33) */
 }
 

@@ -57,6 +57,7 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
     if (kind == CO_RESET_NODE || node->cfg->comm_reset_applies_id) {
         bool id_ok = lss != NULL && lss->node_id >= 1u && lss->node_id <= 127u;
         node->node_id = id_ok ? lss->node_id : node->cfg->default_node_id;
+        node->bitrate = lss != NULL ? lss->bitrate : node->cfg->default_bitrate;
     }
     co_sdo_init(&node->sdo);
     node->autostart = false;

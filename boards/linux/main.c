@@ -283,9 +283,8 @@ int main(int argc, char **argv)
     uint32_t t = now_us();
     for (unsigned i = 0; i < a.nnodes; i++) {
         co_node_start(a.nodes[i], t);
-        const co_lss_para_t *lss = a.nodes[i]->ram[CO_CLS_LSS];
         lp_log("node %u: %s, node-ID 0x%02X on %s, bit-rate code %u (vcan ignores bit rates)",
-               i, a.prod->id, a.nodes[i]->node_id, ifn[i], lss != NULL ? lss->bitrate : 0u);
+               i, a.prod->id, a.nodes[i]->node_id, ifn[i], a.nodes[i]->bitrate);
     }
     uint32_t next_sample = t + CO_FILTER_PERIOD_US;
     int rc = 0;

@@ -157,6 +157,7 @@ def test_save_power_cut_and_load(model, sensor_factory, network, bus):
     del network[node.id]
     node = boot(sensor, network, bus)
     assert int.from_bytes(node.sdo.upload(0x1800, 5), "little") == 20
+    bus.clear()
     frames = bus.collect(0x1FF, 1.0)  # operational without an NMT start
     assert 45 <= len(frames) <= 52
     node.sdo.download(0x1011, 1, b"load")

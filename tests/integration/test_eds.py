@@ -38,7 +38,8 @@ def test_dcfchk_accepts_the_eds(pid, tmp_path):
 @pytest.mark.parametrize("pid", product_ids())
 def test_canopen_loads_the_eds(pid, tmp_path):
     od = canopen.import_od(str(eds_of(pid, tmp_path)), 5)
-    assert od[0x1000].default & 0xFFFF == 0x019A  # CiA 410 in every product so far
+    # CiA 410, or CiA 406 first for the GSH-A (a multiple logical device).
+    assert od[0x1000].default & 0xFFFF in (0x019A, 0x0196)
     assert 0x1018 in od and 0x1800 in od and 0x1A00 in od
     assert od[0x1800][1].default & 0x7FF == 0x185  # $NODEID resolved
     mapped = [od[0x1A00][s].default for s in range(1, od[0x1A00][0].default + 1)]
