@@ -1,7 +1,8 @@
 /*
- * co_sdo.h - SDO server (CiA 301 7.2.4): expedited and segmented upload and
- * download, toggle check, timeout, abort codes from co_res_t.
- * Block transfer is answered with "command specifier not valid".
+ * co_sdo.h - SDO server (CiA 301 7.2.4): expedited, segmented and block
+ * upload and download (block: CRC-16-CCITT when the client wants it; one
+ * block carries any object, the protocol-switch threshold is not used),
+ * toggle and sequence checks, timeout, abort codes from co_res_t.
  */
 #ifndef CO_SDO_H
 #define CO_SDO_H
@@ -9,8 +10,9 @@
 #include "co_common.h"
 #include "co_od.h"
 
-/* Largest object a segmented download can write (bytes). */
-#define CO_SDO_BUF 32u
+/* Largest object a segmented or block download can write, or a block
+ * upload can read (bytes); the RAM cost of the SDO server is about this. */
+#define CO_SDO_BUF 64u
 /* Default SDO timeout between segments (CiA 301 leaves it to the device). */
 #define CO_SDO_TIMEOUT_US 1000000u
 
@@ -22,8 +24,16 @@ typedef struct co_sdo {
     uint32_t size;  /* bytes of the transfer */
     uint32_t pos;   /* bytes done */
     uint32_t deadline;
+    uint8_t blksize;    /* block transfer: segments per block */
+    uint8_t seq;        /* block download: last good seqno; upload: segments sent */
+    bool crc;           /* block transfer: both sides use the CRC */
+    bool sized;         /* block download: the client indicated the size */
+    uint32_t blk_start; /* block upload: byte position of the current block */
     uint8_t buf[CO_SDO_BUF];
 } co_sdo_t;
+
+/* CRC-16-CCITT (polynomial 0x1021, initial 0), as SDO block transfer uses. */
+uint16_t co_crc16_ccitt(uint16_t crc, const uint8_t *data, uint32_t len);
 
 /* Forget any transfer in progress (reset communication). */
 void co_sdo_init(co_sdo_t *sdo);

@@ -138,3 +138,16 @@ def test_emcy_codes(sensor_factory, network, bus):
     sensor.send("fault sensor on")  # not a P+F fault: refused, nothing changes
     assert sensor.stop() == 0
     assert "fault range-x|range-y|undervoltage on|off" in sensor.stderr
+
+
+def test_sdo_block_transfer(sensor_factory, network, bus):
+    node = boot(sensor_factory("iny360d"), network, bus)
+    with node.sdo.open(0x1008, 0, "rb", block_transfer=True) as f:
+        assert f.read() == b"INY360D-F99-B16-V15"
+    with node.sdo.open(0x6014, 0, "wb", size=2, block_transfer=True) as f:
+        f.write((-200).to_bytes(2, "little", signed=True))
+    assert node.sdo["Differential slope long16 offset"].raw == -200
+    with pytest.raises(SdoAbortedError) as e:
+        with node.sdo.open(0x6014, 0, "wb", size=2, block_transfer=True) as f:
+            f.write((5000).to_bytes(2, "little", signed=True))
+    assert e.value.code == 0x06090031  # the object's own check, through a block

@@ -151,8 +151,9 @@ static void test_sdo_expedited(void)
     SDO(d, "2F 00 20 00 0A 00 00 00", "80 00 20 00 13 00 07 06"); /* length too low */
     SDO(d, "2B 02 10 00 00 00 00 00", "80 02 10 00 00 00 02 06");
     SDO(d, "40 00 10 05 00 00 00 00", "80 00 10 05 11 00 09 06");
-    SDO(d, "A0 00 10 00 00 00 00 00", "80 00 10 00 01 00 04 05"); /* block upload */
-    SDO(d, "C0 00 10 00 00 00 00 00", "80 00 10 00 01 00 04 05"); /* block download */
+    SDO(d, "A0 00 10 00 00 00 00 00", "80 00 10 00 02 00 04 05"); /* block size 0 */
+    SDO(d, "C0 00 10 00 00 00 00 00", "80 00 10 00 02 00 01 06"); /* block write to ro */
+    SDO(d, "C1 00 10 00 00 00 00 00", "80 00 10 00 01 00 04 05"); /* block end, none open */
     SDO(d, "E0 00 10 00 00 00 00 00", "80 00 10 00 01 00 04 05");
     SDO(d, "00 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05"); /* segment, none open */
     /* Not 8 bytes: ignored. A client abort: no answer. */
@@ -235,6 +236,91 @@ static void test_sdo_segmented_download(void)
     SDO(d, "21 08 10 00 05 00 00 00", "80 08 10 00 02 00 01 06");
     SDO(d, "21 00 21 00 04 00 00 00", "80 00 21 00 02 00 01 06");
     CHECK_EQ(h_read(d, 0x2000, 0), 300);
+}
+
+static void test_sdo_block_download(void)
+{
+    boot();
+    /* Initiate with CRC and size 4; the server offers CRC and its block size. */
+    SDO(d, "C6 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x610, "81 F4 01 00 00 00 00 00"); /* seq 1, last: 500 */
+    EXPECT(d, 0x590, "A2 01 0A 00 00 00 00 00");
+    uint8_t v[4] = {0xF4, 0x01, 0x00, 0x00};
+    uint16_t crc = co_crc16_ccitt(0, v, 4);
+    char end[64];
+    snprintf(end, sizeof(end), "CD %02X %02X 00 00 00 00 00", crc & 0xFF, crc >> 8); /* n = 3 */
+    SDO(d, end, "A1 00 00 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x2000, 0), 500);
+    /* Wrong CRC: abort 0x05040004, nothing written. */
+    SDO(d, "C6 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    h_rx(d, 0x610, "81 2C 01 00 00 00 00 00");
+    SDO(d, "CD 12 34 00 00 00 00 00", "80 00 20 00 04 00 04 05");
+    CHECK_EQ(h_read(d, 0x2000, 0), 500);
+    /* No CRC (client without it), value out of range: the object's abort. */
+    SDO(d, "C2 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    h_rx(d, 0x610, "81 05 00 00 00 00 00 00");
+    SDO(d, "CD 00 00 00 00 00 00 00", "80 00 20 00 32 00 09 06");
+    /* A segment out of sequence is acknowledged with the last good one. */
+    SDO(d, "C2 01 20 00 02 00 00 00", "A4 01 20 00 0A 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x610, "82 07 00 00 00 00 00 00"); /* seq 2, last, but seq 1 was lost */
+    EXPECT(d, 0x590, "A2 00 0A 00 00 00 00 00");
+    h_rx(d, 0x610, "81 07 00 00 00 00 00 00");
+    EXPECT(d, 0x590, "A2 01 0A 00 00 00 00 00");
+    SDO(d, "D5 00 00 00 00 00 00 00", "A1 00 00 00 00 00 00 00"); /* n = 5: 2 bytes */
+    CHECK_EQ(h_read(d, 0x2001, 0), 7);
+}
+
+static void test_sdo_block_upload(void)
+{
+    boot();
+    const char *name = "A long device name for segmented transfer"; /* 41 bytes */
+    /* Blocks of 2 segments: 41 bytes take 6 segments, three blocks. */
+    SDO(d, "A4 08 10 00 02 00 00 00", "C6 08 10 00 29 00 00 00");
+    char got[64] = {0};
+    unsigned at = 0;
+    h_drain(d);
+    h_rx(d, 0x610, "A3 00 00 00 00 00 00 00");
+    for (int block = 0; block < 3; block++) {
+        for (int seg = 1; seg <= 2; seg++) {
+            const co_frame_t *f = h_next(d);
+            CHECK(f != NULL && (f->data[0] & 0x7F) == seg);
+            if (f == NULL) {
+                return;
+            }
+            memcpy(&got[at], &f->data[1], 7);
+            at += 7;
+            CHECK_EQ((f->data[0] & 0x80) != 0, block == 2 && seg == 2);
+        }
+        EXPECT_NONE(d);
+        h_rx(d, 0x610, "A2 02 02 00 00 00 00 00");
+    }
+    const co_frame_t *f = h_next(d); /* end: n = 1 unused byte, CRC */
+    CHECK(f != NULL && f->data[0] == (0xC1 | (1u << 2)));
+    if (f != NULL) {
+        CHECK_EQ(co_get_u16(&f->data[1]), co_crc16_ccitt(0, (const uint8_t *)name, 41));
+    }
+    CHECK(memcmp(got, name, 41) == 0);
+    h_rx(d, 0x610, "A1 00 00 00 00 00 00 00");
+    EXPECT_NONE(d);
+    /* A lost segment: acknowledging 1 of 2 sends the rest again. */
+    SDO(d, "A4 00 10 00 02 00 00 00", "C6 00 10 00 04 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x610, "A3 00 00 00 00 00 00 00");
+    EXPECT(d, 0x590, "81 78 56 34 12 00 00 00");
+    h_rx(d, 0x610, "A2 00 02 00 00 00 00 00"); /* nothing arrived: again */
+    EXPECT(d, 0x590, "81 78 56 34 12 00 00 00");
+    h_rx(d, 0x610, "A2 01 02 00 00 00 00 00");
+    f = h_next(d);
+    CHECK(f != NULL && f->data[0] == (0xC1 | (3u << 2)));
+    h_rx(d, 0x610, "A1 00 00 00 00 00 00 00");
+    /* Acknowledging more than was sent: abort, invalid sequence number. */
+    SDO(d, "A4 00 10 00 02 00 00 00", "C6 00 10 00 04 00 00 00");
+    h_rx(d, 0x610, "A3 00 00 00 00 00 00 00");
+    SDO(d, "A2 05 02 00 00 00 00 00", "80 00 10 00 03 00 04 05");
+    /* Write-only object. */
+    SDO(d, "A4 10 10 01 10 00 00 00", "80 10 10 01 01 00 01 06");
 }
 
 static void test_nmt(void)
@@ -629,6 +715,8 @@ int main(void)
     RUN(test_sdo_expedited);
     RUN(test_sdo_segmented_upload);
     RUN(test_sdo_segmented_download);
+    RUN(test_sdo_block_download);
+    RUN(test_sdo_block_upload);
     RUN(test_nmt);
     RUN(test_nmt_stopped_is_silent);
     RUN(test_reset_comm_keeps_application);
