@@ -101,6 +101,12 @@ class Bus(can.Listener):
                 return m
         return None
 
+    def wait_for_any(self, pred, timeout=2.0):
+        for m in self.frames(timeout):
+            if pred(m):
+                return m
+        return None
+
     def collect(self, can_id, seconds):
         return [m for m in self.frames(seconds) if m.arbitration_id == can_id]
 
