@@ -84,22 +84,48 @@ static void start_timer(co_sdo_t *sdo)
     sdo->restart = true;
 }
 
-static void initiate_download(co_node_t *node, const uint8_t *d)
+/*
+ * The object a download initiate (segmented or block) names: it must exist,
+ * be writable, fit the buffer, and match an indicated size. NULL after
+ * answering with the abort.
+ */
+static const co_od_entry_t *download_target(co_node_t *node, const uint8_t *d, bool sized)
 {
-    co_sdo_t *sdo = &node->sdo;
     co_res_t r;
     const co_od_entry_t *e = co_od_find(node->cfg->od, co_get_u16(&d[1]), d[3], &r);
     if (e == NULL) {
         sdo_abort(node, d, r);
-        return;
+        return NULL;
     }
-    if ((e->attr & CO_A_W) == 0u) {
-        sdo_abort(node, d, CO_E_RO);
-        return;
+    uint32_t size = co_get_u32(&d[4]);
+    r = (e->attr & CO_A_W) == 0u           ? CO_E_RO
+        : sized && size > co_od_size(e)    ? CO_E_LEN_HIGH
+        : sized && size < co_od_size(e)    ? CO_E_LEN_LOW
+        : co_od_size(e) > CO_SDO_BUF       ? CO_E_OOM
+                                           : CO_OK;
+    if (r != CO_OK) {
+        sdo_abort(node, d, r);
+        return NULL;
     }
+    return e;
+}
+
+static void initiate_download(co_node_t *node, const uint8_t *d)
+{
+    co_sdo_t *sdo = &node->sdo;
     bool expedited = (d[0] & 0x02u) != 0u;
     bool sized = (d[0] & 0x01u) != 0u;
     if (expedited) {
+        co_res_t r;
+        const co_od_entry_t *e = co_od_find(node->cfg->od, co_get_u16(&d[1]), d[3], &r);
+        if (e != NULL && (e->attr & CO_A_W) == 0u) {
+            r = CO_E_RO;
+            e = NULL;
+        }
+        if (e == NULL) {
+            sdo_abort(node, d, r);
+            return;
+        }
         /* Size not indicated (0x22): the object's own size, at most 4. */
         uint32_t len = sized ? 4u - ((d[0] >> 2) & 0x03u) : co_min_u32(co_od_size(e), 4u);
         r = co_od_write(node, e, &d[4], len);
@@ -110,17 +136,8 @@ static void initiate_download(co_node_t *node, const uint8_t *d)
         }
         return;
     }
-    uint32_t size = sized ? co_get_u32(&d[4]) : 0u;
-    if (sized && size > co_od_size(e)) {
-        sdo_abort(node, d, CO_E_LEN_HIGH);
-        return;
-    }
-    if (sized && size < co_od_size(e)) {
-        sdo_abort(node, d, CO_E_LEN_LOW);
-        return;
-    }
-    if (co_od_size(e) > CO_SDO_BUF) {
-        sdo_abort(node, d, CO_E_OOM);
+    const co_od_entry_t *e = download_target(node, d, sized);
+    if (e == NULL) {
         return;
     }
     sdo->state = SDO_DOWNLOAD;
@@ -234,28 +251,9 @@ static void upload_segment(co_node_t *node, const uint8_t *d)
 static void block_download_initiate(co_node_t *node, const uint8_t *d)
 {
     co_sdo_t *sdo = &node->sdo;
-    co_res_t r;
-    const co_od_entry_t *e = co_od_find(node->cfg->od, co_get_u16(&d[1]), d[3], &r);
-    if (e == NULL) {
-        sdo_abort(node, d, r);
-        return;
-    }
-    if ((e->attr & CO_A_W) == 0u) {
-        sdo_abort(node, d, CO_E_RO);
-        return;
-    }
     sdo->sized = (d[0] & 0x02u) != 0u;
-    uint32_t size = co_get_u32(&d[4]);
-    if (sdo->sized && size > co_od_size(e)) {
-        sdo_abort(node, d, CO_E_LEN_HIGH);
-        return;
-    }
-    if (sdo->sized && size < co_od_size(e)) {
-        sdo_abort(node, d, CO_E_LEN_LOW);
-        return;
-    }
-    if (co_od_size(e) > CO_SDO_BUF) {
-        sdo_abort(node, d, CO_E_OOM);
+    const co_od_entry_t *e = download_target(node, d, sdo->sized);
+    if (e == NULL) {
         return;
     }
     sdo->state = SDO_BLK_DL;

@@ -111,6 +111,25 @@ class Bus(can.Listener):
         return [m for m in self.frames(seconds) if m.arbitration_id == can_id]
 
 
+def eds_od(product, tmp_path, node_id):
+    """The master's dictionary: the product's EDS, as canopen-sensor prints it."""
+    path = tmp_path / f"{product}.eds"
+    path.write_text(subprocess.run([BINARY, "--product", product, "--eds"], check=True,
+                                   capture_output=True, text=True).stdout)
+    return canopen.import_od(str(path), node_id)
+
+
+def boot(sensor, network, bus, node_id):
+    """Start the sensor, wait for its boot-up, and give the master its node."""
+    bus.clear()
+    sensor.start()
+    m = bus.wait_for(0x700 + node_id, timeout=3, pred=lambda m: bytes(m.data) == b"\0")
+    assert m is not None, f"no boot-up from node {node_id:#x}"
+    node = canopen.RemoteNode(node_id, eds_od(sensor.product, sensor.log.parent, node_id))
+    network.add_node(node)
+    return node
+
+
 @pytest.fixture
 def network():
     if not pathlib.Path("/sys/class/net", IFACE).exists():

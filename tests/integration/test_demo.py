@@ -1,6 +1,5 @@
 """The README's demo command runs and shows what it promises."""
 import os
-import pathlib
 import subprocess
 import sys
 

@@ -4,13 +4,11 @@ default) unless a test changes it."""
 import struct
 import time
 
-import subprocess
 
-import canopen
 import pytest
 from canopen.sdo.exceptions import SdoAbortedError
 
-from conftest import BINARY
+from conftest import boot as start_node
 
 NODE = 0x7F
 SW_VERSION = {"dst-x730": b"1.24", "dst-x710": b"1.10"}
@@ -22,23 +20,10 @@ def model(request):
     return request.param
 
 
-def eds_od(product, tmp_path, node_id):
-    """The master's dictionary: the product's EDS, as canopen-sensor prints it."""
-    path = tmp_path / f"{product}.eds"
-    path.write_text(subprocess.run([BINARY, "--product", product, "--eds"], check=True,
-                                   capture_output=True, text=True).stdout)
-    return canopen.import_od(str(path), node_id)
 
 
 def boot(sensor, network, bus, node_id=NODE):
-    bus.clear()
-    sensor.start()
-    m = bus.wait_for(0x700 + node_id, timeout=3)
-    assert m is not None, f"no boot-up from node {node_id:#x}"
-    assert bytes(m.data) == b"\x00"
-    node = canopen.RemoteNode(node_id, eds_od(sensor.product, sensor.log.parent, node_id))
-    network.add_node(node)
-    return node
+    return start_node(sensor, network, bus, node_id)
 
 
 def u32(node, index, sub):

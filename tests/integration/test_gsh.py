@@ -1,7 +1,6 @@
 """Gefran GSH-A end to end on vcan: single (node 0x13) and redundant (0x13 +
 0x14, on one bus or one bus each), against the canopen master, which reads
 the PDO mapping through SDO and decodes with the product's EDS."""
-import subprocess
 import time
 
 import can
@@ -9,14 +8,9 @@ import canopen
 import pytest
 from canopen.sdo.exceptions import SdoAbortedError
 
-from conftest import BINARY
+from conftest import eds_od
 
 
-def eds_od(product, tmp_path, node_id):
-    path = tmp_path / f"{product}.eds"
-    path.write_text(subprocess.run([BINARY, "--product", product, "--eds"], check=True,
-                                   capture_output=True, text=True).stdout)
-    return canopen.import_od(str(path), node_id)
 
 
 def checksum(d):

@@ -2,35 +2,24 @@
 (CiA 305 services, Fastscan included), its node guarding, the heartbeat
 consumer, change-of-state PDOs and the TPDO2 remapping example of the
 manual, decoded through the product's EDS. Factory node-ID 10."""
-import subprocess
 import time
 
 import canopen
 import pytest
-from canopen.lss import (CS_INQUIRE_PRODUCT_CODE, CS_INQUIRE_SERIAL_NUMBER,
-                         CS_INQUIRE_VENDOR_ID)
+from canopen.lss import CS_INQUIRE_SERIAL_NUMBER, CS_INQUIRE_VENDOR_ID
 from canopen.sdo.exceptions import SdoAbortedError
 
-from conftest import BINARY
+from conftest import eds_od
+from conftest import boot as start_node
 
 NODE = 10
 VENDOR, PRODUCT, REVISION, SERIAL = 0x0069666D, 0, 0x00010000, 0x0000D001
 
 
-def eds_od(product, tmp_path, node_id):
-    path = tmp_path / f"{product}.eds"
-    path.write_text(subprocess.run([BINARY, "--product", product, "--eds"], check=True,
-                                   capture_output=True, text=True).stdout)
-    return canopen.import_od(str(path), node_id)
 
 
 def boot(sensor, network, bus, node_id=NODE):
-    bus.clear()
-    sensor.start()
-    assert bus.wait_for(0x700 + node_id, timeout=3, pred=lambda m: bytes(m.data) == b"\0")
-    node = canopen.RemoteNode(node_id, eds_od(sensor.product, sensor.log.parent, node_id))
-    network.add_node(node)
-    return node
+    return start_node(sensor, network, bus, node_id)
 
 
 def test_lss_configure_store_and_activate(sensor_factory, network, bus):

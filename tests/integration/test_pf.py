@@ -1,33 +1,19 @@
 """P+F INX360D / INY360D end to end on vcan0 against the canopen master,
 which knows the sensor only from its EDS. Factory node-ID 1."""
-import struct
-import subprocess
 import time
 
-import canopen
 import pytest
 from canopen.sdo.exceptions import SdoAbortedError
 
-from conftest import BINARY
+from conftest import boot as start_node
 
 NODE = 1
 
 
-def eds_od(product, tmp_path, node_id):
-    path = tmp_path / f"{product}.eds"
-    path.write_text(subprocess.run([BINARY, "--product", product, "--eds"], check=True,
-                                   capture_output=True, text=True).stdout)
-    return canopen.import_od(str(path), node_id)
 
 
 def boot(sensor, network, bus, node_id=NODE):
-    bus.clear()
-    sensor.start()
-    m = bus.wait_for(0x700 + node_id, timeout=3)
-    assert m is not None and bytes(m.data) == b"\x00", f"no boot-up from {node_id}"
-    node = canopen.RemoteNode(node_id, eds_od(sensor.product, sensor.log.parent, node_id))
-    network.add_node(node)
-    return node
+    return start_node(sensor, network, bus, node_id)
 
 
 def test_identity_segmented_name(sensor_factory, network, bus):

@@ -205,6 +205,11 @@ static void test_s8_guarding_and_life_guard(void)
     CHECK(r == CO_LED_FLASH2 && g == CO_LED_OFF); /* guard event; only red shown */
     SDO(d, "40 03 10 00 00 00 00 00", "4F 03 10 00 01 00 00 00"); /* in 1003h */
     SDO(d, "40 03 10 01 00 00 00 00", "43 03 10 01 30 81 00 00");
+    h_rx_frame(d, &rtr); /* the error ends; a second one comes */
+    h_rx(d, 0x000, "01 0A");
+    h_rx_frame(d, &rtr);
+    h_advance(d, 310000);
+    SDO(d, "40 03 10 00 00 00 00 00", "4F 03 10 00 01 00 00 00"); /* depth 1 */
 }
 
 static void test_heartbeat_consumer(void)
