@@ -124,26 +124,6 @@ void h_advance(h_dev_t *d, uint32_t us)
     }
 }
 
-unsigned h_hex(const char *hex, uint8_t *out, unsigned cap)
-{
-    unsigned n = 0;
-    while (*hex != '\0') {
-        if (*hex == ' ') {
-            hex++;
-            continue;
-        }
-        char *end;
-        unsigned long v = strtoul(hex, &end, 16);
-        if (end == hex || n >= cap) {
-            fprintf(stderr, "bad hex in test: %s\n", hex);
-            abort();
-        }
-        out[n++] = (uint8_t)v;
-        hex = end;
-    }
-    return n;
-}
-
 void h_rx_frame(h_dev_t *d, const co_frame_t *f)
 {
     for (unsigned i = 0; i < d->nnodes; i++) {

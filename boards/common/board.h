@@ -1,0 +1,28 @@
+/*
+ * board.h - what a bare-metal board provides to the MCU main loop
+ * (mcu_main.c), besides the stack's own co_port.h. One line per function.
+ * Interrupt handlers only queue; everything else runs in the main loop.
+ */
+#ifndef BOARD_H
+#define BOARD_H
+
+#include "co_common.h"
+
+/* Clocks, pins, timer, CAN at the product's bit-rate code; returns false on a fault. */
+bool board_init(void);
+/* Bring the CAN controller to a bit rate (the product's code, from the node). */
+void board_can_bitrate(uint8_t code);
+/* Free-running microseconds (wraps every 71 minutes). */
+uint32_t board_now_us(void);
+/* Take one received frame from the interrupt's queue; false when empty. */
+bool board_can_receive(co_frame_t *f);
+/* The CAN controller's error state (co_can_state_t). */
+uint8_t board_can_state(void);
+/* Drive the two status LEDs. */
+void board_leds(bool green, bool red);
+/* One sensor sample: the product's inputs in thousandths of their unit. */
+void board_sensor(int32_t values[], uint32_t *faults);
+/* Sleep until an interrupt or about us microseconds have passed. */
+void board_sleep(uint32_t us);
+
+#endif /* BOARD_H */

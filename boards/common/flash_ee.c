@@ -1,0 +1,58 @@
+/*
+ * flash_ee.c - see flash_ee.h.
+ */
+#include "flash_ee.h"
+
+#include "co_store.h"
+
+uint32_t flash_ee_size(const flash_ee_t *fe)
+{
+    return fe->pages * CO_STORE_SLOT;
+}
+
+/* Physical address of logical EEPROM byte addr. */
+static uint32_t phys(const flash_ee_t *fe, uint32_t addr)
+{
+    return fe->base + (addr / CO_STORE_SLOT) * fe->page_size + addr % CO_STORE_SLOT;
+}
+
+static bool in_one_slot(const flash_ee_t *fe, uint32_t addr, uint32_t len)
+{
+    return addr < flash_ee_size(fe) && len <= CO_STORE_SLOT - addr % CO_STORE_SLOT;
+}
+
+bool flash_ee_read(const flash_ee_t *fe, uint32_t addr, void *buf, uint32_t len)
+{
+    uint8_t *b = buf;
+    while (len > 0u) {
+        /* Slot by slot: each lives in its own page. */
+        uint32_t n = CO_STORE_SLOT - addr % CO_STORE_SLOT;
+        n = n < len ? n : len;
+        if (addr >= flash_ee_size(fe)) {
+            return false;
+        }
+        fe->ops->read(fe->ctx, phys(fe, addr), b, n);
+        addr += n;
+        b += n;
+        len -= n;
+    }
+    return true;
+}
+
+bool flash_ee_write(const flash_ee_t *fe, uint32_t addr, const void *buf, uint32_t len)
+{
+    if ((addr & 1u) != 0u || (len & 1u) != 0u || !in_one_slot(fe, addr, len)) {
+        return false;
+    }
+    if (addr % CO_STORE_SLOT == 0u && !fe->ops->erase(fe->ctx, phys(fe, addr))) {
+        return false; /* a record starts: its page is erased first */
+    }
+    const uint8_t *b = buf;
+    for (uint32_t i = 0; i < len; i += 2u) {
+        uint16_t v = (uint16_t)(b[i] | (uint16_t)(b[i + 1u] << 8));
+        if (!fe->ops->program16(fe->ctx, phys(fe, addr + i), v)) {
+            return false;
+        }
+    }
+    return true;
+}

@@ -1,0 +1,72 @@
+/*
+ * mcu_main.c - the bare-metal main loop shared by the MCU boards: one
+ * product (PRODUCT_SYM, chosen at build time), its instance in static
+ * storage, the sensor sampled every CO_FILTER_PERIOD_US, the node polled,
+ * received frames fed in, LEDs driven, and the core asleep in between.
+ */
+#include "board.h"
+#include "co_filter.h"
+#include "co_node.h"
+#include "product.h"
+
+#ifndef PRODUCT_SYM
+#error "build with -DPRODUCT_SYM=<product symbol> (see boards/CMakeLists.txt)"
+#endif
+#ifndef PRODUCT_INST_SIZE
+#error "build with -DPRODUCT_INST_SIZE=<bytes>"
+#endif
+
+extern const product_t PRODUCT_SYM;
+
+int main(void)
+{
+    /* The instance: static storage of this image's one product, sized for it.
+     * Board code, not the stack: the stack itself holds no globals. */
+    static _Alignas(8) unsigned char mem[PRODUCT_INST_SIZE];
+    static int32_t values[PRODUCT_MAX_INPUTS];
+    const product_t *p = &PRODUCT_SYM;
+    co_node_t *nodes[PRODUCT_MAX_NODES];
+    void *ports[PRODUCT_MAX_NODES] = {NULL, NULL};
+    uint32_t faults = 0;
+
+    if (!board_init()) {
+        for (;;) {
+            board_leds(false, true);
+        }
+    }
+    p->create(p, mem, ports, nodes);
+    board_sensor(values, &faults);
+    p->sample(mem, values, faults);
+    uint32_t now = board_now_us();
+    for (unsigned i = 0; i < p->nodes; i++) {
+        co_node_start(nodes[i], now);
+    }
+    board_can_bitrate(nodes[0]->bitrate);
+    uint32_t next_sample = now + CO_FILTER_PERIOD_US;
+    for (;;) {
+        now = board_now_us();
+        if (!co_time_before(now, next_sample)) {
+            board_sensor(values, &faults);
+            p->sample(mem, values, faults);
+            next_sample += CO_FILTER_PERIOD_US;
+        }
+        uint32_t wait = co_time_until(now, next_sample);
+        co_frame_t f;
+        while (board_can_receive(&f)) {
+            for (unsigned i = 0; i < p->nodes; i++) {
+                co_node_poll(nodes[i], now);
+                co_node_receive(nodes[i], &f);
+            }
+        }
+        for (unsigned i = 0; i < p->nodes; i++) {
+            co_node_set_can_state(nodes[i], (co_can_state_t)board_can_state());
+            wait = co_min_u32(wait, co_node_poll(nodes[i], now));
+        }
+        bool g;
+        bool r;
+        uint32_t led_next;
+        co_node_leds(nodes[0], now, &g, &r, &led_next);
+        board_leds(g, r);
+        board_sleep(co_min_u32(wait, led_next));
+    }
+}

@@ -1,0 +1,213 @@
+/*
+ * test_flash_ee.c - the MCU boards' flash EEPROM emulation (boards/common/
+ * flash_ee.c) under a DST X730, on a simulated flash that enforces page
+ * erase and erase-before-write, with a power cut injected at every flash
+ * step (each page erase, each half-word program) of a save. After each cut
+ * the device boots with the old or the new complete parameter set.
+ */
+#include <string.h>
+
+#include "co_port.h"
+#include "dst.h"
+#include "flash_ee.h"
+#include "harness.h"
+
+#define PAGE 1024u
+#define PAGES 4u
+
+typedef struct sim_flash {
+    uint8_t mem[PAGES * PAGE];
+    long steps_left;   /* flash operations before the power fails; -1: never */
+    unsigned erases;
+    unsigned programs;
+    unsigned refused;  /* programs of a non-erased half-word (must stay 0) */
+} sim_flash_t;
+
+static sim_flash_t flash;
+
+static bool power_ok(void)
+{
+    if (flash.steps_left == 0) {
+        return false;
+    }
+    if (flash.steps_left > 0) {
+        flash.steps_left--;
+    }
+    return true;
+}
+
+static bool sim_erase(void *ctx, uint32_t addr)
+{
+    (void)ctx;
+    if (addr % PAGE != 0u || addr >= sizeof(flash.mem)) {
+        return false;
+    }
+    if (!power_ok()) {
+        /* Cut during the erase: the page is left in an undefined state. */
+        for (uint32_t i = 0; i < PAGE; i++) {
+            flash.mem[addr + i] = (uint8_t)(i * 37u + 11u);
+        }
+        return false;
+    }
+    memset(&flash.mem[addr], 0xFF, PAGE);
+    flash.erases++;
+    return true;
+}
+
+static bool sim_program16(void *ctx, uint32_t addr, uint16_t v)
+{
+    (void)ctx;
+    if ((addr & 1u) != 0u || addr + 2u > sizeof(flash.mem)) {
+        return false;
+    }
+    if (flash.mem[addr] != 0xFF || flash.mem[addr + 1u] != 0xFF) {
+        flash.refused++;
+        return false; /* not erased */
+    }
+    if (!power_ok()) {
+        return false;
+    }
+    flash.mem[addr] = (uint8_t)v;
+    flash.mem[addr + 1u] = (uint8_t)(v >> 8);
+    flash.programs++;
+    return true;
+}
+
+static void sim_read(void *ctx, uint32_t addr, void *buf, uint32_t len)
+{
+    (void)ctx;
+    memcpy(buf, &flash.mem[addr], len);
+}
+
+static const flash_ops_t sim_ops = {.erase = sim_erase, .program16 = sim_program16, .read = sim_read};
+static const flash_ee_t fe = {.ops = &sim_ops, .ctx = NULL, .base = 0, .page_size = PAGE, .pages = PAGES};
+
+/* The port: CAN frames are kept for inspection, NVM is the flash. */
+static co_frame_t last_tx;
+
+bool co_port_can_send(void *port, const co_frame_t *frame)
+{
+    (void)port;
+    last_tx = *frame;
+    return true;
+}
+
+uint32_t co_port_nvm_size(void *port)
+{
+    (void)port;
+    return flash_ee_size(&fe);
+}
+
+bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
+{
+    (void)port;
+    return flash_ee_read(&fe, addr, buf, len);
+}
+
+bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
+{
+    (void)port;
+    return flash_ee_write(&fe, addr, buf, len);
+}
+
+static _Alignas(8) unsigned char mem[sizeof(dst_dev_t)];
+static co_node_t *node;
+
+static void power_on(void)
+{
+    void *ports[2] = {NULL, NULL};
+    co_node_t *nodes[2];
+    flash.steps_left = -1;
+    dst_x730_xy30.create(&dst_x730_xy30, mem, ports, nodes);
+    node = nodes[0];
+    co_node_start(node, 0);
+}
+
+static uint32_t sdo(const char *hex)
+{
+    co_frame_t f = {.id = 0x67F, .dlc = 8};
+    h_hex(hex, f.data, 8);
+    co_node_receive(node, &f);
+    return last_tx.data[0] == 0x80u ? co_get_u32(&last_tx.data[4]) : 0u;
+}
+
+static uint32_t get(uint16_t index, uint8_t sub)
+{
+    uint32_t v = 0;
+    (void)co_od_get(node, co_node_entry(node, index, sub), &v);
+    return v;
+}
+
+static void test_power_cut_at_every_flash_step(void)
+{
+    unsigned runs = 0;
+    unsigned old_sets = 0;
+    for (long cut = 0;; cut++) {
+        memset(flash.mem, 0xFF, sizeof(flash.mem));
+        power_on();
+        CHECK_EQ(sdo("2B 17 10 00 64 00 00 00"), 0);
+        CHECK_EQ(sdo("2B 00 18 05 0A 00 00 00"), 0);
+        CHECK_EQ(sdo("23 10 10 01 73 61 76 65"), 0); /* the old set */
+        CHECK_EQ(sdo("23 10 10 01 73 61 76 65"), 0); /* both slots written once */
+        CHECK_EQ(sdo("2B 17 10 00 2C 01 00 00"), 0);
+        CHECK_EQ(sdo("2B 00 18 05 1E 00 00 00"), 0);
+        flash.steps_left = cut;
+        uint32_t r = sdo("23 10 10 01 73 61 76 65"); /* the new set, cut at step `cut` */
+        bool finished = r == 0u;
+        power_on();
+        bool is_old = get(0x1017, 0) == 100 && get(0x1800, 5) == 10;
+        bool is_new = get(0x1017, 0) == 300 && get(0x1800, 5) == 30;
+        CHECK(is_old || is_new);
+        CHECK_EQ(node->store.status[CO_CLS_PARA], CO_STORE_OK);
+        runs++;
+        old_sets += is_old;
+        if (finished) {
+            CHECK(is_new);
+            break;
+        }
+        CHECK_EQ(r, CO_E_HW);
+        if (cut > 2000) {
+            CHECK(!"the save never completed");
+            break;
+        }
+    }
+    printf("     power cut at %u flash steps: old set %u times, new set after the completed save\n",
+           runs - 1u, old_sets);
+    CHECK(runs > 30u);
+    CHECK_EQ(flash.refused, 0); /* never a half-word programmed twice */
+}
+
+static void test_pages_and_alignment(void)
+{
+    memset(flash.mem, 0xFF, sizeof(flash.mem));
+    flash.erases = 0;
+    power_on();
+    CHECK_EQ(sdo("23 10 10 01 73 61 76 65"), 0);
+    CHECK_EQ(flash.erases, 1); /* one page per save */
+    CHECK_EQ(sdo("23 10 10 01 73 61 76 65"), 0);
+    CHECK_EQ(flash.erases, 2);
+    /* The two PARA copies live in pages 0 and 1; the LSS set in pages 2, 3. */
+    CHECK(flash.mem[0] == 0x43 && flash.mem[PAGE] == 0x43); /* "CoPS" magic */
+    CHECK_EQ(flash.mem[2u * PAGE], 0xFF);
+    uint8_t two[2] = {1, 2};
+    CHECK(!flash_ee_write(&fe, 1, two, 2));   /* odd address */
+    CHECK(!flash_ee_write(&fe, 2, two, 1));   /* odd length */
+    CHECK(!flash_ee_write(&fe, CO_STORE_SLOT - 2u, "abcd", 4)); /* across a slot */
+    CHECK(!flash_ee_write(&fe, flash_ee_size(&fe), two, 2));    /* beyond the end */
+    uint8_t b[4];
+    CHECK(flash_ee_read(&fe, CO_STORE_SLOT - 2u, b, 4)); /* reads may cross */
+    CHECK(!flash_ee_read(&fe, flash_ee_size(&fe), b, 1));
+    /* Node-ID commit (LSS class) goes to its own pages. */
+    CHECK_EQ(sdo("2F F0 20 00 06 00 00 00"), 0);
+    CHECK_EQ(sdo("2F F1 20 00 06 00 00 00"), 0);
+    CHECK_EQ(flash.mem[2u * PAGE], 0x43);
+    power_on();
+    CHECK_EQ(node->node_id, 6);
+}
+
+int main(void)
+{
+    RUN(test_power_cut_at_every_flash_step);
+    RUN(test_pages_and_alignment);
+    return h_finish();
+}
