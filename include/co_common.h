@@ -26,6 +26,14 @@ typedef struct co_frame {
     uint8_t data[8];
 } co_frame_t;
 
+/* State of the CAN controller as the board reports it. */
+typedef enum co_can_state {
+    CO_CAN_ACTIVE = 0,
+    CO_CAN_WARNING,  /* an error counter reached the warning limit (96) */
+    CO_CAN_PASSIVE,
+    CO_CAN_BUSOFF,
+} co_can_state_t;
+
 /* "No deadline" returned by poll functions. */
 #define CO_NEVER UINT32_MAX
 

@@ -68,6 +68,12 @@ uint8_t co_emcy_register(const co_node_t *node);
 /* Whether an error code is active. */
 bool co_emcy_active(const co_node_t *node, uint16_t code);
 
+/*
+ * A node op (co_node_ops_t.can_state) reporting CAN errors by EMCY: 8120h
+ * while error passive, 8140h once back from bus-off (CiA 301 codes).
+ */
+void co_emcy_can_state(co_node_t *node, co_can_state_t old_state);
+
 /* Read hook for 0x1001 (error register from the error table). */
 co_res_t co_emcy_register_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
 /* Hooks for 0x1003: sub 0 count (write 0 clears), sub n the n-th newest. */

@@ -29,13 +29,6 @@
 #include "co_sync.h"
 #include "co_tpdo.h"
 
-/* State of the CAN controller as the board reports it. */
-typedef enum co_can_state {
-    CO_CAN_ACTIVE = 0,
-    CO_CAN_WARNING,  /* an error counter reached the warning limit (96) */
-    CO_CAN_PASSIVE,
-    CO_CAN_BUSOFF,
-} co_can_state_t;
 
 /* Stored node-ID and bit rate: the RAM struct of class LSS. */
 typedef struct co_lss_para {
@@ -49,6 +42,8 @@ typedef struct co_node_ops {
     void (*reset)(co_node_t *node, co_reset_t kind);
     /* After every NMT state change, boot-up included (old = INIT). */
     void (*state)(co_node_t *node, co_nmt_state_t old_state);
+    /* The CAN controller's state changed (co_emcy_can_state reports it by EMCY). */
+    void (*can_state)(co_node_t *node, co_can_state_t old_state);
     /* After 0x1010 "save" or 0x1011 "load" succeeded. */
     void (*stored)(co_node_t *node, uint32_t signature);
     /* Product work; returns the delay until it next needs to run. */
@@ -65,11 +60,31 @@ typedef struct co_node_ops {
     void (*leds)(co_node_t *node, co_led_pattern_t *green, co_led_pattern_t *red);
 } co_node_ops_t;
 
+/*
+ * An optional service: linked into an image only when a product's config
+ * lists it (STYLE rule 11: a feature is left out by not linking it).
+ * The core (NMT, SDO, SYNC, heartbeat, TPDO, EMCY, store) is always there.
+ */
+typedef struct co_service {
+    bool (*receive)(co_node_t *node, const co_frame_t *f); /* true: consumed */
+    uint32_t (*poll)(co_node_t *node, uint32_t now);       /* next deadline */
+    void (*reset)(co_node_t *node);                        /* at reset communication */
+    bool always; /* receives in every state, and without a node-ID (LSS) */
+} co_service_t;
+
+extern const co_service_t co_guard_service; /* node and life guarding (co_guard.h) */
+extern const co_service_t co_hbc_service;   /* heartbeat consumer (co_hbc.h) */
+extern const co_service_t co_lss_service;   /* LSS slave (co_lss.h) */
+extern const co_service_t co_rtr_service;   /* TPDOs on remote request (co_tpdo.h) */
+
 /* What a product type is; const, shared by every node of that product. */
 typedef struct co_node_cfg {
     const co_od_t *od;
     const co_node_ops_t *ops;
     const co_led_timing_t *led;
+    const co_service_t *const *services; /* optional services, NULL-ended (may be NULL) */
+    /* SDO block transfer (co_sdo_block, in sdo_block.c), or NULL: not offered. */
+    bool (*sdo_block)(co_node_t *node, const uint8_t *d);
     uint16_t ram_size[CO_CLS_COUNT]; /* sizeof each class struct (0: none) */
     uint8_t default_node_id;
     uint8_t default_bitrate;    /* product's code for its default bit rate */
@@ -80,7 +95,7 @@ typedef struct co_node_cfg {
     bool load_keeps_lss;        /* 0x1011 "load" leaves node-ID and bit rate alone */
     bool comm_reset_applies_id; /* reset communication also activates a new node-ID */
     bool save_includes_lss;     /* 0x1010 "save" stores the node-ID / bit-rate set too */
-    bool lss;                   /* LSS slave (CiA 305) */
+    bool lss;                   /* LSS slave (CiA 305): list co_lss_service too */
     uint16_t lss_bitrates;      /* CiA 305 bit-timing indices supported (bit n = index n) */
 } co_node_cfg_t;
 

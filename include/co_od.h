@@ -146,6 +146,14 @@ static inline uint32_t co_od_size(const co_od_entry_t *e)
 #define CO_TYPE_I16 .type = CO_T_I16, .size = 2
 #define CO_TYPE_I32 .type = CO_T_I32, .size = 4
 #define CO_TYPE_STR(s) .type = CO_T_VSTR, .size = (uint16_t)(sizeof(s) - 1u), .cdata = (s)
+/* The manual's name of an entry. The names serve people and EDS files; an
+ * MCU image that prints no EDS builds with CO_OD_NO_NAMES and saves about
+ * 30 bytes of flash per entry (1.3 KB on the DST X730). */
+#ifdef CO_OD_NO_NAMES
+#define CO_NAME(s) .name = NULL
+#else
+#define CO_NAME(s) .name = (s)
+#endif
 /* Value stored in field f of RAM struct T of class c. */
 #define CO_AT(c, T, f) .cls = (c), .off = (uint16_t)offsetof(T, f)
 

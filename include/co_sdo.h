@@ -10,6 +10,8 @@
 #include "co_common.h"
 #include "co_od.h"
 
+typedef struct co_node co_node_t;
+
 /* Largest object a segmented or block download can write, or a block
  * upload can read (bytes); the RAM cost of the SDO server is about this. */
 #define CO_SDO_BUF 64u
@@ -31,6 +33,9 @@ typedef struct co_sdo {
     uint32_t blk_start; /* block upload: byte position of the current block */
     uint8_t buf[CO_SDO_BUF];
 } co_sdo_t;
+
+/* SDO block transfer (sdo_block.c): set as co_node_cfg_t.sdo_block to offer it. */
+bool co_sdo_block(co_node_t *node, const uint8_t *d);
 
 /* CRC-16-CCITT (polynomial 0x1021, initial 0), as SDO block transfer uses. */
 uint16_t co_crc16_ccitt(uint16_t crc, const uint8_t *data, uint32_t len);

@@ -85,8 +85,7 @@ uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls);
 uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len);
 
 /*
- * Write hooks for 0x1010 and 0x1011, sub 1 (all) or sub 2..4 (a group,
- * see co_store_save_group). "save" stores PARA (and LSS, if
+ * Write hooks for 0x1010 and 0x1011 sub 1 (all parameters). "save" stores PARA (and LSS, if
  * cfg->save_includes_lss and it changed);
  * "load" requests defaults for PARA and LSS (unless the product keeps
  * LSS, cfg->load_keeps_lss) at the next reset. Wrong
@@ -94,5 +93,8 @@ uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len);
  */
 co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 co_res_t co_store_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+/* The same for sub 2..4: one CiA 301 group (co_store_save_group). */
+co_res_t co_store_group_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_store_group_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 #endif /* CO_STORE_H */

@@ -100,7 +100,8 @@ extern const product_t dst_x710_xy10, dst_x710_xy15, dst_x710_xy20, dst_x710_xy3
                            .faults = {"sensor", NULL, NULL, NULL},                 \
                            .nodes = 1, .inst_size = sizeof(dst_dev_t), .create = dst_create, \
                            .sample = dst_sample, .variant = &(var), .cfg = (cfgp),     \
-                           .vendor = "Danfoss A/S", .bitrates = DST_BITRATES}
+                           .vendor = "Danfoss A/S", .bitrates = DST_BITRATES,   \
+                           .kbps = product_kbps_cia}
 /* 0x20F2 codes 0..7: 1000, 800, 500, 250, 125, 100, 50, 20 kbit/s (100 has no EDS key). */
 #define DST_BITRATES                                                                    \
     (PRODUCT_BR_20K | PRODUCT_BR_50K | PRODUCT_BR_125K | PRODUCT_BR_250K | PRODUCT_BR_500K | \

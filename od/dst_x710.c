@@ -17,65 +17,65 @@
 #define VOL(f) CO_AT(CO_CLS_VOL, dst_vol_t, f)
 
 static const co_od_entry_t x710_entries[] = {
-    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = 0x0008019Au, .name = "Device type"},
+    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = 0x0008019Au, CO_NAME("Device type")},
     /* "Always ZERO", also inside the EMCY frame (C-14). */
-    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, .def = 0, .name = "Error register"},
-    {.index = 0x1008, .sub = 0, CO_TYPE_STR("GIB"), .attr = CONST, .name = "Manufacturer device name"},
-    {.index = 0x1009, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, .name = "Manufacturer hardware version"},
-    {.index = 0x100A, .sub = 0, CO_TYPE_STR("1.10"), .attr = CONST, .name = "Manufacturer software version"},
-    {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, .name = "Store parameters"},
-    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, .write = co_store_save_hook, .name = "Save all parameters"},
-    {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, .name = "Restore default parameters"},
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, .def = 0, CO_NAME("Error register")},
+    {.index = 0x1008, .sub = 0, CO_TYPE_STR("GIB"), .attr = CONST, CO_NAME("Manufacturer device name")},
+    {.index = 0x1009, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, CO_NAME("Manufacturer hardware version")},
+    {.index = 0x100A, .sub = 0, CO_TYPE_STR("1.10"), .attr = CONST, CO_NAME("Manufacturer software version")},
+    {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Store parameters")},
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, .write = co_store_save_hook, CO_NAME("Save all parameters")},
+    {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Restore default parameters")},
     /* rw, reads 1 = "restores on command" (C-5, C-36). */
-    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_load_hook, .name = "Restore all default parameters"},
-    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, .write = dst_write_emcy_cobid, .name = "COB-ID EMCY"},
+    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_load_hook, CO_NAME("Restore all default parameters")},
+    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, .write = dst_write_emcy_cobid, CO_NAME("COB-ID EMCY")},
     /* 0 or 20..65535 ms; 1..19 "NOT ACCEPTED". */
-    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, .write = dst_write_hb, .name = "Producer heartbeat time"},
-    {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, .name = "Identity object"},
-    {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x00000093u, .name = "Vendor-ID"},
-    {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x00000064u, .name = "Product code"},
-    {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x00000001u, .name = "Revision number"},
-    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0x00000000u, .name = "Serial number"},
-    {.index = 0x1200, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, .name = "SDO server parameter"},
-    {.index = 0x1200, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x600, .name = "COB-ID client to server"},
-    {.index = 0x1200, .sub = 2, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x580, .name = "COB-ID server to client"},
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, .write = dst_write_hb, CO_NAME("Producer heartbeat time")},
+    {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Identity object")},
+    {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x00000093u, CO_NAME("Vendor-ID")},
+    {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x00000064u, CO_NAME("Product code")},
+    {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x00000001u, CO_NAME("Revision number")},
+    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0x00000000u, CO_NAME("Serial number")},
+    {.index = 0x1200, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("SDO server parameter")},
+    {.index = 0x1200, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x600, CO_NAME("COB-ID client to server")},
+    {.index = 0x1200, .sub = 2, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x580, CO_NAME("COB-ID server to client")},
     /* Highest sub-index 5; sub 4 (reserved) does not exist (C-19). */
-    {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, .name = "TPDO1 communication parameter"},
-    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x180, .name = "COB-ID TPDO1"},
-    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RW, PARA(tx_type), .def = 254, .write = dst_write_tx_type, .name = "Transmission type"},
+    {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, CO_NAME("TPDO1 communication parameter")},
+    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x180, CO_NAME("COB-ID TPDO1")},
+    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RW, PARA(tx_type), .def = 254, .write = dst_write_tx_type, CO_NAME("Transmission type")},
     /* Main table: rw, default 4, 4..65535, unit 1 ms (C-19; Example 3 says ro 0). */
-    {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit_ms), .def = 4, .min = 4, .max = 65535, .write = co_tpdo_write_hook, .name = "Inhibit time"},
+    {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit_ms), .def = 4, .min = 4, .max = 65535, .write = co_tpdo_write_hook, CO_NAME("Inhibit time")},
     /* 0 = inactive, 4..65535 ms; default 100 = 0x64 (C-16, C-17). */
-    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 100, .write = dst_write_event, .name = "Event timer"},
-    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, .name = "TPDO1 mapping parameter"},
-    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x60100010u, .name = "1st mapped object"},
+    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 100, .write = dst_write_event, CO_NAME("Event timer")},
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("TPDO1 mapping parameter")},
+    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x60100010u, CO_NAME("1st mapped object")},
     /* The manual prints 0x60200020; 0x6020 is 16 bits (C-4). */
-    {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x60200010u, .name = "2nd mapped object"},
+    {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x60200010u, CO_NAME("2nd mapped object")},
     /* 0 slow, 1 medium, 2 fast; active after "save". Default 0 (C-2). */
-    {.index = 0x2001, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(filter), .def = 0, .min = 0, .max = 2, .name = "Filter setting"},
-    {.index = 0x20F0, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(id[0]), .def = 0x7F, .min = 1, .max = 127, .write = dst_write_id, .name = "Node-ID setting copy 1"},
-    {.index = 0x20F1, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(id[1]), .def = 0x7F, .min = 1, .max = 127, .write = dst_write_id, .name = "Node-ID setting copy 2"},
+    {.index = 0x2001, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(filter), .def = 0, .min = 0, .max = 2, CO_NAME("Filter setting")},
+    {.index = 0x20F0, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(id[0]), .def = 0x7F, .min = 1, .max = 127, .write = dst_write_id, CO_NAME("Node-ID setting copy 1")},
+    {.index = 0x20F1, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(id[1]), .def = 0x7F, .min = 1, .max = 127, .write = dst_write_id, CO_NAME("Node-ID setting copy 2")},
     /* 0 1000k, 1 800k, 2 500k, 3 250k, 4 125k, 5 100k, 6 50k, 7 20k. */
-    {.index = 0x20F2, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(br[0]), .def = 3, .min = 0, .max = 7, .write = dst_write_bitrate, .name = "Bit rate setting copy 1"},
-    {.index = 0x20F3, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(br[1]), .def = 3, .min = 0, .max = 7, .write = dst_write_bitrate, .name = "Bit rate setting copy 2"},
+    {.index = 0x20F2, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(br[0]), .def = 3, .min = 0, .max = 7, .write = dst_write_bitrate, CO_NAME("Bit rate setting copy 1")},
+    {.index = 0x20F3, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(br[1]), .def = 3, .min = 0, .max = 7, .write = dst_write_bitrate, CO_NAME("Bit rate setting copy 2")},
     /* 0 pre-operational, 1 no change, 2 stopped; 3..255 accepted as 1. */
-    {.index = 0x4000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(err_behaviour), .def = 1, .name = "Error behaviour"},
-    {.index = 0x4001, .sub = 0, CO_TYPE_U8, .attr = RO, .read = dst_read_errors, .name = "Error code"},
-    {.index = 0x5000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(autostart), .def = 0, .min = 0, .max = 1, .name = "Automatic NMT start"},
+    {.index = 0x4000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(err_behaviour), .def = 1, CO_NAME("Error behaviour")},
+    {.index = 0x4001, .sub = 0, CO_TYPE_U8, .attr = RO, .read = dst_read_errors, CO_NAME("Error code")},
+    {.index = 0x5000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(autostart), .def = 0, .min = 0, .max = 1, CO_NAME("Automatic NMT start")},
     /* No 0x5001: PDOs are always little-endian on the X710. */
     /* 10, 50, 100, 500, 1000 (x 0.001 deg); needs scaling on both axes. */
-    {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(incl.resolution), .def = 50, .write = dst_write_resolution, .name = "Resolution"},
-    {.index = 0x6010, .sub = 0, CO_TYPE_I16, .attr = RO | CO_A_PDO, .read = dst_read_slope, .name = "Slope longitudinal"},
+    {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(incl.resolution), .def = 50, .write = dst_write_resolution, CO_NAME("Resolution")},
+    {.index = 0x6010, .sub = 0, CO_TYPE_I16, .attr = RO | CO_A_PDO, .read = dst_read_slope, CO_NAME("Slope longitudinal")},
     /* bit0 invert, bit1 scaling; default 0x02 (C-3). */
-    {.index = 0x6011, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(incl.op[0]), .def = 0x02, .min = 0, .max = 3, .name = "Slope longitudinal operating parameter"},
-    {.index = 0x6012, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.preset[0]), .def = 0, .write = dst_write_preset, .name = "Slope longitudinal preset value"},
-    {.index = 0x6013, .sub = 0, CO_TYPE_I16, .attr = RO, PARA(incl.offset[0]), .def = 0, .name = "Slope longitudinal offset"},
-    {.index = 0x6014, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.diff[0]), .def = 0, .name = "Differential slope longitudinal offset"},
-    {.index = 0x6020, .sub = 0, CO_TYPE_I16, .attr = RO | CO_A_PDO, .read = dst_read_slope, .name = "Slope lateral"},
-    {.index = 0x6021, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(incl.op[1]), .def = 0x02, .min = 0, .max = 3, .name = "Slope lateral operating parameter"},
-    {.index = 0x6022, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.preset[1]), .def = 0, .write = dst_write_preset, .name = "Slope lateral preset value"},
-    {.index = 0x6023, .sub = 0, CO_TYPE_I16, .attr = RO, PARA(incl.offset[1]), .def = 0, .name = "Slope lateral offset"},
-    {.index = 0x6024, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.diff[1]), .def = 0, .name = "Differential slope lateral offset"},
+    {.index = 0x6011, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(incl.op[0]), .def = 0x02, .min = 0, .max = 3, CO_NAME("Slope longitudinal operating parameter")},
+    {.index = 0x6012, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.preset[0]), .def = 0, .write = dst_write_preset, CO_NAME("Slope longitudinal preset value")},
+    {.index = 0x6013, .sub = 0, CO_TYPE_I16, .attr = RO, PARA(incl.offset[0]), .def = 0, CO_NAME("Slope longitudinal offset")},
+    {.index = 0x6014, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.diff[0]), .def = 0, CO_NAME("Differential slope longitudinal offset")},
+    {.index = 0x6020, .sub = 0, CO_TYPE_I16, .attr = RO | CO_A_PDO, .read = dst_read_slope, CO_NAME("Slope lateral")},
+    {.index = 0x6021, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(incl.op[1]), .def = 0x02, .min = 0, .max = 3, CO_NAME("Slope lateral operating parameter")},
+    {.index = 0x6022, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.preset[1]), .def = 0, .write = dst_write_preset, CO_NAME("Slope lateral preset value")},
+    {.index = 0x6023, .sub = 0, CO_TYPE_I16, .attr = RO, PARA(incl.offset[1]), .def = 0, CO_NAME("Slope lateral offset")},
+    {.index = 0x6024, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.diff[1]), .def = 0, CO_NAME("Differential slope lateral offset")},
 };
 
 static const co_od_t x710_od = {
@@ -87,6 +87,7 @@ static const co_od_t x710_od = {
 const co_node_cfg_t dst_x710_cfg = {
     .od = &x710_od,
     .ops = &dst_ops,
+    /* No SDO block transfer: "only expedited transfer is used" (B-33). */
     .led = NULL, /* the manual describes no LED: CiA 303-3 patterns */
     .ram_size = {0, sizeof(dst_vol_t), sizeof(dst_para_t), sizeof(co_lss_para_t)},
     .default_node_id = 0x7F,

@@ -15,56 +15,56 @@
 /* The node-ID default (0x3001) is per channel, so two tables differ in one line. */
 #define GSH_ENTRIES(node_id_default)                                                                        \
     /* Multiple logical device, DS-406 first (L504). */ \
-    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = 0xFFFF0196u, .name = "Device type"}, \
+    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = 0xFFFF0196u, CO_NAME("Device type")}, \
     /* "Always 0", even with alarms in the PDO (R-13). */ \
-    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, .def = 0, .name = "Error register"}, \
-    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = RW, PARA(sync_cobid), .def = 0x80, .write = co_sync_write_hook, .name = "COB-ID SYNC"}, \
-    {.index = 0x1008, .sub = 0, CO_TYPE_STR("GSHA"), .attr = CONST, .name = "Manufacturer device name"}, \
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, .def = 0, CO_NAME("Error register")}, \
+    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = RW, PARA(sync_cobid), .def = 0x80, .write = co_sync_write_hook, CO_NAME("COB-ID SYNC")}, \
+    {.index = 0x1008, .sub = 0, CO_TYPE_STR("GSHA"), .attr = CONST, CO_NAME("Manufacturer device name")}, \
     /* "1.xx", format Maj.MinMin: the unit's own values are not known (C-31). */ \
-    {.index = 0x1009, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, .name = "Manufacturer hardware version"}, \
-    {.index = 0x100A, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, .name = "Manufacturer software version"}, \
-    {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, .name = "Store parameters"}, \
+    {.index = 0x1009, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, CO_NAME("Manufacturer hardware version")}, \
+    {.index = 0x100A, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, CO_NAME("Manufacturer software version")}, \
+    {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Store parameters")}, \
     /* wo as the manual says (C-08); subs 2-4 per CiA 301 (C-07). */ \
-    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, .write = co_store_save_hook, .name = "Save all parameters"}, \
-    {.index = 0x1010, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_save_hook, .name = "Save communication parameters"}, \
-    {.index = 0x1010, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_save_hook, .name = "Save application parameters"}, \
-    {.index = 0x1010, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_save_hook, .name = "Save manufacturer parameters"}, \
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, .write = co_store_save_hook, CO_NAME("Save all parameters")}, \
+    {.index = 0x1010, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_group_save_hook, CO_NAME("Save communication parameters")}, \
+    {.index = 0x1010, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_group_save_hook, CO_NAME("Save application parameters")}, \
+    {.index = 0x1010, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_group_save_hook, CO_NAME("Save manufacturer parameters")}, \
     /* No 0x1011 (C-09). Heartbeat 0x1017 is not in the table but described (C-10). */ \
-    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, .write = co_hb_write_hook, .name = "Producer heartbeat time"}, \
-    {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, .name = "Identity object"}, \
-    {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x00000093u, .name = "Vendor-ID"}, \
-    {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x00000067u, .name = "Product code"}, \
-    {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x00000001u, .name = "Revision number"}, \
-    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0, .name = "Serial number"}, /* per unit */ \
-    {.index = 0x1200, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, .name = "SDO server parameter"}, \
-    {.index = 0x1200, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x600, .name = "COB-ID client to server"}, \
-    {.index = 0x1200, .sub = 2, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x580, .name = "COB-ID server to client"}, \
-    {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, .name = "Tx PDO #0 communication parameter"}, \
-    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x180, .name = "COB-ID"}, \
-    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RO, .def = 254, .name = "Transmission type"}, /* fixed (C-11) */ \
-    {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RO, .def = 4, .name = "Inhibit time"}, /* (C-12) */ \
-    {.index = 0x1800, .sub = 4, CO_TYPE_U8, .attr = RO, .def = 0, .name = "Reserved"}, /* listed (C-13) */ \
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, .write = co_hb_write_hook, CO_NAME("Producer heartbeat time")}, \
+    {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Identity object")}, \
+    {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x00000093u, CO_NAME("Vendor-ID")}, \
+    {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x00000067u, CO_NAME("Product code")}, \
+    {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x00000001u, CO_NAME("Revision number")}, \
+    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Serial number")}, /* per unit */ \
+    {.index = 0x1200, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("SDO server parameter")}, \
+    {.index = 0x1200, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x600, CO_NAME("COB-ID client to server")}, \
+    {.index = 0x1200, .sub = 2, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x580, CO_NAME("COB-ID server to client")}, \
+    {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, CO_NAME("Tx PDO #0 communication parameter")}, \
+    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x180, CO_NAME("COB-ID")}, \
+    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RO, .def = 254, CO_NAME("Transmission type")}, /* fixed (C-11) */ \
+    {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RO, .def = 4, CO_NAME("Inhibit time")}, /* (C-12) */ \
+    {.index = 0x1800, .sub = 4, CO_TYPE_U8, .attr = RO, .def = 0, CO_NAME("Reserved")}, /* listed (C-13) */ \
     /* 100 ms (C-02); 0 = off, 4..65535 ms. */ \
-    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 100, .write = gsh_write_event, .name = "Event timer"}, \
+    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 100, .write = gsh_write_event, CO_NAME("Event timer")}, \
     /* Informative: the frame is always the fixed 8-byte layout (C-04). */ \
-    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, .name = "Tx PDO #0 mapping parameter"}, \
-    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x60040010u, .name = "1st object"}, /* (C-03, C-05) */ \
-    {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x68100010u, .name = "2nd object"}, \
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("Tx PDO #0 mapping parameter")}, \
+    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x60040010u, CO_NAME("1st object")}, /* (C-03, C-05) */ \
+    {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x68100010u, CO_NAME("2nd object")}, \
     /* Bit rate 0..7 = 1000, 800, 500, 250, 125, 100, 50, 20 kbit/s; node-ID 1..127.
      * Both saved by 0x1010 and active after a reset (R-29, R-31, C-24). */ \
-    {.index = 0x3000, .sub = 0, CO_TYPE_U8, .attr = RW, LSS(bitrate), .def = 3, .min = 0, .max = 7, .name = "Setting of the baud rate"}, \
-    {.index = 0x3001, .sub = 0, CO_TYPE_U8, .attr = RW, LSS(node_id), .def = (node_id_default), .min = 1, .max = 127, .name = "Setting of the node-ID"}, \
-    {.index = 0x5000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(autostart), .def = 1, .min = 0, .max = 1, .name = "Automatic NMT start after power on"}, \
-    {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RO, .def = 0, .name = "Operating parameters"}, /* (C-16) */ \
+    {.index = 0x3000, .sub = 0, CO_TYPE_U8, .attr = RW, LSS(bitrate), .def = 3, .min = 0, .max = 7, CO_NAME("Setting of the baud rate")}, \
+    {.index = 0x3001, .sub = 0, CO_TYPE_U8, .attr = RW, LSS(node_id), .def = (node_id_default), .min = 1, .max = 127, CO_NAME("Setting of the node-ID")}, \
+    {.index = 0x5000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(autostart), .def = 1, .min = 0, .max = 1, CO_NAME("Automatic NMT start after power on")}, \
+    {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RO, .def = 0, CO_NAME("Operating parameters")}, /* (C-16) */ \
     /* Position in 0x6005 steps (1 mm); the PDO carries its low 16 bits (C-05). */ \
-    {.index = 0x6004, .sub = 0, CO_TYPE_U32, .attr = RO | CO_A_PDO, .read = gsh_read_position, .name = "Position value"}, \
-    {.index = 0x6005, .sub = 0, CO_TYPE_U32, .attr = RO, .def = 1000000u, .name = "Position step setting"}, /* nm (C-17) */ \
-    {.index = 0x67FF, .sub = 0, CO_TYPE_U32, .attr = RO, .def = 0x000A0196u, .name = "Device type logical device 1"}, \
-    {.index = 0x6800, .sub = 0, CO_TYPE_U16, .attr = RO, .def = 100, .name = "Resolution"}, /* 0.1 deg */ \
+    {.index = 0x6004, .sub = 0, CO_TYPE_U32, .attr = RO | CO_A_PDO, .read = gsh_read_position, CO_NAME("Position value")}, \
+    {.index = 0x6005, .sub = 0, CO_TYPE_U32, .attr = RO, .def = 1000000u, CO_NAME("Position step setting")}, /* nm (C-17) */ \
+    {.index = 0x67FF, .sub = 0, CO_TYPE_U32, .attr = RO, .def = 0x000A0196u, CO_NAME("Device type logical device 1")}, \
+    {.index = 0x6800, .sub = 0, CO_TYPE_U16, .attr = RO, .def = 100, CO_NAME("Resolution")}, /* 0.1 deg */ \
     /* 0..3599: UNSIGNED16 as the manual says (C-19). */ \
-    {.index = 0x6810, .sub = 0, CO_TYPE_U16, .attr = RO | CO_A_PDO, .read = gsh_read_angle, .name = "Slope long16"}, \
-    {.index = 0x6811, .sub = 0, CO_TYPE_U8, .attr = RO, .def = 0, .name = "Slope long16 operating parameter"}, \
-    {.index = 0x6FFF, .sub = 0, CO_TYPE_U32, .attr = RO, .def = 0x0002019Au, .name = "Device type logical device 2"} /* (C-18) */
+    {.index = 0x6810, .sub = 0, CO_TYPE_U16, .attr = RO | CO_A_PDO, .read = gsh_read_angle, CO_NAME("Slope long16")}, \
+    {.index = 0x6811, .sub = 0, CO_TYPE_U8, .attr = RO, .def = 0, CO_NAME("Slope long16 operating parameter")}, \
+    {.index = 0x6FFF, .sub = 0, CO_TYPE_U32, .attr = RO, .def = 0x0002019Au, CO_NAME("Device type logical device 2")} /* (C-18) */
 
 static const co_od_entry_t ch1_entries[] = {GSH_ENTRIES(0x13)};
 static const co_od_entry_t ch2_entries[] = {GSH_ENTRIES(0x14)};
@@ -75,7 +75,7 @@ _Static_assert(sizeof(gsh_para_t) <= CO_STORE_MAX_DATA, "PARA set must fit one s
 _Static_assert(sizeof(gsh_dev_t) <= PRODUCT_INST_MAX, "instance must fit PRODUCT_INST_MAX");
 
 #define GSH_CFG(odp, id)                                                             \
-    {.od = (odp), .ops = &gsh_ops, .led = NULL,                                       \
+    {.od = (odp), .ops = &gsh_ops, .led = NULL, .sdo_block = co_sdo_block,             \
      .ram_size = {0, 0, sizeof(gsh_para_t), sizeof(co_lss_para_t)},                    \
      .default_node_id = (id), .default_bitrate = 3, .tpdo_dlc = 8,                     \
      .store_write_limit = 100000u /* L308 */, .save_includes_lss = true /* C-21 */,    \
@@ -94,10 +94,10 @@ const product_t gsh_a = {
     .id = "gsh-a", .summary = "Gefran GSH-A draw-wire + tilt, node 0x13 (CiA 406 + 410)",
     .inputs = GSH_INPUTS, .faults = GSH_FAULTS, .nodes = 1, .inst_size = sizeof(gsh_dev_t),
     .create = gsh_create, .sample = gsh_sample, .cfg = &gsh_ch1_cfg, .vendor = "Gefran",
-    .bitrates = GSH_BITRATES};
+    .bitrates = GSH_BITRATES, .kbps = product_kbps_cia};
 const product_t gsh_a_redundant = {
     .id = "gsh-a-redundant",
     .summary = "Gefran GSH-A redundant: two nodes 0x13 + 0x14 (--iface A or A,B)",
     .inputs = GSH_INPUTS, .faults = GSH_FAULTS, .nodes = 2, .inst_size = sizeof(gsh_dev_t),
     .create = gsh_create, .sample = gsh_sample, .cfg = &gsh_ch1_cfg, .vendor = "Gefran",
-    .bitrates = GSH_BITRATES};
+    .bitrates = GSH_BITRATES, .kbps = product_kbps_cia};

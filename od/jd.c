@@ -270,6 +270,7 @@ static void jd_leds(co_node_t *n, co_led_pattern_t *g, co_led_pattern_t *r)
 
 const co_node_ops_t jd_ops = {
     .reset = jd_reset,
+    .can_state = co_emcy_can_state, /* 8120h, 8140h (R34) */
     .lss_store = jd_lss_store,
     .leds = jd_leds,
 };

@@ -52,6 +52,7 @@ struct product {
     const co_node_cfg_t *cfg;    /* node 0's configuration and dictionary */
     const char *vendor;          /* vendor name */
     uint8_t bitrates;            /* supported bit rates, PRODUCT_BR_* bits */
+    const uint16_t *kbps;        /* kbit/s of each bit-rate code (0: unused), 16 codes */
     bool lss;                    /* LSS slave (CiA 305) */
 };
 
@@ -64,6 +65,14 @@ struct product {
 #define PRODUCT_BR_500K 0x20u
 #define PRODUCT_BR_800K 0x40u
 #define PRODUCT_BR_1000K 0x80u
+
+/* The bit-rate code tables of the manuals (kbit/s by code). */
+extern const uint16_t product_kbps_cia[16];  /* 0 = 1000 ... 7 = 20: DST, GSH-A */
+extern const uint16_t product_kbps_ifm[16];  /* 0 = 20 ... 7 = 1000: ifm JD (3001h) */
+extern const uint16_t product_kbps_pf[16];   /* 1 = 125, 2 = 250, 4 = 500, 8 = 1000: P+F */
+
+/* kbit/s of code for product p, 0 if the code means nothing. */
+uint16_t product_kbps(const product_t *p, uint8_t code);
 
 /* Every product, in --list-products order; NULL-terminated. */
 extern const product_t *const product_list[];

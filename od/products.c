@@ -1,28 +1,14 @@
 /*
- * products.c - the product registry.
+ * products.c - bit-rate code tables shared by the products.
  */
 #include "product.h"
 
-#include <string.h>
+const uint16_t product_kbps_cia[16] = {1000, 800, 500, 250, 125, 100, 50, 20};
+const uint16_t product_kbps_ifm[16] = {20, 50, 100, 125, 250, 500, 800, 1000};
+const uint16_t product_kbps_pf[16] = {[1] = 125, [2] = 250, [4] = 500, [8] = 1000};
 
-#include "dst.h"
-#include "gsh.h"
-#include "jd.h"
-#include "pf.h"
-
-const product_t *const product_list[] = {
-    &dst_x730_xy10, &dst_x730_xy15, &dst_x730_xy20, &dst_x730_xy30, &dst_x730_xy45,
-    &dst_x730_xy60, &dst_x730_xy90, &dst_x730_z360, &dst_x710_xy10, &dst_x710_xy15,
-    &dst_x710_xy20, &dst_x710_xy30, &dst_x710_xy45, &dst_x710_xy60, &dst_x710_xy90,
-    &dst_x710_z360, &gsh_a, &gsh_a_redundant, &jd1xxx, &jd2xxx, &pf_inx360d, &pf_iny360d, NULL,
-};
-
-const product_t *product_find(const char *id)
+uint16_t product_kbps(const product_t *p, uint8_t code)
 {
-    for (size_t i = 0; product_list[i] != NULL; i++) {
-        if (strcmp(product_list[i]->id, id) == 0) {
-            return product_list[i];
-        }
-    }
-    return NULL;
+    return (p->kbps != NULL && code < 16u) ? p->kbps[code] : 0u;
 }
+

@@ -147,3 +147,14 @@ co_res_t co_emcy_cobid_write(co_node_t *node, const co_od_entry_t *e, uint32_t v
     }
     return co_od_store(node, e, value);
 }
+
+void co_emcy_can_state(co_node_t *node, co_can_state_t old_state)
+{
+    /* CiA 301 codes: error passive while it lasts; bus-off reported once
+     * the node is back on the bus (nothing can be sent while off). */
+    (void)co_emcy_error(node, 0x8120, CO_ER_COMM, node->can_state == CO_CAN_PASSIVE, NULL);
+    if (old_state == CO_CAN_BUSOFF) {
+        (void)co_emcy_error(node, 0x8140, CO_ER_COMM, true, NULL);
+        (void)co_emcy_error(node, 0x8140, CO_ER_COMM, false, NULL);
+    }
+}

@@ -247,3 +247,6 @@ bool co_lss_receive(co_node_t *node, const co_frame_t *f)
     }
     return true;
 }
+
+const co_service_t co_lss_service = {.receive = co_lss_receive, .reset = co_lss_init,
+                                     .always = true};

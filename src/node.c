@@ -69,13 +69,15 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
         node->node_id = node->lss.pending_id;
         node->lss.pending_id = 0;
     }
-    co_lss_init(node);
+    for (const co_service_t *const *sv = node->cfg->services; sv != NULL && *sv != NULL; sv++) {
+        if ((*sv)->reset != NULL) {
+            (*sv)->reset(node);
+        }
+    }
     if (node->node_id == CO_LSS_UNCONFIGURED) {
         return; /* no node-ID: silent but for LSS until one is configured */
     }
     co_hb_reconfig(node);
-    co_guard_reset(node);
-    co_hbc_reconfig(node);
     co_sync_reconfig(node);
     for (unsigned n = 0; n < CO_TPDO_MAX; n++) {
         co_tpdo_reconfig(node, n);
@@ -94,16 +96,27 @@ void co_node_start(co_node_t *node, uint32_t now)
     co_node_reset(node, CO_RESET_NODE);
 }
 
+/* Offer f to the optional services of the given kind (always or not). */
+static bool services_receive(co_node_t *node, const co_frame_t *f, bool always)
+{
+    for (const co_service_t *const *sv = node->cfg->services; sv != NULL && *sv != NULL; sv++) {
+        if ((*sv)->always == always && (*sv)->receive != NULL && (*sv)->receive(node, f)) {
+            return true;
+        }
+    }
+    return false;
+}
+
 void co_node_receive(co_node_t *node, const co_frame_t *f)
 {
-    if (co_lss_receive(node, f)) {
+    if (services_receive(node, f, true)) {
         return; /* LSS works in every state, and without a node-ID */
     }
     if (node->nmt.state == CO_NMT_INIT) {
         return;
     }
     if (co_nmt_receive(node, f) || co_sync_receive(node, f) || co_sdo_receive(node, f) ||
-        co_guard_receive(node, f) || co_hbc_receive(node, f) || co_tpdo_rtr(node, f)) {
+        services_receive(node, f, false)) {
         return;
     }
     /* Anything else (other nodes' traffic, RTRs nobody serves) is ignored. */
@@ -119,8 +132,11 @@ uint32_t co_node_poll(co_node_t *node, uint32_t now)
     }
     uint32_t next = co_sdo_poll(node, now);
     next = co_min_u32(next, co_hb_poll(node, now));
-    next = co_min_u32(next, co_guard_poll(node, now));
-    next = co_min_u32(next, co_hbc_poll(node, now));
+    for (const co_service_t *const *sv = node->cfg->services; sv != NULL && *sv != NULL; sv++) {
+        if ((*sv)->poll != NULL) {
+            next = co_min_u32(next, (*sv)->poll(node, now));
+        }
+    }
     if (node->cfg->ops != NULL && node->cfg->ops->poll != NULL) {
         next = co_min_u32(next, node->cfg->ops->poll(node, now));
     }
@@ -130,7 +146,14 @@ uint32_t co_node_poll(co_node_t *node, uint32_t now)
 
 void co_node_set_can_state(co_node_t *node, co_can_state_t s)
 {
+    co_can_state_t old = (co_can_state_t)node->can_state;
+    if (old == s) {
+        return;
+    }
     node->can_state = (uint8_t)s;
+    if (node->cfg->ops != NULL && node->cfg->ops->can_state != NULL) {
+        node->cfg->ops->can_state(node, old);
+    }
 }
 
 void co_node_led_patterns(co_node_t *node, co_led_pattern_t *green, co_led_pattern_t *red)

@@ -364,20 +364,16 @@ static co_res_t group_op(co_node_t *node, uint8_t sub, bool defaults)
 
 co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
+    (void)e;
     if (value != CO_SIG_SAVE) {
         return CO_E_STORE;
     }
-    co_res_t r;
-    if (e->sub >= 2u && e->sub <= 4u) {
-        r = group_op(node, e->sub, false);
-    } else {
-        /* "Save all parameters"; the LSS set too where the product keeps
-         * node-ID and bit rate among the saved parameters. */
-        r = co_store_save(node, CO_CLS_PARA);
-        if (r == CO_OK && node->cfg->save_includes_lss && stored_class(node, CO_CLS_LSS) &&
-            !same_as_stored(node, CO_CLS_LSS)) {
-            r = co_store_save(node, CO_CLS_LSS); /* unchanged: no write cycle spent */
-        }
+    /* "Save all parameters"; the LSS set too where the product keeps
+     * node-ID and bit rate among the saved parameters. */
+    co_res_t r = co_store_save(node, CO_CLS_PARA);
+    if (r == CO_OK && node->cfg->save_includes_lss && stored_class(node, CO_CLS_LSS) &&
+        !same_as_stored(node, CO_CLS_LSS)) {
+        r = co_store_save(node, CO_CLS_LSS); /* unchanged: no write cycle spent */
     }
     if (r == CO_OK) {
         notify(node, value);
@@ -387,18 +383,38 @@ co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
 
 co_res_t co_store_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
+    (void)e;
     if (value != CO_SIG_LOAD) {
         return CO_E_STORE;
     }
-    co_res_t r;
-    if (e->sub >= 2u && e->sub <= 4u) {
-        r = group_op(node, e->sub, true);
-    } else {
-        r = co_store_request_defaults(node, CO_CLS_PARA);
-        if (r == CO_OK && stored_class(node, CO_CLS_LSS) && !node->cfg->load_keeps_lss) {
-            r = co_store_request_defaults(node, CO_CLS_LSS);
-        }
+    co_res_t r = co_store_request_defaults(node, CO_CLS_PARA);
+    if (r == CO_OK && stored_class(node, CO_CLS_LSS) && !node->cfg->load_keeps_lss) {
+        r = co_store_request_defaults(node, CO_CLS_LSS);
     }
+    if (r == CO_OK) {
+        notify(node, value);
+    }
+    return r;
+}
+
+co_res_t co_store_group_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+{
+    if (value != CO_SIG_SAVE || e->sub < 2u || e->sub > 4u) {
+        return CO_E_STORE;
+    }
+    co_res_t r = group_op(node, e->sub, false);
+    if (r == CO_OK) {
+        notify(node, value);
+    }
+    return r;
+}
+
+co_res_t co_store_group_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+{
+    if (value != CO_SIG_LOAD || e->sub < 2u || e->sub > 4u) {
+        return CO_E_STORE;
+    }
+    co_res_t r = group_op(node, e->sub, true);
     if (r == CO_OK) {
         notify(node, value);
     }

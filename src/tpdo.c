@@ -356,3 +356,5 @@ uint32_t co_tpdo_poll(co_node_t *node, uint32_t now)
     }
     return next;
 }
+
+const co_service_t co_rtr_service = {.receive = co_tpdo_rtr};

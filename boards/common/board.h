@@ -7,11 +7,12 @@
 #define BOARD_H
 
 #include "co_common.h"
+#include "product.h"
 
 /* Clocks, pins, timer, CAN at the product's bit-rate code; returns false on a fault. */
 bool board_init(void);
-/* Bring the CAN controller to a bit rate (the product's code, from the node). */
-void board_can_bitrate(uint8_t code);
+/* Bring the CAN controller to a bit rate (kbit/s); false if it cannot. */
+bool board_can_bitrate(uint16_t kbps);
 /* Free-running microseconds (wraps every 71 minutes). */
 uint32_t board_now_us(void);
 /* Take one received frame from the interrupt's queue; false when empty. */
@@ -20,8 +21,8 @@ bool board_can_receive(co_frame_t *f);
 uint8_t board_can_state(void);
 /* Drive the two status LEDs. */
 void board_leds(bool green, bool red);
-/* One sensor sample: the product's inputs in thousandths of their unit. */
-void board_sensor(int32_t values[], uint32_t *faults);
+/* One sensor sample of product p's inputs, in thousandths of their unit. */
+void board_sensor(const product_t *p, int32_t values[], uint32_t *faults);
 /* Sleep until an interrupt or about us microseconds have passed. */
 void board_sleep(uint32_t us);
 

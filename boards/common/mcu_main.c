@@ -9,6 +9,10 @@
 #include "co_node.h"
 #include "product.h"
 
+#ifdef PRODUCT_HEADER
+#include PRODUCT_HEADER /* the product family's instance type, for PRODUCT_INST_SIZE */
+#endif
+
 #ifndef PRODUCT_SYM
 #error "build with -DPRODUCT_SYM=<product symbol> (see boards/CMakeLists.txt)"
 #endif
@@ -35,18 +39,20 @@ int main(void)
         }
     }
     p->create(p, mem, ports, nodes);
-    board_sensor(values, &faults);
+    board_sensor(p, values, &faults);
     p->sample(mem, values, faults);
     uint32_t now = board_now_us();
     for (unsigned i = 0; i < p->nodes; i++) {
         co_node_start(nodes[i], now);
     }
-    board_can_bitrate(nodes[0]->bitrate);
+    if (!board_can_bitrate(product_kbps(p, nodes[0]->bitrate))) {
+        (void)board_can_bitrate(250); /* an unusable stored code: the common default */
+    }
     uint32_t next_sample = now + CO_FILTER_PERIOD_US;
     for (;;) {
         now = board_now_us();
         if (!co_time_before(now, next_sample)) {
-            board_sensor(values, &faults);
+            board_sensor(p, values, &faults);
             p->sample(mem, values, faults);
             next_sample += CO_FILTER_PERIOD_US;
         }

@@ -283,8 +283,9 @@ int main(int argc, char **argv)
     uint32_t t = now_us();
     for (unsigned i = 0; i < a.nnodes; i++) {
         co_node_start(a.nodes[i], t);
-        lp_log("node %u: %s, node-ID 0x%02X on %s, bit-rate code %u (vcan ignores bit rates)",
-               i, a.prod->id, a.nodes[i]->node_id, ifn[i], a.nodes[i]->bitrate);
+        lp_log("node %u: %s, node-ID 0x%02X on %s, bit-rate code %u = %u kbit/s (vcan ignores it)",
+               i, a.prod->id, a.nodes[i]->node_id, ifn[i], a.nodes[i]->bitrate,
+               product_kbps(a.prod, a.nodes[i]->bitrate));
     }
     uint32_t next_sample = t + CO_FILTER_PERIOD_US;
     int rc = 0;

@@ -47,7 +47,7 @@ def test_lss_configure_store_and_activate(sensor_factory, network, bus):
     sensor.stop()
     del network[32]
     boot(sensor, network, bus, node_id=32)  # stored: survives a power cycle
-    assert "node-ID 0x20 on vcan0, bit-rate code 5" in sensor.log_text()
+    assert "node-ID 0x20 on vcan0, bit-rate code 5 = 500 kbit/s" in sensor.log_text()
 
 
 def test_lss_fastscan_finds_an_unconfigured_node(sensor_factory, network, bus):

@@ -390,6 +390,24 @@ static void test_lss_unconfigured_and_fastscan(void)
     EXPECT(d, 0x707, "00");
 }
 
+static void test_can_error_emcy(void)
+{
+    boot(&jd2xxx);
+    h_drain(d);
+    co_node_set_can_state(d->node, CO_CAN_PASSIVE);
+    EXPECT(d, 0x08A, "20 81 11 00 00 00 00 00"); /* R34: 8120h */
+    co_node_set_can_state(d->node, CO_CAN_BUSOFF);
+    EXPECT(d, 0x08A, "00 00 00 00 00 00 00 00"); /* passive over (nothing sent while off) */
+    co_node_set_can_state(d->node, CO_CAN_ACTIVE);
+    EXPECT(d, 0x08A, "40 81 11 00 00 00 00 00"); /* recovered from bus-off */
+    EXPECT(d, 0x08A, "00 00 00 00 00 00 00 00");
+    co_led_pattern_t g;
+    co_led_pattern_t r;
+    co_node_set_can_state(d->node, CO_CAN_BUSOFF);
+    co_node_led_patterns(d->node, &g, &r);
+    CHECK(r == CO_LED_ON);
+}
+
 int main(void)
 {
     RUN(test_nmt_frames);
@@ -408,5 +426,6 @@ int main(void)
     RUN(test_lss_services);
     RUN(test_lss_selective_and_identify);
     RUN(test_lss_unconfigured_and_fastscan);
+    RUN(test_can_error_emcy);
     return h_finish();
 }

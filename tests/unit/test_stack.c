@@ -78,8 +78,12 @@ static const co_od_entry_t t_entries[] = {
 
 static const co_od_t t_od = {.entries = t_entries, .count = sizeof(t_entries) / sizeof(t_entries[0])};
 
+static const co_service_t *const t_services[] = {&co_guard_service, &co_rtr_service, NULL};
+
 static const co_node_cfg_t t_cfg = {
     .od = &t_od,
+    .services = t_services,
+    .sdo_block = co_sdo_block,
     .ram_size = {0, sizeof(t_vol_t), sizeof(t_para_t), sizeof(co_lss_para_t)},
     .default_node_id = 0x10,
 };

@@ -1,0 +1,291 @@
+/*
+ * board.c - Nucleo-F042K6 (STM32F042K6, Cortex-M0 at 48 MHz from HSI48),
+ * bare metal: clock, SysTick time base, bxCAN on PA11/PA12, status LEDs on
+ * PB3 (green: the Nucleo's LD3) and PB4 (red: external, pin D12), the
+ * EEPROM emulation on the last flash pages, and a sensor that is a fixed
+ * test pattern (no sensor driver exists for this board: see board_sensor).
+ *
+ * Interrupts: SysTick counts milliseconds; the CAN receive interrupt only
+ * copies frames into a ring buffer that the main loop drains. Those two
+ * and the transmit queue are the board's state: file-level variables,
+ * because interrupt handlers take no context (the stack itself has none).
+ */
+#include "board.h"
+
+#include "co_port.h"
+#include "flash_ee.h"
+#include "stm32f042.h"
+
+/* ---- time -------------------------------------------------------------- */
+
+static volatile uint32_t ms_ticks;
+
+void systick_handler(void);
+void systick_handler(void)
+{
+    ms_ticks++;
+}
+
+uint32_t board_now_us(void)
+{
+    uint32_t ms;
+    uint32_t cvr;
+    do {
+        ms = ms_ticks;
+        cvr = SYST_CVR;
+    } while (ms != ms_ticks); /* a tick between the two reads: read again */
+    uint32_t load = SYST_RVR;
+    return ms * 1000u + (load - cvr) / (SYSCLK_HZ / 1000000u);
+}
+
+void board_sleep(uint32_t us)
+{
+    (void)us; /* SysTick wakes the core every millisecond anyway */
+    __asm__ volatile("wfi");
+}
+
+/* ---- CAN ----------------------------------------------------------------- */
+
+#define RXQ 16u
+static co_frame_t rxq[RXQ];
+static volatile uint32_t rx_head, rx_tail; /* ISR writes head, main reads tail */
+static volatile uint32_t rx_overruns;
+
+void can_irq_handler(void);
+void can_irq_handler(void)
+{
+    while ((CAN_RF0R & CAN_RF0R_FMP0) != 0u) {
+        uint32_t ri = CAN_RI0R;
+        uint32_t next = (rx_head + 1u) % RXQ;
+        if (next != rx_tail && (ri & CAN_RI0R_IDE) == 0u) {
+            co_frame_t *f = &rxq[rx_head];
+            f->id = (uint16_t)(ri >> 21);
+            f->rtr = (ri & CAN_RI0R_RTR) != 0u;
+            f->dlc = (uint8_t)(CAN_RDT0R & 0x0Fu);
+            f->dlc = f->dlc > 8u ? 8u : f->dlc;
+            co_put_u32(&f->data[0], CAN_RDL0R);
+            co_put_u32(&f->data[4], CAN_RDH0R);
+            rx_head = next;
+        } else if (next == rx_tail) {
+            rx_overruns++;
+        }
+        CAN_RF0R = CAN_RF0R_RFOM0; /* release the FIFO entry */
+    }
+    if ((CAN_RF0R & CAN_RF0R_FOVR0) != 0u) {
+        CAN_RF0R = CAN_RF0R_FOVR0;
+        rx_overruns++;
+    }
+}
+
+bool board_can_receive(co_frame_t *f)
+{
+    if (rx_tail == rx_head) {
+        return false;
+    }
+    *f = rxq[rx_tail];
+    rx_tail = (rx_tail + 1u) % RXQ;
+    return true;
+}
+
+/* Bit timing at 48 MHz: prescaler and segments per rate, sample point
+ * 87.5 % (86.7 % at 800 k), SJW 1. */
+typedef struct timing {
+    uint16_t kbps;
+    uint16_t brp;
+    uint8_t ts1, ts2;
+} timing_t;
+static const timing_t timings[] = {
+    {1000, 3, 13, 2}, {800, 4, 12, 2}, {500, 6, 13, 2},  {250, 12, 13, 2}, {125, 24, 13, 2},
+    {100, 30, 13, 2}, {50, 60, 13, 2}, {20, 150, 13, 2}, {10, 300, 13, 2},
+};
+
+bool board_can_bitrate(uint16_t kbps)
+{
+    const timing_t *t = NULL;
+    for (unsigned i = 0; i < sizeof(timings) / sizeof(timings[0]); i++) {
+        if (timings[i].kbps == kbps) {
+            t = &timings[i];
+        }
+    }
+    if (t == NULL) {
+        return false;
+    }
+    CAN_MCR = CAN_MCR_INRQ | CAN_MCR_ABOM | CAN_MCR_TXFP; /* init; auto bus-off recovery */
+    while ((CAN_MSR & CAN_MSR_INAK) == 0u) {
+    }
+    CAN_BTR = (uint32_t)(t->brp - 1u) | ((uint32_t)(t->ts1 - 1u) << 16) |
+              ((uint32_t)(t->ts2 - 1u) << 20);
+    /* Filter 0, 32-bit mask mode to FIFO 0: every standard-ID frame (the
+     * IDE bit must be 0); the stack sorts them out. */
+    CAN_FMR |= 1u;
+    CAN_FA1R &= ~1u;
+    CAN_FS1R |= 1u;
+    CAN_FM1R &= ~1u;
+    CAN_FFA1R &= ~1u;
+    CAN_F0R1 = 0;
+    CAN_F0R2 = CAN_RI0R_IDE;
+    CAN_FA1R |= 1u;
+    CAN_FMR &= ~1u;
+    CAN_IER = CAN_IER_FMPIE0;
+    CAN_MCR &= ~CAN_MCR_INRQ; /* leave init: on the bus */
+    while ((CAN_MSR & CAN_MSR_INAK) != 0u) {
+    }
+    return true;
+}
+
+bool co_port_can_send(void *port, const co_frame_t *frame)
+{
+    (void)port;
+    uint32_t tsr = CAN_TSR;
+    for (unsigned n = 0; n < 3u; n++) {
+        if ((tsr & (CAN_TSR_TME0 << n)) != 0u) {
+            CAN_TDTR(n) = frame->dlc;
+            CAN_TDLR(n) = co_get_u32(&frame->data[0]);
+            CAN_TDHR(n) = co_get_u32(&frame->data[4]);
+            CAN_TIR(n) = ((uint32_t)frame->id << 21) | (frame->rtr ? CAN_TIR_RTR : 0u) | CAN_TIR_TXRQ;
+            return true;
+        }
+    }
+    return false; /* three mailboxes busy: the stack counts the loss */
+}
+
+uint8_t board_can_state(void)
+{
+    uint32_t esr = CAN_ESR;
+    if ((esr & CAN_ESR_BOFF) != 0u) {
+        return CO_CAN_BUSOFF;
+    }
+    if ((esr & CAN_ESR_EPVF) != 0u) {
+        return CO_CAN_PASSIVE;
+    }
+    return (esr & CAN_ESR_EWGF) != 0u ? CO_CAN_WARNING : CO_CAN_ACTIVE;
+}
+
+/* ---- LEDs -------------------------------------------------------------- */
+
+void board_leds(bool green, bool red)
+{
+    GPIO_BSRR(GPIOB_BASE) = (green ? (1u << 3) : (1u << 19)) | (red ? (1u << 4) : (1u << 20));
+}
+
+/* ---- flash EEPROM ---------------------------------------------------------- */
+
+extern uint32_t _eeprom_start;
+
+static bool flash_wait(void)
+{
+    while ((FLASH_SR & FLASH_SR_BSY) != 0u) {
+    }
+    uint32_t sr = FLASH_SR;
+    FLASH_SR = FLASH_SR_EOP | FLASH_SR_PGERR | FLASH_SR_WRPRTERR;
+    return (sr & (FLASH_SR_PGERR | FLASH_SR_WRPRTERR)) == 0u;
+}
+
+static void flash_unlock(void)
+{
+    if ((FLASH_CR & FLASH_CR_LOCK) != 0u) {
+        FLASH_KEYR = 0x45670123u;
+        FLASH_KEYR = 0xCDEF89ABu;
+    }
+}
+
+static bool f042_erase(void *ctx, uint32_t page)
+{
+    (void)ctx;
+    flash_unlock();
+    FLASH_CR = FLASH_CR_PER;
+    FLASH_AR = page;
+    FLASH_CR = FLASH_CR_PER | FLASH_CR_STRT;
+    bool ok = flash_wait();
+    FLASH_CR = FLASH_CR_LOCK;
+    return ok;
+}
+
+static bool f042_program16(void *ctx, uint32_t addr, uint16_t v)
+{
+    (void)ctx;
+    volatile uint16_t *p = (volatile uint16_t *)addr;
+    if (*p != 0xFFFFu) {
+        return false; /* erase before write */
+    }
+    flash_unlock();
+    FLASH_CR = FLASH_CR_PG;
+    *p = v;
+    bool ok = flash_wait() && *p == v;
+    FLASH_CR = FLASH_CR_LOCK;
+    return ok;
+}
+
+static void f042_read(void *ctx, uint32_t addr, void *buf, uint32_t len)
+{
+    (void)ctx;
+    const volatile uint8_t *p = (const volatile uint8_t *)addr;
+    uint8_t *b = buf;
+    for (uint32_t i = 0; i < len; i++) {
+        b[i] = p[i];
+    }
+}
+
+static const flash_ops_t f042_flash = {.erase = f042_erase, .program16 = f042_program16, .read = f042_read};
+static const flash_ee_t eeprom = {.ops = &f042_flash, .ctx = 0, .base = 0x08006000u,
+                                  .page_size = 1024u, .pages = 8u};
+
+uint32_t co_port_nvm_size(void *port)
+{
+    (void)port;
+    return flash_ee_size(&eeprom);
+}
+
+bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
+{
+    (void)port;
+    return flash_ee_read(&eeprom, addr, buf, len);
+}
+
+bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
+{
+    (void)port;
+    return flash_ee_write(&eeprom, addr, buf, len);
+}
+
+/* ---- the sensor: a fixed test pattern ----------------------------------- */
+
+/* No sensor driver exists for this board: every input sweeps a triangle of
+ * +-10 % of its range around its initial value, one period in 20 s, so the
+ * outputs move and every code path of the product runs. */
+void board_sensor(const product_t *p, int32_t values[], uint32_t *faults)
+{
+    uint32_t t = ms_ticks % 20000u;
+    int32_t tri = (int32_t)(t < 10000u ? t : 20000u - t) - 5000; /* -5000..5000 */
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && p->inputs[i].name != 0; i++) {
+        const product_input_t *in = &p->inputs[i];
+        values[i] = in->initial + tri * in->limit / 50; /* limit x 1000 x 10 % x tri/5000 */
+    }
+    *faults = 0;
+}
+
+/* ---- start-up ------------------------------------------------------------- */
+
+bool board_init(void)
+{
+    /* 48 MHz from the internal HSI48; one flash wait state, prefetch on. */
+    FLASH_ACR = 0x11u;
+    RCC_CR2 |= RCC_CR2_HSI48ON;
+    while ((RCC_CR2 & RCC_CR2_HSI48RDY) == 0u) {
+    }
+    RCC_CFGR = (RCC_CFGR & ~3u) | RCC_CFGR_SW_HSI48;
+    while (((RCC_CFGR >> 2) & 3u) != RCC_CFGR_SW_HSI48) {
+    }
+    RCC_AHBENR |= RCC_AHBENR_IOPA | RCC_AHBENR_IOPB;
+    RCC_APB1ENR |= RCC_APB1ENR_CAN;
+    /* PA11 CAN_RX, PA12 CAN_TX: alternate function 4. */
+    GPIO_MODER(GPIOA_BASE) = (GPIO_MODER(GPIOA_BASE) & ~(0xFu << 22)) | (0xAu << 22);
+    GPIO_AFRH(GPIOA_BASE) = (GPIO_AFRH(GPIOA_BASE) & ~(0xFFu << 12)) | (0x44u << 12);
+    /* PB3, PB4: outputs. */
+    GPIO_MODER(GPIOB_BASE) = (GPIO_MODER(GPIOB_BASE) & ~(0xFu << 6)) | (0x5u << 6);
+    SYST_RVR = SYSCLK_HZ / 1000u - 1u;
+    SYST_CVR = 0;
+    SYST_CSR = 7u; /* processor clock, interrupt, enable */
+    NVIC_ISER = 1u << CAN_IRQ;
+    return true;
+}
