@@ -397,26 +397,26 @@ co_res_t co_store_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
     return r;
 }
 
-co_res_t co_store_group_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+/* Group save (defaults = false) or restore of 0x1010 / 0x1011 sub 2..4. */
+static co_res_t group_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value,
+                           uint32_t signature, bool defaults)
 {
-    if (value != CO_SIG_SAVE || e->sub < 2u || e->sub > 4u) {
+    if (value != signature || e->sub < 2u || e->sub > 4u) {
         return CO_E_STORE;
     }
-    co_res_t r = group_op(node, e->sub, false);
+    co_res_t r = group_op(node, e->sub, defaults);
     if (r == CO_OK) {
         notify(node, value);
     }
     return r;
 }
 
+co_res_t co_store_group_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+{
+    return group_hook(node, e, value, CO_SIG_SAVE, false);
+}
+
 co_res_t co_store_group_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
-    if (value != CO_SIG_LOAD || e->sub < 2u || e->sub > 4u) {
-        return CO_E_STORE;
-    }
-    co_res_t r = group_op(node, e->sub, true);
-    if (r == CO_OK) {
-        notify(node, value);
-    }
-    return r;
+    return group_hook(node, e, value, CO_SIG_LOAD, true);
 }

@@ -112,10 +112,8 @@ static void block_download_end(co_node_t *node, const uint8_t *d)
 static void block_upload_initiate(co_node_t *node, const uint8_t *d)
 {
     co_sdo_t *sdo = &node->sdo;
-    co_res_t r;
-    const co_od_entry_t *e = co_od_find(node->cfg->od, co_get_u16(&d[1]), d[3], &r);
+    const co_od_entry_t *e = co_sdo_find(node, d);
     if (e == NULL) {
-        co_sdo_abort(node, d, r);
         return;
     }
     if ((e->attr & CO_A_R) == 0u) {
@@ -131,7 +129,7 @@ static void block_upload_initiate(co_node_t *node, const uint8_t *d)
         return;
     }
     uint32_t len;
-    r = co_od_read(node, e, 0, sdo->buf, CO_SDO_BUF, &len);
+    co_res_t r = co_od_read(node, e, 0, sdo->buf, CO_SDO_BUF, &len);
     if (r != CO_OK) {
         co_sdo_abort(node, d, r);
         return;

@@ -35,6 +35,7 @@ void co_sdo_reply_head(co_node_t *node, uint8_t cmd, const uint8_t *req, uint32_
 void co_sdo_abort(co_node_t *node, const uint8_t *mux, co_res_t r);
 void co_sdo_mux(const co_sdo_t *sdo, uint8_t mux[4]);
 void co_sdo_restart(co_sdo_t *sdo);
+const co_od_entry_t *co_sdo_find(co_node_t *node, const uint8_t *d);
 const co_od_entry_t *co_sdo_download_target(co_node_t *node, const uint8_t *d, bool sized);
 
 #endif /* SDO_INTERNAL_H */

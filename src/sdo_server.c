@@ -50,6 +50,17 @@ void co_sdo_restart(co_sdo_t *sdo)
     sdo->restart = true;
 }
 
+/* The object a request's multiplexer names, or NULL after the abort. */
+const co_od_entry_t *co_sdo_find(co_node_t *node, const uint8_t *d)
+{
+    co_res_t r;
+    const co_od_entry_t *e = co_od_find(node->cfg->od, co_get_u16(&d[1]), d[3], &r);
+    if (e == NULL) {
+        co_sdo_abort(node, d, r);
+    }
+    return e;
+}
+
 /*
  * The object a download initiate (segmented or block) names: it must exist,
  * be writable, fit the buffer, and match an indicated size. NULL after
@@ -57,14 +68,12 @@ void co_sdo_restart(co_sdo_t *sdo)
  */
 const co_od_entry_t *co_sdo_download_target(co_node_t *node, const uint8_t *d, bool sized)
 {
-    co_res_t r;
-    const co_od_entry_t *e = co_od_find(node->cfg->od, co_get_u16(&d[1]), d[3], &r);
+    const co_od_entry_t *e = co_sdo_find(node, d);
     if (e == NULL) {
-        co_sdo_abort(node, d, r);
         return NULL;
     }
     uint32_t size = co_get_u32(&d[4]);
-    r = (e->attr & CO_A_W) == 0u           ? CO_E_RO
+    co_res_t r = (e->attr & CO_A_W) == 0u           ? CO_E_RO
         : sized && size > co_od_size(e)    ? CO_E_LEN_HIGH
         : sized && size < co_od_size(e)    ? CO_E_LEN_LOW
         : co_od_size(e) > CO_SDO_BUF       ? CO_E_OOM
@@ -82,19 +91,17 @@ static void initiate_download(co_node_t *node, const uint8_t *d)
     bool expedited = (d[0] & 0x02u) != 0u;
     bool sized = (d[0] & 0x01u) != 0u;
     if (expedited) {
-        co_res_t r;
-        const co_od_entry_t *e = co_od_find(node->cfg->od, co_get_u16(&d[1]), d[3], &r);
-        if (e != NULL && (e->attr & CO_A_W) == 0u) {
-            r = CO_E_RO;
-            e = NULL;
-        }
+        const co_od_entry_t *e = co_sdo_find(node, d);
         if (e == NULL) {
-            co_sdo_abort(node, d, r);
+            return;
+        }
+        if ((e->attr & CO_A_W) == 0u) {
+            co_sdo_abort(node, d, CO_E_RO);
             return;
         }
         /* Size not indicated (0x22): the object's own size, at most 4. */
         uint32_t len = sized ? 4u - ((d[0] >> 2) & 0x03u) : co_min_u32(co_od_size(e), 4u);
-        r = co_od_write(node, e, &d[4], len);
+        co_res_t r = co_od_write(node, e, &d[4], len);
         if (r != CO_OK) {
             co_sdo_abort(node, d, r);
         } else {
@@ -154,15 +161,13 @@ static void download_segment(co_node_t *node, const uint8_t *d)
 static void initiate_upload(co_node_t *node, const uint8_t *d)
 {
     co_sdo_t *sdo = &node->sdo;
-    co_res_t r;
-    const co_od_entry_t *e = co_od_find(node->cfg->od, co_get_u16(&d[1]), d[3], &r);
+    const co_od_entry_t *e = co_sdo_find(node, d);
     if (e == NULL) {
-        co_sdo_abort(node, d, r);
         return;
     }
     uint8_t out[8] = {0, d[1], d[2], d[3], 0, 0, 0, 0};
     uint32_t len;
-    r = co_od_read(node, e, 0, &out[4], 4, &len);
+    co_res_t r = co_od_read(node, e, 0, &out[4], 4, &len);
     if (r != CO_OK) {
         co_sdo_abort(node, d, r);
         return;
