@@ -14,6 +14,10 @@
 #include "co_node.h"
 #include "product.h"
 
+#ifdef HARNESS_BARE
+#include "bare_io.h" /* printf and friends over semihosting (tests/qemu) */
+#endif
+
 extern int h_failures;
 extern int h_checks;
 
@@ -54,12 +58,27 @@ extern int h_failed_tests;
 
 /* Prints "N passed, M failed" and returns the exit status. */
 int h_finish(void);
+/* Most sent frames ever left unread at once (printed by h_finish). */
+extern unsigned h_tx_high_water;
 
+/*
+ * Sizes. The bare-metal build (tests/qemu, 16 KB of RAM) makes them small;
+ * the host keeps room to spare. FAKE_TX_MAX frames are kept unread at most:
+ * sending more without reading them fails the test loudly (an overrun is a
+ * harness limit, never silently lost frames).
+ */
+#ifndef FAKE_TX_MAX
 #define FAKE_TX_MAX 4096u
+#endif
+#ifndef FAKE_NVM_SIZE
 #define FAKE_NVM_SIZE 2048u
+#endif
+#ifndef H_INST_MAX
+#define H_INST_MAX PRODUCT_INST_MAX /* instance bytes of a device under test */
+#endif
 
 typedef struct fake_port {
-    co_frame_t tx[FAKE_TX_MAX];
+    co_frame_t tx[FAKE_TX_MAX]; /* ring of sent frames, index = count % FAKE_TX_MAX */
     unsigned ntx;      /* frames sent */
     unsigned rd;       /* frames consumed by h_next() */
     bool tx_full;      /* co_port_can_send() refuses */
@@ -73,7 +92,7 @@ void fake_port_init(fake_port_t *p);
 
 /* A product under test: its memory, port, node and virtual clock. */
 typedef struct h_dev {
-    _Alignas(max_align_t) unsigned char mem[PRODUCT_INST_MAX];
+    _Alignas(max_align_t) unsigned char mem[H_INST_MAX];
     const product_t *prod;
     fake_port_t port;
     co_node_t *node;       /* node 0 (SDO helpers talk to it) */
@@ -84,6 +103,12 @@ typedef struct h_dev {
     int32_t truth[PRODUCT_MAX_INPUTS]; /* true inputs, milli-units */
     uint32_t fault; /* bit i: the product's fault i */
 } h_dev_t;
+
+/* The product instance (aligned for any type: cast it to the family's type). */
+static inline void *h_inst(h_dev_t *d)
+{
+    return d->mem;
+}
 
 /* Create (port and NVM fresh unless keep_nvm) and power on. */
 void h_boot(h_dev_t *d, const product_t *p, bool keep_nvm);

@@ -10,10 +10,11 @@ int h_failures;
 int h_checks;
 int h_tests;
 int h_failed_tests;
+unsigned h_tx_high_water;
 
 int h_finish(void)
 {
-    printf("%d checks\n", h_checks);
+    printf("%d checks, at most %u sent frames unread\n", h_checks, h_tx_high_water);
     printf("%d passed, %d failed\n", h_tests - h_failed_tests, h_failed_tests);
     return h_failures == 0 ? 0 : 1;
 }

@@ -170,11 +170,11 @@ static void test_e1_bitrate(void)
     boot(M->xy30);
     SDO(d, "2F F2 20 00 02 00 00 00", "60 F2 20 00 00 00 00 00"); /* E1.1/E1.2 */
     SDO(d, "2F F3 20 00 02 00 00 00", "60 F3 20 00 00 00 00 00"); /* E1.3/E1.4 */
-    dst_dev_t *x = (dst_dev_t *)d->mem;
+    dst_dev_t *x = (dst_dev_t *)h_inst(d);
     CHECK_EQ(x->lss.bitrate, 2);
     h_power_cycle(d); /* no "save" needed (B-50) */
     EXPECT(d, 0x77F, "00");
-    x = (dst_dev_t *)d->mem;
+    x = (dst_dev_t *)h_inst(d);
     CHECK_EQ(x->lss.bitrate, 2);
     CHECK_EQ(h_read(d, 0x20F2, 0), 2);
     CHECK_EQ(h_read(d, 0x20F3, 0), 2);
@@ -292,7 +292,7 @@ static void test_e9_resolution(void)
 static void test_e10_filter_after_save(void)
 {
     boot(M->xy30);
-    dst_dev_t *x = (dst_dev_t *)d->mem;
+    dst_dev_t *x = (dst_dev_t *)h_inst(d);
     SDO(d, "2F 01 20 00 02 00 00 00", "60 01 20 00 00 00 00 00");
     CHECK_EQ(x->filter_active, 0); /* not yet: only after STORE (B-81) */
     CHECK_EQ(h_read(d, 0x2001, 0), 2);
@@ -503,7 +503,7 @@ static void test_error_behaviour(void)
     d->fault = 1u; /* "sensor" */
     h_advance(d, 100000);
     CHECK_EQ(d->node->nmt.state, CO_NMT_STOPPED);
-    CHECK_EQ(((dst_dev_t *)d->mem)->errors, DST_ERR_SENSOR);
+    CHECK_EQ(((dst_dev_t *)h_inst(d))->errors, DST_ERR_SENSOR);
     boot(M->xy10);
     SDO(d, "2F 00 40 00 00 00 00 00", "60 00 40 00 00 00 00 00"); /* pre-op */
     operational_settled();

@@ -89,7 +89,7 @@ static void test_v8_node_id_and_d1_to_d5(void)
 static void test_v9_v10_bitrate_d6_d7(void)
 {
     boot(&pf_inx360d);
-    pf_dev_t *x = (pf_dev_t *)d->mem;
+    pf_dev_t *x = (pf_dev_t *)h_inst(d);
     SDO(d, "2F 01 20 00 08 00 00 00", "60 01 20 00 00 00 00 00"); /* V9, D6 */
     SDO(d, "2F 01 20 00 04 00 00 00", "60 01 20 00 00 00 00 00"); /* V10 */
     SDO(d, "2F 01 20 00 02 00 00 00", "60 01 20 00 00 00 00 00");
@@ -98,7 +98,7 @@ static void test_v9_v10_bitrate_d6_d7(void)
     SDO(d, "2F 01 20 00 08 00 00 00", "60 01 20 00 00 00 00 00");
     h_rx(d, 0x000, "81 01");
     EXPECT(d, 0x701, "00"); /* D6: boot-up, now at 1 Mbit/s */
-    x = (pf_dev_t *)d->mem;
+    x = (pf_dev_t *)h_inst(d);
     CHECK_EQ(x->lss.bitrate, PF_BR_1M);
     SDO(d, "40 01 20 00 00 00 00 00", "4F 01 20 00 08 00 00 00");
 }

@@ -30,7 +30,7 @@ static void test_filter_settling(void)
     uint32_t medium = settle_ms(1, 0, 90000);
     uint32_t fast = settle_ms(2, 0, 90000);
     printf("     settling to 0.01 deg after a 90 deg step: slow %u ms, medium %u ms, fast %u ms\n",
-           slow, medium, fast);
+           (unsigned)slow, (unsigned)medium, (unsigned)fast);
     CHECK(slow >= 1700 && slow <= 2500);
     CHECK(medium >= 400 && medium <= 650);
     CHECK(fast >= 150 && fast <= 300);

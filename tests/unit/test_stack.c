@@ -428,7 +428,7 @@ static void test_tpdo_event_and_inhibit(void)
     CHECK_EQ(count_id(d, 0x190), 0);
     /* COB-ID written as 0x180 + node-ID is stored as following the ID. */
     SDO(d, "23 00 18 01 90 01 00 00", "60 00 18 01 00 00 00 00");
-    CHECK_EQ(((t_dev_t *)d->mem)->para.cob[0], 0x180);
+    CHECK_EQ(((t_dev_t *)h_inst(d))->para.cob[0], 0x180);
     SDO(d, "23 00 18 01 85 03 00 00", "60 00 18 01 00 00 00 00");
     CHECK_EQ(h_read(d, 0x1800, 1), 0x385);
     h_drain(d);
@@ -503,23 +503,25 @@ static void test_tx_full_is_counted(void)
 
 static void test_two_nodes_one_process(void)
 {
-    static h_dev_t a;
-    static h_dev_t b;
-    h_boot(&a, &t_prod, false);
-    h_boot(&b, &dst_x730_xy30, false);
-    SDO(&a, "2B 17 10 00 64 00 00 00", "60 17 10 00 00 00 00 00");
-    SDO(&b, "2B 17 10 00 C8 00 00 00", "60 17 10 00 00 00 00 00");
-    CHECK_EQ(h_read(&a, 0x1017, 0), 100);
-    CHECK_EQ(h_read(&b, 0x1017, 0), 200);
-    h_rx(&a, 0x000, "01 10");
-    CHECK_EQ(a.node->nmt.state, CO_NMT_OPERATIONAL);
-    CHECK_EQ(b.node->nmt.state, CO_NMT_PREOP);
-    SDO(&a, "2B 01 20 00 05 00 00 00", "60 01 20 00 00 00 00 00");
-    SDO(&a, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
-    h_power_cycle(&b);
-    CHECK_EQ(h_read(&b, 0x1017, 0), 0); /* b's save never happened */
-    h_power_cycle(&a);
-    CHECK_EQ(h_read(&a, 0x2001, 0), 5);
+    /* Two devices: the file's own and one more (16 KB of RAM under qemu). */
+    h_dev_t *a = d;
+    static h_dev_t other;
+    h_dev_t *b = &other;
+    h_boot(a, &t_prod, false);
+    h_boot(b, &dst_x730_xy30, false);
+    SDO(a, "2B 17 10 00 64 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(b, "2B 17 10 00 C8 00 00 00", "60 17 10 00 00 00 00 00");
+    CHECK_EQ(h_read(a, 0x1017, 0), 100);
+    CHECK_EQ(h_read(b, 0x1017, 0), 200);
+    h_rx(a, 0x000, "01 10");
+    CHECK_EQ(a->node->nmt.state, CO_NMT_OPERATIONAL);
+    CHECK_EQ(b->node->nmt.state, CO_NMT_PREOP);
+    SDO(a, "2B 01 20 00 05 00 00 00", "60 01 20 00 00 00 00 00");
+    SDO(a, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_power_cycle(b);
+    CHECK_EQ(h_read(b, 0x1017, 0), 0); /* b's save never happened */
+    h_power_cycle(a);
+    CHECK_EQ(h_read(a, 0x2001, 0), 5);
 }
 
 static void test_node_guarding(void)
@@ -624,7 +626,7 @@ static void test_tpdo_rtr_and_types(void)
     h_rx_frame(d, &rtr);
     EXPECT_NONE(d); /* nothing sampled yet */
     h_rx(d, 0x080, "");
-    uint32_t sampled = ((t_dev_t *)d->mem)->vol.counter;
+    uint32_t sampled = ((t_dev_t *)h_inst(d))->vol.counter;
     h_advance(d, 50000); /* the counter moves on */
     EXPECT_NONE(d);
     h_rx_frame(d, &rtr);
