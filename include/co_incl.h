@@ -20,6 +20,8 @@
 #ifndef CO_INCL_H
 #define CO_INCL_H
 
+#include <string.h>
+
 #include "co_common.h"
 #include "co_filter.h"
 
@@ -47,6 +49,10 @@ typedef struct co_incl {
     int32_t angle[2];    /* filtered, saturated angle (mdeg) */
     int32_t unwrapped;   /* wrap mode: continuous input fed to the filter */
     co_filter_t f[2];
+    /* The slope outputs, computed once per sample rather than per read
+     * (SDO, every PDO): valid while *p still equals seen. */
+    int16_t out[2];
+    co_incl_para_t seen;
 } co_incl_t;
 
 /* p is owned by the caller and must outlive incl. */
@@ -55,8 +61,23 @@ void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limi
 /* Feed one sensor sample (mdeg per axis; unused axes ignored). */
 void co_incl_sample(co_incl_t *incl, const int32_t mdeg[2]);
 
-/* The slope object (0x6010 axis 0, 0x6020 axis 1) in resolution units. */
-int16_t co_incl_slope(const co_incl_t *incl, unsigned axis);
+/* co_incl_slope's slow path: recompute the outputs, return one. */
+int16_t co_incl_refresh_slope(co_incl_t *incl, unsigned axis);
+
+/* The slope object (0x6010 axis 0, 0x6020 axis 1) in resolution units.
+ * Recomputed only when a parameter changed since the last sample:
+ * parameters reach p through plain dictionary writes and the store too,
+ * so compare rather than rely on every writer telling us. */
+static inline int16_t co_incl_slope(co_incl_t *incl, unsigned axis)
+{
+    if (axis >= incl->axes) {
+        return 0;
+    }
+    if (memcmp(&incl->seen, incl->p, sizeof(incl->seen)) != 0) {
+        return co_incl_refresh_slope(incl, axis);
+    }
+    return incl->out[axis];
+}
 
 /* Any axis beyond its limit. */
 bool co_incl_beyond(const co_incl_t *incl);

@@ -91,6 +91,10 @@ typedef struct co_od {
  */
 uint32_t co_cobid_resolve(uint32_t raw, uint32_t def, uint8_t node_id);
 
+/* CiA 301 7.3.5 restricted CAN-IDs (NMT, SDO, LSS, NMT error control, ...):
+ * no configurable COB-ID (SYNC, EMCY, PDO) may use one. */
+bool co_cobid_restricted(uint32_t id);
+
 /*
  * Find (index, sub). Returns the entry, or NULL with *res set to
  * CO_E_NO_OBJ (no such index) or CO_E_NO_SUB (index exists, sub does not).

@@ -24,6 +24,8 @@ void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limi
     co_filter_reset(&incl->f[1]);
 }
 
+static void refresh(co_incl_t *incl);
+
 /* Angle in [-180000, 180000) millidegrees. */
 static int32_t wrap180(int32_t a)
 {
@@ -75,6 +77,7 @@ void co_incl_sample(co_incl_t *incl, const int32_t mdeg[2])
         }
         incl->angle[a] = y;
     }
+    refresh(incl);
 }
 
 bool co_incl_beyond(const co_incl_t *incl)
@@ -112,11 +115,8 @@ static int32_t circular_a1(const co_incl_t *incl, unsigned axis)
     return (incl->p->op[axis] & CO_INCL_OP_INVERT) != 0u ? mod_pos(f - m, f) : m;
 }
 
-int16_t co_incl_slope(const co_incl_t *incl, unsigned axis)
+static int16_t compute_slope(const co_incl_t *incl, unsigned axis)
 {
-    if (axis >= incl->axes) {
-        return 0;
-    }
     if (incl->circular) {
         int32_t a1 = circular_a1(incl, axis);
         if ((incl->p->op[axis] & CO_INCL_OP_SCALING) != 0u) {
@@ -134,6 +134,21 @@ int16_t co_incl_slope(const co_incl_t *incl, unsigned axis)
         v = INT16_MIN;
     }
     return (int16_t)v;
+}
+
+/* Recompute the outputs and remember the parameters they were made with. */
+static void refresh(co_incl_t *incl)
+{
+    incl->seen = *incl->p;
+    for (unsigned a = 0; a < incl->axes; a++) {
+        incl->out[a] = compute_slope(incl, a);
+    }
+}
+
+int16_t co_incl_refresh_slope(co_incl_t *incl, unsigned axis)
+{
+    refresh(incl);
+    return incl->out[axis];
 }
 
 co_res_t co_incl_set_resolution(co_incl_t *incl, uint16_t res)

@@ -109,6 +109,12 @@ static bool services_receive(co_node_t *node, const co_frame_t *f, bool always)
 
 void co_node_receive(co_node_t *node, const co_frame_t *f)
 {
+    /* The frame a slave gets most, straight to its server: no other
+     * service may use an SDO CAN-ID (restricted, CiA 301 7.3.5). */
+    if (f->id == 0x600u + node->node_id && node->nmt.state != CO_NMT_INIT) {
+        (void)co_sdo_receive(node, f);
+        return;
+    }
     if (services_receive(node, f, true)) {
         return; /* LSS works in every state, and without a node-ID */
     }

@@ -35,32 +35,59 @@ uint32_t co_cobid_resolve(uint32_t raw, uint32_t def, uint8_t node_id)
     return raw;
 }
 
+bool co_cobid_restricted(uint32_t id)
+{
+    return id <= 0x07Fu || (id >= 0x101u && id <= 0x180u) || (id >= 0x581u && id <= 0x5FFu) ||
+           (id >= 0x601u && id <= 0x67Fu) || (id >= 0x6E0u && id <= 0x6FFu) || id >= 0x701u;
+}
+
 const co_od_entry_t *co_od_find(const co_od_t *od, uint16_t index, uint8_t sub, co_res_t *res)
 {
-    uint32_t key = ((uint32_t)index << 8) | sub;
+    /* Binary search on the index alone (one 16-bit compare a step), then
+     * the sub-index among that object's entries, which are sorted and
+     * nearly always numbered 0, 1, 2...: try its expected place first. */
+    const co_od_entry_t *t = od->entries;
     uint32_t lo = 0;
     uint32_t hi = od->count;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2u;
-        const co_od_entry_t *e = &od->entries[mid];
-        uint32_t k = ((uint32_t)e->index << 8) | e->sub;
-        if (k == key) {
+    uint32_t at = 0;
+    for (;;) {
+        if (lo >= hi) {
+            if (res != NULL) {
+                *res = CO_E_NO_OBJ;
+            }
+            return NULL;
+        }
+        at = (lo + hi) / 2u;
+        if (t[at].index == index) {
+            break;
+        }
+        if (t[at].index < index) {
+            lo = at + 1u;
+        } else {
+            hi = at;
+        }
+    }
+    uint32_t guess = at + sub - t[at].sub; /* wraps to a huge value when below 0 */
+    if (guess < od->count && t[guess].index == index && t[guess].sub == sub) {
+        if (res != NULL) {
+            *res = CO_OK;
+        }
+        return &t[guess];
+    }
+    /* Holes in the sub-indices: walk the object's entries. */
+    while (at > 0u && t[at - 1u].index == index) {
+        at--;
+    }
+    for (; at < od->count && t[at].index == index; at++) {
+        if (t[at].sub == sub) {
             if (res != NULL) {
                 *res = CO_OK;
             }
-            return e;
-        }
-        if (k < key) {
-            lo = mid + 1u;
-        } else {
-            hi = mid;
+            return &t[at];
         }
     }
     if (res != NULL) {
-        /* lo is where the key would go; the index exists if a neighbour has it. */
-        bool index_exists = (lo < od->count && od->entries[lo].index == index) ||
-                            (lo > 0u && od->entries[lo - 1u].index == index);
-        *res = index_exists ? CO_E_NO_SUB : CO_E_NO_OBJ;
+        *res = CO_E_NO_SUB;
     }
     return NULL;
 }

@@ -165,6 +165,21 @@ static void initiate_upload(co_node_t *node, const uint8_t *d)
     if (e == NULL) {
         return;
     }
+    uint32_t size = co_od_size(e);
+    if (size <= 4u && e->type != CO_T_VSTR) {
+        /* A number: expedited, size indicated (0x4F / 0x4B / 0x47 / 0x43). */
+        uint32_t v;
+        co_res_t r = (e->attr & CO_A_R) == 0u ? CO_E_WO : co_od_get(node, e, &v);
+        if (r != CO_OK) {
+            co_sdo_abort(node, d, r);
+            return;
+        }
+        if (size < 4u) {
+            v &= (1u << (8u * size)) - 1u; /* only the object's own bytes */
+        }
+        co_sdo_reply_head(node, (uint8_t)(0x43u | ((4u - size) << 2)), d, v);
+        return;
+    }
     uint8_t out[8] = {0, d[1], d[2], d[3], 0, 0, 0, 0};
     uint32_t len;
     co_res_t r = co_od_read(node, e, 0, &out[4], 4, &len);
@@ -172,10 +187,8 @@ static void initiate_upload(co_node_t *node, const uint8_t *d)
         co_sdo_abort(node, d, r);
         return;
     }
-    uint32_t size = co_od_size(e);
     if (size <= 4u) {
-        /* Expedited, size indicated: 0x4F / 0x4B / 0x47 / 0x43. */
-        out[0] = (uint8_t)(0x43u | ((4u - size) << 2));
+        out[0] = (uint8_t)(0x43u | ((4u - size) << 2)); /* a short string */
         co_sdo_reply(node, out);
         return;
     }

@@ -4,6 +4,7 @@
 #include "co_sync.h"
 
 #include "co_node.h"
+#include "co_od.h"
 
 void co_sync_reconfig(co_node_t *node)
 {
@@ -17,8 +18,10 @@ void co_sync_reconfig(co_node_t *node)
 
 co_res_t co_sync_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
-    if ((value & 0xBFFFF800u) != 0u) {
-        return CO_E_VAL; /* 11-bit IDs only; bit 30 (we generate SYNC) not supported */
+    if ((value & 0xBFFFF800u) != 0u || co_cobid_restricted(value & 0x7FFu)) {
+        /* 11-bit IDs only; bit 30 (we generate SYNC) not supported; never a
+         * restricted CAN-ID (co_node_receive relies on it for SDO frames). */
+        return CO_E_VAL;
     }
     co_res_t r = co_od_store(node, e, value);
     if (r == CO_OK) {

@@ -113,17 +113,10 @@ co_res_t co_tpdo_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
     return r;
 }
 
-/* CiA 301 restricted CAN-IDs: NMT, SYNC/EMCY/TIME range, SDO, LSS, NMT error control. */
-static bool restricted(uint32_t id)
-{
-    return id <= 0x07Fu || (id >= 0x101u && id <= 0x180u) || (id >= 0x581u && id <= 0x5FFu) ||
-           (id >= 0x601u && id <= 0x67Fu) || (id >= 0x6E0u && id <= 0x6FFu) || id >= 0x701u;
-}
-
 co_res_t co_tpdo_cobid_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     bool valid = (value & 0x80000000u) == 0u;
-    if ((value & 0x3FFFF800u) != 0u || (valid && restricted(value & 0x7FFu))) {
+    if ((value & 0x3FFFF800u) != 0u || (valid && co_cobid_restricted(value & 0x7FFu))) {
         return CO_E_VAL; /* an invalid COB-ID may name any CAN-ID (0x80000000) */
     }
     uint32_t cur;
@@ -193,23 +186,37 @@ void co_tpdo_stop(co_node_t *node)
     }
 }
 
-/* The mapped part of TPDO n, without the product's fill hook. */
-static void build_mapped(co_node_t *node, unsigned n, co_frame_t *f)
+/* The low nb bytes of v in reverse order (big-endian PDO values). */
+static uint32_t reverse_bytes(uint32_t v, unsigned nb)
+{
+    v = (v << 24) | ((v & 0xFF00u) << 8) | ((v >> 8) & 0xFF00u) | (v >> 24);
+    return v >> (32u - 8u * nb);
+}
+
+/* The mapped part of TPDO n, without the product's fill hook. The data
+ * bytes are gathered in one 64-bit word and stored at the end. */
+static inline void build_mapped(co_node_t *node, unsigned n, co_frame_t *f)
 {
     const co_tpdo_t *t = &node->tpdo[n];
-    memset(f, 0, sizeof(*f));
     f->id = t->cob_id;
-    uint8_t pos = 0;
-    for (uint8_t i = 0; i < t->nmap; i++) {
+    f->rtr = false;
+    uint64_t data = 0;
+    unsigned pos = 0;
+    for (unsigned i = 0; i < t->nmap; i++) {
         uint32_t v = 0;
         (void)co_od_get(node, t->map[i], &v);
-        uint8_t nb = t->map_bytes[i];
-        for (uint8_t b = 0; b < nb; b++) {
-            uint8_t shift = node->pdo_msb_first ? (uint8_t)(nb - 1u - b) : b;
-            f->data[pos + b] = (uint8_t)(v >> (8u * shift));
+        unsigned nb = t->map_bytes[i]; /* 1..4: every mapped object is at most 32 bits */
+        if (nb < 4u) {
+            v &= (1u << (8u * nb)) - 1u;
         }
-        pos = (uint8_t)(pos + nb);
+        if (node->pdo_msb_first) {
+            v = reverse_bytes(v, nb);
+        }
+        data |= (uint64_t)v << (8u * pos);
+        pos += nb;
     }
+    co_put_u32(&f->data[0], (uint32_t)data);
+    co_put_u32(&f->data[4], (uint32_t)(data >> 32));
     f->dlc = node->cfg->tpdo_dlc != 0u ? node->cfg->tpdo_dlc : t->len;
 }
 

@@ -136,6 +136,30 @@ static void test_od_find(void)
             uint32_t b = ((uint32_t)od->entries[k].index << 8) | od->entries[k].sub;
             CHECK(a < b);
         }
+        /* The search against a linear scan: every sub-index of every index
+         * the table has, and of the indices next to them. */
+        unsigned wrong = 0;
+        for (uint16_t k = 0; k < od->count; k++) {
+            for (int near = -1; near <= 1; near++) {
+                uint16_t index = (uint16_t)(od->entries[k].index + near);
+                for (unsigned sub = 0; sub < 256u; sub++) {
+                    const co_od_entry_t *want = NULL;
+                    co_res_t want_r = CO_E_NO_OBJ;
+                    for (uint16_t j = 0; j < od->count; j++) {
+                        if (od->entries[j].index == index) {
+                            want_r = want == NULL ? CO_E_NO_SUB : CO_OK;
+                            if (od->entries[j].sub == sub) {
+                                want = &od->entries[j];
+                                want_r = CO_OK;
+                            }
+                        }
+                    }
+                    const co_od_entry_t *got = co_od_find(od, index, (uint8_t)sub, &r);
+                    wrong += got != want || r != want_r;
+                }
+            }
+        }
+        CHECK_EQ(wrong, 0);
     }
 }
 
@@ -472,6 +496,10 @@ static void test_tpdo_sync_and_bad_mapping(void)
     h_rx(d, 0x081, "");
     f = h_next(d);
     CHECK(f != NULL && f->id == 0x190);
+    /* Never a restricted CAN-ID (CiA 301 7.3.5): this node's SDO, NMT. */
+    SDO(d, "23 05 10 00 10 06 00 00", "80 05 10 00 30 00 09 06");
+    SDO(d, "23 05 10 00 00 00 00 00", "80 05 10 00 30 00 09 06");
+    SDO(d, "40 05 10 00 00 00 00 00", "43 05 10 00 81 00 00 00");
 }
 
 static void test_emcy(void)
