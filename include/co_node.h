@@ -112,6 +112,9 @@ struct co_node {
     bool autostart;             /* set by the reset op: go operational after boot-up */
     bool pdo_msb_first;         /* PDO values big-endian (DST 0x5001 = 0) */
     uint8_t reset_request;      /* co_reset_t to perform at the next poll (0: none) */
+    bool dirty;                 /* something happened since the last full poll */
+    bool due_never;             /* the last full poll found no deadline at all */
+    uint32_t due;               /* not dirty: no service needs to run before this time */
     uint32_t tx_dropped;        /* frames the board could not queue */
     co_nmt_t nmt;
     co_sdo_t sdo;
@@ -136,10 +139,21 @@ void co_node_init(co_node_t *node, const co_node_cfg_t *cfg, void *port, void *a
 /* Power-on: reset node (load the store, boot-up, pre-operational). */
 void co_node_start(co_node_t *node, uint32_t now);
 
+/*
+ * Tell the node that something its services look at changed outside a
+ * received frame (a sensor sample, a fault): the next co_node_poll() runs
+ * every service instead of returning at once because nothing is due.
+ */
+static inline void co_node_wake(co_node_t *node)
+{
+    node->dirty = true;
+}
+
 /* Reset at the next poll, after the answer to the current request went out. */
 static inline void co_node_request_reset(co_node_t *node, co_reset_t kind)
 {
     node->reset_request = (uint8_t)kind;
+    co_node_wake(node);
 }
 
 /* Reset node or communication now (what the NMT commands do). */
@@ -148,7 +162,11 @@ void co_node_reset(co_node_t *node, co_reset_t kind);
 /* One received frame. */
 void co_node_receive(co_node_t *node, const co_frame_t *f);
 
-/* Run timers; returns the delay (us) until the next call is needed. */
+/*
+ * Run timers; returns the delay (us) until the next call is needed. When
+ * nothing happened since the last poll (no frame, no co_node_wake(), no
+ * CAN state change) and no deadline has come, it returns at once.
+ */
 uint32_t co_node_poll(co_node_t *node, uint32_t now);
 
 /* Send through the port, counting frames the board could not queue. */

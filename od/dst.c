@@ -239,4 +239,5 @@ void dst_sample(void *mem, const int32_t values[], uint32_t faults)
     d->sensor_fault = fault;
     d->incl.fault = fault;
     co_incl_sample(&d->incl, values);
+    co_node_wake(&d->node); /* errors may have changed: dst_poll looks */
 }

@@ -376,4 +376,5 @@ void jd_sample(void *mem, const int32_t values[], uint32_t faults)
             co_tpdo_event(&d->node, n);
         }
     }
+    co_node_wake(&d->node); /* every product wakes its nodes on a sample */
 }

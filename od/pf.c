@@ -106,6 +106,7 @@ void pf_sample(void *mem, const int32_t values[], uint32_t faults)
     pf_dev_t *d = mem;
     d->faults = faults;
     co_incl_sample(&d->incl, values);
+    co_node_wake(&d->node); /* faults may have changed: pf_poll looks */
     /* Type 254/255: a PDO "after each calculation" (R26), within the inhibit time. */
     co_tpdo_event(&d->node, 0);
 }

@@ -39,6 +39,7 @@ bool co_node_send(co_node_t *node, const co_frame_t *f)
 
 void co_node_reset(co_node_t *node, co_reset_t kind)
 {
+    co_node_wake(node);
     /* Silent while re-initialising: no state hook for INIT. */
     co_tpdo_stop(node);
     node->nmt.state = CO_NMT_INIT;
@@ -109,6 +110,7 @@ static bool services_receive(co_node_t *node, const co_frame_t *f, bool always)
 
 void co_node_receive(co_node_t *node, const co_frame_t *f)
 {
+    co_node_wake(node);
     /* The frame a slave gets most, straight to its server: no other
      * service may use an SDO CAN-ID (restricted, CiA 301 7.3.5). */
     if (f->id == 0x600u + node->node_id && node->nmt.state != CO_NMT_INIT) {
@@ -131,6 +133,10 @@ void co_node_receive(co_node_t *node, const co_frame_t *f)
 uint32_t co_node_poll(co_node_t *node, uint32_t now)
 {
     node->now = now;
+    if (!node->dirty && co_time_before(now, node->due)) {
+        return node->due_never ? CO_NEVER : node->due - now; /* the idle poll */
+    }
+    node->dirty = false;
     if (node->reset_request != 0u) {
         co_reset_t kind = (co_reset_t)node->reset_request;
         node->reset_request = 0;
@@ -147,6 +153,10 @@ uint32_t co_node_poll(co_node_t *node, uint32_t now)
         next = co_min_u32(next, node->cfg->ops->poll(node, now));
     }
     next = co_min_u32(next, co_tpdo_poll(node, now));
+    /* Nothing can fall due before next unless something happens first.
+     * No deadline at all: look again after half the clock's range. */
+    node->due_never = next == CO_NEVER;
+    node->due = now + co_min_u32(next, 0x7FFFFFFFu);
     return next;
 }
 
@@ -157,6 +167,7 @@ void co_node_set_can_state(co_node_t *node, co_can_state_t s)
         return;
     }
     node->can_state = (uint8_t)s;
+    co_node_wake(node);
     if (node->cfg->ops != NULL && node->cfg->ops->can_state != NULL) {
         node->cfg->ops->can_state(node, old);
     }

@@ -318,6 +318,7 @@ void co_tpdo_event(co_node_t *node, unsigned n)
     co_tpdo_t *t = &node->tpdo[n];
     if (t->valid && event_driven(t) && node->nmt.state == CO_NMT_OPERATIONAL) {
         t->pending = true; /* sent by the next poll, or when the inhibit time ends */
+        co_node_wake(node);
     }
 }
 

@@ -397,6 +397,30 @@ static void test_reset_comm_keeps_application(void)
     CHECK_EQ(h_read(d, 0x2001, 0), -5 & 0xFFFF);
 }
 
+/* The idle poll: between events co_node_poll only counts down to the
+ * deadline the last full poll found; a frame or co_node_wake() ends that. */
+static void test_idle_poll(void)
+{
+    boot();
+    co_node_t *n = d->node;
+    uint32_t t = d->now;
+    CHECK_EQ(co_node_poll(n, t), CO_NEVER); /* heartbeat off, no PDO: nothing due */
+    CHECK_EQ(co_node_poll(n, t + 5000000u), CO_NEVER);
+    h_rx(d, 0x610, "2B 17 10 00 32 00 00 00"); /* heartbeat 50 ms: a frame wakes */
+    t = d->now;
+    CHECK_EQ(co_node_poll(n, t), 50000);
+    CHECK_EQ(co_node_poll(n, t + 20000u), 30000);
+    h_drain(d);
+    CHECK_EQ(co_node_poll(n, t + 50000u), 50000); /* due: a full poll sends it */
+    EXPECT(d, 0x710, "7F");
+    /* A change the poll cannot see (here: the heartbeat period poked
+     * directly) is ignored until something wakes the node. */
+    n->hb.period_ms = 0;
+    CHECK_EQ(co_node_poll(n, t + 60000u), 40000);
+    co_node_wake(n);
+    CHECK_EQ(co_node_poll(n, t + 60000u), CO_NEVER);
+}
+
 static void test_heartbeat_timing(void)
 {
     boot();
@@ -754,6 +778,7 @@ int main(void)
     RUN(test_nmt);
     RUN(test_nmt_stopped_is_silent);
     RUN(test_reset_comm_keeps_application);
+    RUN(test_idle_poll);
     RUN(test_heartbeat_timing);
     RUN(test_tpdo_event_and_inhibit);
     RUN(test_tpdo_sync_and_bad_mapping);
