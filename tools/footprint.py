@@ -1,47 +1,58 @@
-"""Print the MCU footprint table from the linker maps (see tools/footprint).
-The shares split the flash bytes by the source file each input section
-came from: src/ (the stack), od/ (dictionaries and product logic), the rest
-(board, main loop, libgcc)."""
+"""Print the MCU footprint table (see tools/footprint).
+The shares split the flash bytes by the source file each function or
+constant of the final image comes from (nm -l reads it from the debug
+information, which is not loaded into flash; link-time optimisation makes
+the linker map useless for this): src/ (the stack), od/ (dictionaries and
+product logic), the rest (board, main loop, libgcc, padding)."""
 import re
 import subprocess
 import sys
 from pathlib import Path
 
+from stack_depth import depth
+
 TARGET_FLASH, TARGET_RAM = 10 * 1024, 1024  # DST X730 on the Cortex-M0 (issue 4)
+M0_RAM = 6 * 1024  # STM32F042K6: every image's RAM and worst-case stack must fit
 
 
 ROOT = Path(__file__).resolve().parents[1]
-STACK = {p.name for p in (ROOT / "src").glob("*.c")}
-OD = {p.name for p in (ROOT / "od").glob("*.c")}
+SOURCES = sorted(ROOT.glob("src/*.c")) + sorted(ROOT.glob("od/*.c")) + sorted(ROOT.glob("boards/**/*.c"))
 
 
-def shares(map_file):
-    """Bytes of allocated input sections by origin: stack, od, board."""
+def origin_of(path):
+    """stack, od or board, from a source path."""
+    parts = Path(path).parts
+    if "src" in parts and not "boards" in parts:
+        return "stack"
+    if "od" in parts:
+        return "od"
+    return "board"
+
+
+def defined_in(name):
+    """Where a symbol nm has no line for (constant tables) is defined."""
+    pat = re.compile(r"\b" + re.escape(name) + r"\b\s*(\[[^]]*\])*\s*=")
+    for src in SOURCES:
+        if pat.search(src.read_text()):
+            return str(src)
+    return None
+
+
+def shares(elf, nm_tool, flash):
+    """Flash bytes by origin: stack, od, board (the rest)."""
     out = {"stack": 0, "od": 0, "board": 0}
-    cur = None
-    section = None
-    for line in map_file.read_text().splitlines():
-        if line.startswith("Discarded input sections"):
-            cur = "skip"
-        if line.startswith("Memory map") or line.startswith("Linker script and memory map"):
-            cur = "map"
-        if cur != "map":
-            continue
-        top = re.match(r"^(\.\S+)", line)  # an output section of the image
-        if top:
-            section = top.group(1)
-        m = re.match(r"^ ?(\.\S+)?\s+0x([0-9a-f]+)\s+0x([0-9a-f]+)\s+(\S+)$", line)
-        if not m or section not in (".isr_vector", ".text", ".data"):
-            continue  # flash only: .bss is RAM, the rest is not loaded
-        size, origin = int(m.group(3), 16), m.group(4)
-        # "lib.a(name.c.obj)": the source file's name decides.
-        name = re.sub(r"\.(obj|o)\)?$", "", origin.split("(")[-1])
-        if name in STACK:
-            out["stack"] += size
-        elif name in OD:
-            out["od"] += size
-        else:
-            out["board"] += size  # board files, the main loop, libgcc
+    lines = subprocess.run([nm_tool, "-l", "-S", str(elf)], check=True, capture_output=True,
+                           text=True).stdout.splitlines()
+    for line in lines:
+        m = re.match(r"^[0-9a-f]+ ([0-9a-f]+) ([TtRrDd]) (\S+)(?:\t(\S+):\d+)?$", line)
+        if not m:
+            continue  # no size, or not in flash (.bss)
+        size, name, path = int(m.group(1), 16), m.group(3), m.group(4)
+        if path is None:
+            path = defined_in(name.split(".")[0])
+        if path is not None:
+            out[origin_of(path)] += size
+    out["board"] = flash - out["stack"] - out["od"]  # board code, libgcc, padding
     return out
 
 
@@ -49,19 +60,31 @@ def main(argv):
     check = "--check" in argv
     argv = [a for a in argv if a != "--check"]
     failed = False
+    overflow = False
     for build, size_tool, title in zip(argv[0::3], argv[1::3], argv[2::3]):
         print(f"\n{title}")
-        print(f"{'product ID':<18} {'flash':>7} {'RAM':>6} {'stack':>7} {'od':>6} {'board':>6}")
+        print(f"{'product ID':<18} {'flash':>7} {'RAM':>6} {'stack':>7} {'od':>6} {'board':>6}"
+              f" {'SP max':>7}")
         for elf in sorted(Path(build, "bin").glob("fw-*.elf")):
             pid = elf.stem[3:]
             text, data, bss = map(int, subprocess.run([size_tool, str(elf)], check=True,
                                   capture_output=True, text=True).stdout.splitlines()[1].split()[:3])
-            s = shares(elf.with_suffix(".map"))
-            print(f"{pid:<18} {text + data:>7} {data + bss:>6} {s['stack']:>7} {s['od']:>6} {s['board']:>6}")
-            if check and "arm" in size_tool and pid == "dst-x730-xy30":
-                failed |= text + data > TARGET_FLASH or data + bss > TARGET_RAM
+            s = shares(elf, size_tool.replace("-size", "-nm"), text + data)
+            arm = "arm" in size_tool
+            sp = depth(elf)[0] if arm else None  # the analysis reads Thumb code only
+            print(f"{pid:<18} {text + data:>7} {data + bss:>6} {s['stack']:>7} {s['od']:>6} {s['board']:>6}"
+                  f" {sp if sp is not None else '-':>7}")
+            if arm and data + bss + sp > M0_RAM:
+                print(f"footprint: {pid} needs {data + bss + sp} bytes of RAM with its stack",
+                      file=sys.stderr)
+                overflow = True
+            if check and arm and pid == "dst-x730-xy30":
+                failed |= text + data > TARGET_FLASH or data + bss + sp > TARGET_RAM
+    if overflow:
+        return 1
     if check and failed:
-        print("footprint: the DST X730 misses its target (10 KB flash, 1 KB RAM)", file=sys.stderr)
+        print("footprint: the DST X730 misses its target (10 KB flash, 1 KB RAM with the stack)",
+              file=sys.stderr)
         return 1
     return 0
 

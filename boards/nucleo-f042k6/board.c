@@ -46,7 +46,10 @@ void board_sleep(uint32_t us)
 
 /* ---- CAN ----------------------------------------------------------------- */
 
-#define RXQ 16u
+/* Frames between two main-loop passes: the controller's FIFO holds 3 more,
+ * and a pass takes far less than the 8 frame times (>= 376 us at 1 Mbit/s)
+ * this queue covers. Overruns are counted. */
+#define RXQ 8u
 static co_frame_t rxq[RXQ];
 static volatile uint32_t rx_head, rx_tail; /* ISR writes head, main reads tail */
 static volatile uint32_t rx_overruns;

@@ -19,7 +19,7 @@
 #define MTIME_LO (*(volatile uint32_t *)0x0200BFF8u)
 
 int main(void);
-void reset_c(void);
+void reset_c(void) __attribute__((used)); /* called from the assembly above: LTO must keep it */
 
 __attribute__((naked, section(".text.start"))) void _start(void);
 void _start(void)
