@@ -41,6 +41,15 @@ bool co_cobid_restricted(uint32_t id)
            (id >= 0x601u && id <= 0x67Fu) || (id >= 0x6E0u && id <= 0x6FFu) || id >= 0x701u;
 }
 
+/* co_od_find's answer: the result code where asked for, and the entry. */
+static const co_od_entry_t *answer(co_res_t *res, co_res_t r, const co_od_entry_t *e)
+{
+    if (res != NULL) {
+        *res = r;
+    }
+    return e;
+}
+
 const co_od_entry_t *co_od_find(const co_od_t *od, uint16_t index, uint8_t sub, co_res_t *res)
 {
     /* Binary search on the index alone (one 16-bit compare a step), then
@@ -50,13 +59,7 @@ const co_od_entry_t *co_od_find(const co_od_t *od, uint16_t index, uint8_t sub, 
     uint32_t lo = 0;
     uint32_t hi = od->count;
     uint32_t at = 0;
-    for (;;) {
-        if (lo >= hi) {
-            if (res != NULL) {
-                *res = CO_E_NO_OBJ;
-            }
-            return NULL;
-        }
+    while (lo < hi) {
         at = (lo + hi) / 2u;
         if (t[at].index == index) {
             break;
@@ -67,12 +70,12 @@ const co_od_entry_t *co_od_find(const co_od_t *od, uint16_t index, uint8_t sub, 
             hi = at;
         }
     }
+    if (lo >= hi) {
+        return answer(res, CO_E_NO_OBJ, NULL);
+    }
     uint32_t guess = at + sub - t[at].sub; /* wraps to a huge value when below 0 */
     if (guess < od->count && t[guess].index == index && t[guess].sub == sub) {
-        if (res != NULL) {
-            *res = CO_OK;
-        }
-        return &t[guess];
+        return answer(res, CO_OK, &t[guess]);
     }
     /* Holes in the sub-indices: walk the object's entries. */
     while (at > 0u && t[at - 1u].index == index) {
@@ -80,16 +83,10 @@ const co_od_entry_t *co_od_find(const co_od_t *od, uint16_t index, uint8_t sub, 
     }
     for (; at < od->count && t[at].index == index; at++) {
         if (t[at].sub == sub) {
-            if (res != NULL) {
-                *res = CO_OK;
-            }
-            return &t[at];
+            return answer(res, CO_OK, &t[at]);
         }
     }
-    if (res != NULL) {
-        *res = CO_E_NO_SUB;
-    }
-    return NULL;
+    return answer(res, CO_E_NO_SUB, NULL);
 }
 
 /* Load a size-byte little-endian host value, sign-extending INTEGERn. */

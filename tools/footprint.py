@@ -22,7 +22,7 @@ SOURCES = sorted(ROOT.glob("src/*.c")) + sorted(ROOT.glob("od/*.c")) + sorted(RO
 def origin_of(path):
     """stack, od or board, from a source path."""
     parts = Path(path).parts
-    if "src" in parts and not "boards" in parts:
+    if "src" in parts and "boards" not in parts:
         return "stack"
     if "od" in parts:
         return "od"
