@@ -1,11 +1,12 @@
 /*
- * div.c - compact integer division for the Cortex-M0, which has no divide
- * instruction. libgcc's versions are unrolled for speed (about 730 bytes);
- * the stack divides a few times per sensor sample, so these shift-and-
- * subtract loops (about 100 bytes, at most 32 steps) are the better trade.
- * They implement the AEABI run-time helpers the compiler calls (RTABI).
+ * aeabi_div.c - compact integer division for the Cortex-M0, which has no
+ * divide instruction (aeabi_div.h). libgcc's versions are unrolled for
+ * speed (about 730 bytes); the stack divides a few times per sensor sample,
+ * so these shift-and-subtract loops (about 100 bytes, at most 32 steps,
+ * a few hundred cycles) are the better trade. Built without LTO: the
+ * compiler emits the calls to them after link-time optimisation.
  */
-#include <stdint.h>
+#include "aeabi_div.h"
 
 typedef struct {
     uint32_t quot;
@@ -16,7 +17,7 @@ static udivmod_t udivmod(uint32_t n, uint32_t d)
 {
     udivmod_t r = {0, 0};
     if (d == 0u) {
-        return r; /* undefined in C; the stack never divides by zero */
+        return r; /* see aeabi_div.h */
     }
     for (int bit = 31; bit >= 0; bit--) {
         r.rem = (r.rem << 1) | ((n >> bit) & 1u);
@@ -27,11 +28,6 @@ static udivmod_t udivmod(uint32_t n, uint32_t d)
     }
     return r;
 }
-
-uint32_t __aeabi_uidiv(uint32_t n, uint32_t d);
-uint64_t __aeabi_uidivmod(uint32_t n, uint32_t d);
-int32_t __aeabi_idiv(int32_t n, int32_t d);
-uint64_t __aeabi_idivmod(int32_t n, int32_t d);
 
 uint32_t __aeabi_uidiv(uint32_t n, uint32_t d)
 {
