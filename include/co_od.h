@@ -60,21 +60,42 @@ typedef enum co_cls {
 typedef co_res_t (*co_od_write_fn)(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 typedef co_res_t (*co_od_read_fn)(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
 
-struct co_od_entry {
-    uint16_t index;
-    uint8_t sub;
-    uint8_t type;     /* co_type_t */
-    uint8_t attr;     /* CO_A_* */
-    uint8_t cls;      /* co_cls_t */
-    uint16_t size;    /* bytes: 1, 2 or 4 for numbers, string length */
-    uint16_t off;     /* offset of the value in the class's RAM struct */
-    uint32_t def;     /* default / constant value (numbers) */
+/* What few entries have: limits and hooks. Behind one pointer so that the
+ * many plain entries cost 16 bytes of flash each on a 32-bit MCU. */
+typedef struct co_od_ext {
     int32_t min, max; /* inclusive limits, checked when min != max */
     co_od_write_fn write;
     co_od_read_fn read;
-    const void *cdata; /* constant bytes (strings) */
-    const char *name;  /* the manual's name, for people and EDS files */
+} co_od_ext_t;
+
+struct co_od_entry {
+    uint16_t index;
+    uint8_t sub;
+    uint8_t type;  /* co_type_t */
+    uint8_t attr;  /* CO_A_* */
+    uint8_t cls;   /* co_cls_t */
+    uint8_t size;  /* bytes: 1, 2 or 4 for numbers, string length (< 256) */
+    uint8_t off;   /* offset of the value in the class's RAM struct (< 256) */
+    union {
+        uint32_t def;      /* default / constant value (numbers) */
+        const void *cdata; /* constant bytes (strings) */
+    };
+    const co_od_ext_t *ext; /* limits and hooks, NULL: none */
+#ifndef CO_OD_NO_NAMES
+    const char *name; /* the manual's name, for people and EDS files */
+#endif
 };
+
+/* An entry's limits and hooks, none when it has no ext. */
+static inline co_od_write_fn co_od_write_hook(const co_od_entry_t *e)
+{
+    return e->ext != NULL ? e->ext->write : NULL;
+}
+
+static inline co_od_read_fn co_od_read_hook(const co_od_entry_t *e)
+{
+    return e->ext != NULL ? e->ext->read : NULL;
+}
 
 /* A product's dictionary: the table and its length. */
 typedef struct co_od {
@@ -149,16 +170,21 @@ static inline uint32_t co_od_size(const co_od_entry_t *e)
 #define CO_TYPE_I8 .type = CO_T_I8, .size = 1
 #define CO_TYPE_I16 .type = CO_T_I16, .size = 2
 #define CO_TYPE_I32 .type = CO_T_I32, .size = 4
-#define CO_TYPE_STR(s) .type = CO_T_VSTR, .size = (uint16_t)(sizeof(s) - 1u), .cdata = (s)
-/* The manual's name of an entry. The names serve people and EDS files; an
- * MCU image that prints no EDS builds with CO_OD_NO_NAMES and saves about
- * 30 bytes of flash per entry (1.3 KB on the DST X730). */
+#define CO_TYPE_STR(s) .type = CO_T_VSTR, .size = sizeof(s) - 1u, .cdata = (s)
+/* The manual's name of an entry, always its last field. The names serve
+ * people and EDS files; an MCU image that prints no EDS builds with
+ * CO_OD_NO_NAMES, where entries have no name (about 30 bytes of flash less
+ * per entry) and CO_NAME leaves a trailing comma. */
 #ifdef CO_OD_NO_NAMES
-#define CO_NAME(s) .name = NULL
+#define CO_NAME(s)
 #else
 #define CO_NAME(s) .name = (s)
 #endif
-/* Value stored in field f of RAM struct T of class c. */
-#define CO_AT(c, T, f) .cls = (c), .off = (uint16_t)offsetof(T, f)
+/* Value stored in field f of RAM struct T of class c. No cast: an offset
+ * beyond 255 does not fit .off, which the compiler refuses (-Woverflow). */
+#define CO_AT(c, T, f) .cls = (c), .off = offsetof(T, f)
+/* Limits and hooks: CO_EXT(.min = 1, .max = 127, .write = fn). A compound
+ * literal at file scope: a constant in flash next to the table. */
+#define CO_EXT(...) .ext = &(const co_od_ext_t){__VA_ARGS__}
 
 #endif /* CO_OD_H */

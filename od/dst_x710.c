@@ -24,13 +24,13 @@ static const co_od_entry_t x710_entries[] = {
     {.index = 0x1009, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, CO_NAME("Manufacturer hardware version")},
     {.index = 0x100A, .sub = 0, CO_TYPE_STR("1.10"), .attr = CONST, CO_NAME("Manufacturer software version")},
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Store parameters")},
-    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, .write = co_store_save_hook, CO_NAME("Save all parameters")},
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, CO_EXT(.write = co_store_save_hook), CO_NAME("Save all parameters")},
     {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Restore default parameters")},
     /* rw, reads 1 = "restores on command" (C-5, C-36). */
-    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_load_hook, CO_NAME("Restore all default parameters")},
-    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, .write = dst_write_emcy_cobid, CO_NAME("COB-ID EMCY")},
+    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_load_hook), CO_NAME("Restore all default parameters")},
+    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, CO_EXT(.write = dst_write_emcy_cobid), CO_NAME("COB-ID EMCY")},
     /* 0 or 20..65535 ms; 1..19 "NOT ACCEPTED". */
-    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, .write = dst_write_hb, CO_NAME("Producer heartbeat time")},
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, CO_EXT(.write = dst_write_hb), CO_NAME("Producer heartbeat time")},
     {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Identity object")},
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x00000093u, CO_NAME("Vendor-ID")},
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x00000064u, CO_NAME("Product code")},
@@ -42,38 +42,38 @@ static const co_od_entry_t x710_entries[] = {
     /* Highest sub-index 5; sub 4 (reserved) does not exist (C-19). */
     {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, CO_NAME("TPDO1 communication parameter")},
     {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x180, CO_NAME("COB-ID TPDO1")},
-    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RW, PARA(tx_type), .def = 254, .write = dst_write_tx_type, CO_NAME("Transmission type")},
+    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RW, PARA(tx_type), .def = 254, CO_EXT(.write = dst_write_tx_type), CO_NAME("Transmission type")},
     /* Main table: rw, default 4, 4..65535, unit 1 ms (C-19; Example 3 says ro 0). */
-    {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit_ms), .def = 4, .min = 4, .max = 65535, .write = co_tpdo_write_hook, CO_NAME("Inhibit time")},
+    {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit_ms), .def = 4, CO_EXT(.min = 4, .max = 65535, .write = co_tpdo_write_hook), CO_NAME("Inhibit time")},
     /* 0 = inactive, 4..65535 ms; default 100 = 0x64 (C-16, C-17). */
-    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 100, .write = dst_write_event, CO_NAME("Event timer")},
+    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 100, CO_EXT(.write = dst_write_event), CO_NAME("Event timer")},
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("TPDO1 mapping parameter")},
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x60100010u, CO_NAME("1st mapped object")},
     /* The manual prints 0x60200020; 0x6020 is 16 bits (C-4). */
     {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x60200010u, CO_NAME("2nd mapped object")},
     /* 0 slow, 1 medium, 2 fast; active after "save". Default 0 (C-2). */
-    {.index = 0x2001, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(filter), .def = 0, .min = 0, .max = 2, CO_NAME("Filter setting")},
-    {.index = 0x20F0, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(id[0]), .def = 0x7F, .min = 1, .max = 127, .write = dst_write_id, CO_NAME("Node-ID setting copy 1")},
-    {.index = 0x20F1, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(id[1]), .def = 0x7F, .min = 1, .max = 127, .write = dst_write_id, CO_NAME("Node-ID setting copy 2")},
+    {.index = 0x2001, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(filter), .def = 0, CO_EXT(.min = 0, .max = 2), CO_NAME("Filter setting")},
+    {.index = 0x20F0, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(id[0]), .def = 0x7F, CO_EXT(.min = 1, .max = 127, .write = dst_write_id), CO_NAME("Node-ID setting copy 1")},
+    {.index = 0x20F1, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(id[1]), .def = 0x7F, CO_EXT(.min = 1, .max = 127, .write = dst_write_id), CO_NAME("Node-ID setting copy 2")},
     /* 0 1000k, 1 800k, 2 500k, 3 250k, 4 125k, 5 100k, 6 50k, 7 20k. */
-    {.index = 0x20F2, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(br[0]), .def = 3, .min = 0, .max = 7, .write = dst_write_bitrate, CO_NAME("Bit rate setting copy 1")},
-    {.index = 0x20F3, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(br[1]), .def = 3, .min = 0, .max = 7, .write = dst_write_bitrate, CO_NAME("Bit rate setting copy 2")},
+    {.index = 0x20F2, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(br[0]), .def = 3, CO_EXT(.min = 0, .max = 7, .write = dst_write_bitrate), CO_NAME("Bit rate setting copy 1")},
+    {.index = 0x20F3, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(br[1]), .def = 3, CO_EXT(.min = 0, .max = 7, .write = dst_write_bitrate), CO_NAME("Bit rate setting copy 2")},
     /* 0 pre-operational, 1 no change, 2 stopped; 3..255 accepted as 1. */
     {.index = 0x4000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(err_behaviour), .def = 1, CO_NAME("Error behaviour")},
-    {.index = 0x4001, .sub = 0, CO_TYPE_U8, .attr = RO, .read = dst_read_errors, CO_NAME("Error code")},
-    {.index = 0x5000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(autostart), .def = 0, .min = 0, .max = 1, CO_NAME("Automatic NMT start")},
+    {.index = 0x4001, .sub = 0, CO_TYPE_U8, .attr = RO, CO_EXT(.read = dst_read_errors), CO_NAME("Error code")},
+    {.index = 0x5000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(autostart), .def = 0, CO_EXT(.min = 0, .max = 1), CO_NAME("Automatic NMT start")},
     /* No 0x5001: PDOs are always little-endian on the X710. */
     /* 10, 50, 100, 500, 1000 (x 0.001 deg); needs scaling on both axes. */
-    {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(incl.resolution), .def = 50, .write = dst_write_resolution, CO_NAME("Resolution")},
-    {.index = 0x6010, .sub = 0, CO_TYPE_I16, .attr = RO | CO_A_PDO, .read = dst_read_slope, CO_NAME("Slope longitudinal")},
+    {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(incl.resolution), .def = 50, CO_EXT(.write = dst_write_resolution), CO_NAME("Resolution")},
+    {.index = 0x6010, .sub = 0, CO_TYPE_I16, .attr = RO | CO_A_PDO, CO_EXT(.read = dst_read_slope), CO_NAME("Slope longitudinal")},
     /* bit0 invert, bit1 scaling; default 0x02 (C-3). */
-    {.index = 0x6011, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(incl.op[0]), .def = 0x02, .min = 0, .max = 3, CO_NAME("Slope longitudinal operating parameter")},
-    {.index = 0x6012, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.preset[0]), .def = 0, .write = dst_write_preset, CO_NAME("Slope longitudinal preset value")},
+    {.index = 0x6011, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(incl.op[0]), .def = 0x02, CO_EXT(.min = 0, .max = 3), CO_NAME("Slope longitudinal operating parameter")},
+    {.index = 0x6012, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.preset[0]), .def = 0, CO_EXT(.write = dst_write_preset), CO_NAME("Slope longitudinal preset value")},
     {.index = 0x6013, .sub = 0, CO_TYPE_I16, .attr = RO, PARA(incl.offset[0]), .def = 0, CO_NAME("Slope longitudinal offset")},
     {.index = 0x6014, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.diff[0]), .def = 0, CO_NAME("Differential slope longitudinal offset")},
-    {.index = 0x6020, .sub = 0, CO_TYPE_I16, .attr = RO | CO_A_PDO, .read = dst_read_slope, CO_NAME("Slope lateral")},
-    {.index = 0x6021, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(incl.op[1]), .def = 0x02, .min = 0, .max = 3, CO_NAME("Slope lateral operating parameter")},
-    {.index = 0x6022, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.preset[1]), .def = 0, .write = dst_write_preset, CO_NAME("Slope lateral preset value")},
+    {.index = 0x6020, .sub = 0, CO_TYPE_I16, .attr = RO | CO_A_PDO, CO_EXT(.read = dst_read_slope), CO_NAME("Slope lateral")},
+    {.index = 0x6021, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(incl.op[1]), .def = 0x02, CO_EXT(.min = 0, .max = 3), CO_NAME("Slope lateral operating parameter")},
+    {.index = 0x6022, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.preset[1]), .def = 0, CO_EXT(.write = dst_write_preset), CO_NAME("Slope lateral preset value")},
     {.index = 0x6023, .sub = 0, CO_TYPE_I16, .attr = RO, PARA(incl.offset[1]), .def = 0, CO_NAME("Slope lateral offset")},
     {.index = 0x6024, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.diff[1]), .def = 0, CO_NAME("Differential slope lateral offset")},
 };

@@ -18,19 +18,19 @@
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = 0xFFFF0196u, CO_NAME("Device type")}, \
     /* "Always 0", even with alarms in the PDO. */ \
     {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, .def = 0, CO_NAME("Error register")}, \
-    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = RW, PARA(sync_cobid), .def = 0x80, .write = co_sync_write_hook, CO_NAME("COB-ID SYNC")}, \
+    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = RW, PARA(sync_cobid), .def = 0x80, CO_EXT(.write = co_sync_write_hook), CO_NAME("COB-ID SYNC")}, \
     {.index = 0x1008, .sub = 0, CO_TYPE_STR("GSHA"), .attr = CONST, CO_NAME("Manufacturer device name")}, \
     /* "1.xx", format Maj.MinMin: the unit's own values are not known (C-31). */ \
     {.index = 0x1009, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, CO_NAME("Manufacturer hardware version")}, \
     {.index = 0x100A, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, CO_NAME("Manufacturer software version")}, \
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Store parameters")}, \
     /* wo as the manual says (C-08); subs 2-4 per CiA 301 (C-07). */ \
-    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, .write = co_store_save_hook, CO_NAME("Save all parameters")}, \
-    {.index = 0x1010, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_group_save_hook, CO_NAME("Save communication parameters")}, \
-    {.index = 0x1010, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_group_save_hook, CO_NAME("Save application parameters")}, \
-    {.index = 0x1010, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_group_save_hook, CO_NAME("Save manufacturer parameters")}, \
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, CO_EXT(.write = co_store_save_hook), CO_NAME("Save all parameters")}, \
+    {.index = 0x1010, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_save_hook), CO_NAME("Save communication parameters")}, \
+    {.index = 0x1010, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_save_hook), CO_NAME("Save application parameters")}, \
+    {.index = 0x1010, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_save_hook), CO_NAME("Save manufacturer parameters")}, \
     /* No 0x1011 (C-09). Heartbeat 0x1017 is not in the table but described (C-10). */ \
-    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, .write = co_hb_write_hook, CO_NAME("Producer heartbeat time")}, \
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, CO_EXT(.write = co_hb_write_hook), CO_NAME("Producer heartbeat time")}, \
     {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Identity object")}, \
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x00000093u, CO_NAME("Vendor-ID")}, \
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x00000067u, CO_NAME("Product code")}, \
@@ -45,24 +45,24 @@
     {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RO, .def = 4, CO_NAME("Inhibit time")}, /* (C-12) */ \
     {.index = 0x1800, .sub = 4, CO_TYPE_U8, .attr = RO, .def = 0, CO_NAME("Reserved")}, /* listed (C-13) */ \
     /* 100 ms (C-02); 0 = off, 4..65535 ms. */ \
-    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 100, .write = gsh_write_event, CO_NAME("Event timer")}, \
+    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 100, CO_EXT(.write = gsh_write_event), CO_NAME("Event timer")}, \
     /* Informative: the frame is always the fixed 8-byte layout (C-04). */ \
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("Tx PDO #0 mapping parameter")}, \
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x60040010u, CO_NAME("1st object")}, /* (C-03, C-05) */ \
     {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x68100010u, CO_NAME("2nd object")}, \
     /* Bit rate 0..7 = 1000, 800, 500, 250, 125, 100, 50, 20 kbit/s; node-ID 1..127.
      * Both saved by 0x1010 and active after a reset (R-29, R-31, C-24). */ \
-    {.index = 0x3000, .sub = 0, CO_TYPE_U8, .attr = RW, LSS(bitrate), .def = 3, .min = 0, .max = 7, CO_NAME("Setting of the baud rate")}, \
-    {.index = 0x3001, .sub = 0, CO_TYPE_U8, .attr = RW, LSS(node_id), .def = (node_id_default), .min = 1, .max = 127, CO_NAME("Setting of the node-ID")}, \
-    {.index = 0x5000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(autostart), .def = 1, .min = 0, .max = 1, CO_NAME("Automatic NMT start after power on")}, \
+    {.index = 0x3000, .sub = 0, CO_TYPE_U8, .attr = RW, LSS(bitrate), .def = 3, CO_EXT(.min = 0, .max = 7), CO_NAME("Setting of the baud rate")}, \
+    {.index = 0x3001, .sub = 0, CO_TYPE_U8, .attr = RW, LSS(node_id), .def = (node_id_default), CO_EXT(.min = 1, .max = 127), CO_NAME("Setting of the node-ID")}, \
+    {.index = 0x5000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(autostart), .def = 1, CO_EXT(.min = 0, .max = 1), CO_NAME("Automatic NMT start after power on")}, \
     {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RO, .def = 0, CO_NAME("Operating parameters")}, /* (C-16) */ \
     /* Position in 0x6005 steps (1 mm); the PDO carries its low 16 bits (C-05). */ \
-    {.index = 0x6004, .sub = 0, CO_TYPE_U32, .attr = RO | CO_A_PDO, .read = gsh_read_position, CO_NAME("Position value")}, \
+    {.index = 0x6004, .sub = 0, CO_TYPE_U32, .attr = RO | CO_A_PDO, CO_EXT(.read = gsh_read_position), CO_NAME("Position value")}, \
     {.index = 0x6005, .sub = 0, CO_TYPE_U32, .attr = RO, .def = 1000000u, CO_NAME("Position step setting")}, /* nm (C-17) */ \
     {.index = 0x67FF, .sub = 0, CO_TYPE_U32, .attr = RO, .def = 0x000A0196u, CO_NAME("Device type logical device 1")}, \
     {.index = 0x6800, .sub = 0, CO_TYPE_U16, .attr = RO, .def = 100, CO_NAME("Resolution")}, /* 0.1 deg */ \
     /* 0..3599: UNSIGNED16 as the manual says (C-19). */ \
-    {.index = 0x6810, .sub = 0, CO_TYPE_U16, .attr = RO | CO_A_PDO, .read = gsh_read_angle, CO_NAME("Slope long16")}, \
+    {.index = 0x6810, .sub = 0, CO_TYPE_U16, .attr = RO | CO_A_PDO, CO_EXT(.read = gsh_read_angle), CO_NAME("Slope long16")}, \
     {.index = 0x6811, .sub = 0, CO_TYPE_U8, .attr = RO, .def = 0, CO_NAME("Slope long16 operating parameter")}, \
     {.index = 0x6FFF, .sub = 0, CO_TYPE_U32, .attr = RO, .def = 0x0002019Au, CO_NAME("Device type logical device 2")} /* (C-18) */
 

@@ -16,44 +16,44 @@
  * writable only while invalid, the shared event timer, dynamic mapping. */
 #define JD_TPDO(n, cobdef, inhdef)                                                                           \
     {.index = 0x1800 + (n), .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, CO_NAME("TPDO communication parameter")}, \
-    {.index = 0x1800 + (n), .sub = 1, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(cob[n]), .def = (cobdef), .write = co_tpdo_cobid_write_hook, CO_NAME("COB-ID")}, \
-    {.index = 0x1800 + (n), .sub = 2, CO_TYPE_U8, .attr = RW, PARA(type[n]), .def = 1, .write = co_tpdo_write_hook, CO_NAME("Transmission type")}, \
-    {.index = 0x1800 + (n), .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit[n]), .def = (inhdef), .write = jd_write_inhibit, CO_NAME("Inhibit time")}, \
-    {.index = 0x1800 + (n), .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 10, .write = jd_write_event, CO_NAME("Event timer")}
+    {.index = 0x1800 + (n), .sub = 1, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(cob[n]), .def = (cobdef), CO_EXT(.write = co_tpdo_cobid_write_hook), CO_NAME("COB-ID")}, \
+    {.index = 0x1800 + (n), .sub = 2, CO_TYPE_U8, .attr = RW, PARA(type[n]), .def = 1, CO_EXT(.write = co_tpdo_write_hook), CO_NAME("Transmission type")}, \
+    {.index = 0x1800 + (n), .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit[n]), .def = (inhdef), CO_EXT(.write = jd_write_inhibit), CO_NAME("Inhibit time")}, \
+    {.index = 0x1800 + (n), .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 10, CO_EXT(.write = jd_write_event), CO_NAME("Event timer")}
 
 #define JD_MAP(n, count, m2)                                                                                 \
-    {.index = 0x1A00 + (n), .sub = 0, CO_TYPE_U8, .attr = RW, PARA(map_count[n]), .def = (count), .write = co_tpdo_map_write_hook, CO_NAME("TPDO mapping parameter")}, \
-    {.index = 0x1A00 + (n), .sub = 1, CO_TYPE_U32, .attr = RW, PARA(map[n][0]), .def = 0x60100010u, .write = co_tpdo_map_write_hook, CO_NAME("1st mapped object")}, \
-    {.index = 0x1A00 + (n), .sub = 2, CO_TYPE_U32, .attr = RW, PARA(map[n][1]), .def = (m2), .write = co_tpdo_map_write_hook, CO_NAME("2nd mapped object")}
+    {.index = 0x1A00 + (n), .sub = 0, CO_TYPE_U8, .attr = RW, PARA(map_count[n]), .def = (count), CO_EXT(.write = co_tpdo_map_write_hook), CO_NAME("TPDO mapping parameter")}, \
+    {.index = 0x1A00 + (n), .sub = 1, CO_TYPE_U32, .attr = RW, PARA(map[n][0]), .def = 0x60100010u, CO_EXT(.write = co_tpdo_map_write_hook), CO_NAME("1st mapped object")}, \
+    {.index = 0x1A00 + (n), .sub = 2, CO_TYPE_U32, .attr = RW, PARA(map[n][1]), .def = (m2), CO_EXT(.write = co_tpdo_map_write_hook), CO_NAME("2nd mapped object")}
 
 /* 0x1000 .. 0x1018, the same on both models but for the device type and name. */
 #define JD_COMM(devtype, devname)                                                                            \
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = (devtype), CO_NAME("Device type")},       \
-    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, .read = co_emcy_register_read, CO_NAME("Error register")}, \
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, CO_EXT(.read = co_emcy_register_read), CO_NAME("Error register")}, \
     /* Depth 1: only sub 1 is documented (C41). */ \
-    {.index = 0x1003, .sub = 0, CO_TYPE_U8, .attr = RW, .read = co_emcy_hist_read, .write = co_emcy_hist_write, CO_NAME("Pre-defined error field")}, \
-    {.index = 0x1003, .sub = 1, CO_TYPE_U32, .attr = RO, .read = co_emcy_hist_read, CO_NAME("Most recent error")}, \
-    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = RW, PARA(sync_cobid), .def = 0x80, .write = co_sync_write_hook, CO_NAME("COB-ID SYNC")}, \
+    {.index = 0x1003, .sub = 0, CO_TYPE_U8, .attr = RW, CO_EXT(.write = co_emcy_hist_write, .read = co_emcy_hist_read), CO_NAME("Pre-defined error field")}, \
+    {.index = 0x1003, .sub = 1, CO_TYPE_U32, .attr = RO, CO_EXT(.read = co_emcy_hist_read), CO_NAME("Most recent error")}, \
+    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = RW, PARA(sync_cobid), .def = 0x80, CO_EXT(.write = co_sync_write_hook), CO_NAME("COB-ID SYNC")}, \
     {.index = 0x1008, .sub = 0, CO_TYPE_STR(devname), .attr = CONST, CO_NAME("Manufacturer device name")}, /* (?) */ \
     {.index = 0x1009, .sub = 0, CO_TYPE_STR("HW 1.0"), .attr = CONST, CO_NAME("Manufacturer hardware version")}, /* (?) */ \
     {.index = 0x100A, .sub = 0, CO_TYPE_STR("FW 1.0"), .attr = CONST, CO_NAME("Manufacturer software version")}, /* (?) */ \
     {.index = 0x100C, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(guard_ms), .def = 0, CO_NAME("Guard time")}, \
     {.index = 0x100D, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(life_factor), .def = 0, CO_NAME("Life time factor")}, \
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Store parameters")}, \
-    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_save_hook, CO_NAME("Save all parameters")}, \
-    {.index = 0x1010, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_group_save_hook, CO_NAME("Save communication parameters")}, \
-    {.index = 0x1010, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_group_save_hook, CO_NAME("Save application parameters")}, \
-    {.index = 0x1010, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_group_save_hook, CO_NAME("Save manufacturer parameters")}, \
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_save_hook), CO_NAME("Save all parameters")}, \
+    {.index = 0x1010, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_save_hook), CO_NAME("Save communication parameters")}, \
+    {.index = 0x1010, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_save_hook), CO_NAME("Save application parameters")}, \
+    {.index = 0x1010, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_save_hook), CO_NAME("Save manufacturer parameters")}, \
     {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Restore default parameters")}, \
-    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_load_hook, CO_NAME("Restore all parameters")}, \
-    {.index = 0x1011, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_group_load_hook, CO_NAME("Restore communication parameters")}, \
-    {.index = 0x1011, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_group_load_hook, CO_NAME("Restore application parameters")}, \
-    {.index = 0x1011, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, .write = co_store_group_load_hook, CO_NAME("Restore manufacturer parameters")}, \
+    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_load_hook), CO_NAME("Restore all parameters")}, \
+    {.index = 0x1011, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_load_hook), CO_NAME("Restore communication parameters")}, \
+    {.index = 0x1011, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_load_hook), CO_NAME("Restore application parameters")}, \
+    {.index = 0x1011, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_load_hook), CO_NAME("Restore manufacturer parameters")}, \
     /* UNSIGNED32, rw, 0x80 + node-ID (C2). */ \
-    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, .write = co_emcy_cobid_write, CO_NAME("COB-ID EMCY")}, \
+    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, CO_EXT(.write = co_emcy_cobid_write), CO_NAME("COB-ID EMCY")}, \
     {.index = 0x1016, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Consumer heartbeat time")}, \
-    {.index = 0x1016, .sub = 1, CO_TYPE_U32, .attr = RW, PARA(hb_consumer), .def = 0, .write = co_hbc_write_hook, CO_NAME("Consumer heartbeat time 1")}, \
-    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, .write = co_hb_write_hook, CO_NAME("Producer heartbeat time")}, \
+    {.index = 0x1016, .sub = 1, CO_TYPE_U32, .attr = RW, PARA(hb_consumer), .def = 0, CO_EXT(.write = co_hbc_write_hook), CO_NAME("Consumer heartbeat time 1")}, \
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, CO_EXT(.write = co_hb_write_hook), CO_NAME("Producer heartbeat time")}, \
     {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Identity object")}, \
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x0069666Du, CO_NAME("Vendor-ID")}, /* "ifm" */ \
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Product code")}, /* "0x0 (JDxxxx)" (?) */ \
@@ -63,41 +63,41 @@
 /* 0x2200 .. 0x3411 (2601h on JD2 only). */
 #define JD_MFR_HEAD \
     /* The cyclic timer is the event timer (R20). */ \
-    {.index = 0x2200, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 10, .write = jd_write_event, CO_NAME("Cyclic time")}, \
-    {.index = 0x2300, .sub = 0, CO_TYPE_U32, .attr = WO, .write = jd_write_save_reset, CO_NAME("Save parameters with reset")}, \
-    {.index = 0x2600, .sub = 0, CO_TYPE_I16, .attr = RW, .read = jd_read_preset, .write = jd_write_preset, CO_NAME("Preset X-axis")}
+    {.index = 0x2200, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 10, CO_EXT(.write = jd_write_event), CO_NAME("Cyclic time")}, \
+    {.index = 0x2300, .sub = 0, CO_TYPE_U32, .attr = WO, CO_EXT(.write = jd_write_save_reset), CO_NAME("Save parameters with reset")}, \
+    {.index = 0x2600, .sub = 0, CO_TYPE_I16, .attr = RW, CO_EXT(.write = jd_write_preset, .read = jd_read_preset), CO_NAME("Preset X-axis")}
 #define JD_MFR_TAIL \
     /* Fast boot-up: stored; the simulated boot is immediate either way. */ \
-    {.index = 0x2700, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(fast_boot), .def = 0, .min = 0, .max = 1, CO_NAME("Fast boot-up")}, \
+    {.index = 0x2700, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(fast_boot), .def = 0, CO_EXT(.min = 0, .max = 1), CO_NAME("Fast boot-up")}, \
     /* Node-ID - 1 (C1, R41); active after save and reset. */ \
-    {.index = 0x3000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(node_number), .def = 0x09, .min = 0, .max = 0x7E, CO_NAME("Node number")}, \
+    {.index = 0x3000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(node_number), .def = 0x09, CO_EXT(.min = 0, .max = 0x7E), CO_NAME("Node number")}, \
     /* 0..7 = 20, 50, 100, 125, 250, 500, 800, 1000 kbit/s. */ \
-    {.index = 0x3001, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(bitrate), .def = 0x03, .min = 0, .max = 7, CO_NAME("Baud rate")}, \
-    {.index = 0x3002, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(termination), .def = 0, .min = 0, .max = 1, CO_NAME("Termination resistor")}, \
-    {.index = 0x3005, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(autostart), .def = 0, .min = 0, .max = 1, CO_NAME("Auto boot-up")}, \
+    {.index = 0x3001, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(bitrate), .def = 0x03, CO_EXT(.min = 0, .max = 7), CO_NAME("Baud rate")}, \
+    {.index = 0x3002, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(termination), .def = 0, CO_EXT(.min = 0, .max = 1), CO_NAME("Termination resistor")}, \
+    {.index = 0x3005, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(autostart), .def = 0, CO_EXT(.min = 0, .max = 1), CO_NAME("Auto boot-up")}, \
     {.index = 0x3022, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(recursive), .def = 0, CO_NAME("Digital recursive filter")}, /* undocumented (?) */ \
-    {.index = 0x3100, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(maf), .def = 0, .min = 0, .max = JD_MAF_MAX, CO_NAME("Moving average filter")}, \
-    {.index = 0x3400, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, .read = jd_read_sensor, CO_NAME("Gyro X axis 16")}, \
-    {.index = 0x3401, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, .read = jd_read_sensor, CO_NAME("Gyro Y axis 16")}, \
-    {.index = 0x3402, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, .read = jd_read_sensor, CO_NAME("Gyro Z axis 16")}, \
-    {.index = 0x3403, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, .read = jd_read_sensor, CO_NAME("Acceleration X axis 16")}, \
-    {.index = 0x3404, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, .read = jd_read_sensor, CO_NAME("Acceleration Y axis 16")}, \
-    {.index = 0x3405, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, .read = jd_read_sensor, CO_NAME("Acceleration Z axis 16")}, \
-    {.index = 0x3411, .sub = 0, CO_TYPE_U16, .attr = RO | PDO, .read = jd_read_sensor, CO_NAME("Temperature gyro")}, \
+    {.index = 0x3100, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(maf), .def = 0, CO_EXT(.min = 0, .max = JD_MAF_MAX), CO_NAME("Moving average filter")}, \
+    {.index = 0x3400, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, CO_EXT(.read = jd_read_sensor), CO_NAME("Gyro X axis 16")}, \
+    {.index = 0x3401, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, CO_EXT(.read = jd_read_sensor), CO_NAME("Gyro Y axis 16")}, \
+    {.index = 0x3402, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, CO_EXT(.read = jd_read_sensor), CO_NAME("Gyro Z axis 16")}, \
+    {.index = 0x3403, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, CO_EXT(.read = jd_read_sensor), CO_NAME("Acceleration X axis 16")}, \
+    {.index = 0x3404, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, CO_EXT(.read = jd_read_sensor), CO_NAME("Acceleration Y axis 16")}, \
+    {.index = 0x3405, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, CO_EXT(.read = jd_read_sensor), CO_NAME("Acceleration Z axis 16")}, \
+    {.index = 0x3411, .sub = 0, CO_TYPE_U16, .attr = RO | PDO, CO_EXT(.read = jd_read_sensor), CO_NAME("Temperature gyro")}, \
     /* 10, 100, 1000 (x 0.001 deg); a change rescales presets and offsets (R55). */ \
-    {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(resolution), .def = 10, .write = jd_write_resolution, CO_NAME("Resolution")}
+    {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(resolution), .def = 10, CO_EXT(.write = jd_write_resolution), CO_NAME("Resolution")}
 
 /* One axis of 16-bit slope objects at base (0x6010 / 0x6020). */
 #define JD_AXIS16(base, ax, type16, nm) \
-    {.index = (base), .sub = 0, type16, .attr = RO | PDO, .read = jd_read_slope, CO_NAME("Slope " nm "16")}, \
-    {.index = (base) + 1, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(op16[ax]), .def = 0, .min = 0, .max = 3, CO_NAME("Slope " nm "16 operating parameter")}, \
-    {.index = (base) + 2, .sub = 0, CO_TYPE_I16, .attr = RW, .read = jd_read_preset, .write = jd_write_preset, CO_NAME("Slope " nm "16 preset value")}, \
+    {.index = (base), .sub = 0, type16, .attr = RO | PDO, CO_EXT(.read = jd_read_slope), CO_NAME("Slope " nm "16")}, \
+    {.index = (base) + 1, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(op16[ax]), .def = 0, CO_EXT(.min = 0, .max = 3), CO_NAME("Slope " nm "16 operating parameter")}, \
+    {.index = (base) + 2, .sub = 0, CO_TYPE_I16, .attr = RW, CO_EXT(.write = jd_write_preset, .read = jd_read_preset), CO_NAME("Slope " nm "16 preset value")}, \
     {.index = (base) + 3, .sub = 0, CO_TYPE_I16, .attr = RO, PARA(off16[ax]), .def = 0, CO_NAME("Slope " nm "16 offset")}, \
     {.index = (base) + 4, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(diff16[ax]), .def = 0, CO_NAME("Differential slope " nm "16 offset")}
 #define JD_AXIS32(base, ax, nm) \
-    {.index = (base), .sub = 0, CO_TYPE_I32, .attr = RO | PDO, .read = jd_read_slope, CO_NAME("Slope " nm "32")}, \
-    {.index = (base) + 1, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(op32[ax]), .def = 0, .min = 0, .max = 3, CO_NAME("Slope " nm "32 operating parameter")}, \
-    {.index = (base) + 2, .sub = 0, CO_TYPE_I32, .attr = RW, PARA(preset[ax]), .def = 0, .write = jd_write_preset, CO_NAME("Slope " nm "32 preset value")}, \
+    {.index = (base), .sub = 0, CO_TYPE_I32, .attr = RO | PDO, CO_EXT(.read = jd_read_slope), CO_NAME("Slope " nm "32")}, \
+    {.index = (base) + 1, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(op32[ax]), .def = 0, CO_EXT(.min = 0, .max = 3), CO_NAME("Slope " nm "32 operating parameter")}, \
+    {.index = (base) + 2, .sub = 0, CO_TYPE_I32, .attr = RW, PARA(preset[ax]), .def = 0, CO_EXT(.write = jd_write_preset), CO_NAME("Slope " nm "32 preset value")}, \
     {.index = (base) + 3, .sub = 0, CO_TYPE_I32, .attr = RO, PARA(off32[ax]), .def = 0, CO_NAME("Slope " nm "32 offset")}, \
     {.index = (base) + 4, .sub = 0, CO_TYPE_I32, .attr = RW, PARA(diff32[ax]), .def = 0, CO_NAME("Differential slope " nm "32 offset")}
 
@@ -108,7 +108,7 @@ static const co_od_entry_t jd2_entries[] = {
     JD_MAP(0, 2, 0x60200010u),
     JD_MAP(1, 2, 0x60200010u),
     JD_MFR_HEAD,
-    {.index = 0x2601, .sub = 0, CO_TYPE_I16, .attr = RW, .read = jd_read_preset, .write = jd_write_preset, CO_NAME("Preset Y-axis")},
+    {.index = 0x2601, .sub = 0, CO_TYPE_I16, .attr = RW, CO_EXT(.write = jd_write_preset, .read = jd_read_preset), CO_NAME("Preset Y-axis")},
     JD_MFR_TAIL,
     JD_AXIS16(0x6010, 0, CO_TYPE_I16, "long"),
     JD_AXIS16(0x6020, 1, CO_TYPE_I16, "lateral"),
@@ -127,9 +127,9 @@ static const co_od_entry_t jd1_entries[] = {
     /* Z, 0..N-1 as UNSIGNED16 (R50, R54). */
     JD_AXIS16(0x6010, 0, CO_TYPE_U16, "long"),
     /* "6020h always returns 0" (L1671); 6021h-6024h absent (?). */
-    {.index = 0x6020, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, .read = jd_read_slope, CO_NAME("Slope lateral16")},
+    {.index = 0x6020, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, CO_EXT(.read = jd_read_slope), CO_NAME("Slope lateral16")},
     JD_AXIS32(0x6110, 0, "long"),
-    {.index = 0x6120, .sub = 0, CO_TYPE_I32, .attr = RO | PDO, .read = jd_read_slope, CO_NAME("Slope lateral32")},
+    {.index = 0x6120, .sub = 0, CO_TYPE_I32, .attr = RO | PDO, CO_EXT(.read = jd_read_slope), CO_NAME("Slope lateral32")},
 };
 
 static const co_od_t jd2_od = {.entries = jd2_entries, .count = sizeof(jd2_entries) / sizeof(jd2_entries[0])};

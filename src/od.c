@@ -142,8 +142,9 @@ void co_od_native(const co_od_entry_t *e, uint32_t value, uint8_t *out)
 
 co_res_t co_od_get(co_node_t *node, const co_od_entry_t *e, uint32_t *value)
 {
-    if (e->read != NULL) {
-        return e->read(node, e, value);
+    co_od_read_fn read = co_od_read_hook(e);
+    if (read != NULL) {
+        return read(node, e, value);
     }
     const uint8_t *p = ram_of(node, e);
     uint32_t v = (p != NULL) ? load_value(e, p) : e->def;
@@ -214,25 +215,30 @@ co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf
     uint8_t tmp[4] = {0, 0, 0, 0};
     memcpy(tmp, buf, len);
     uint32_t v = load_value(e, tmp);
-    if (e->min != e->max) {
-        if (is_signed(e)) {
-            int32_t s = (int32_t)v;
-            if (s < e->min) {
-                return CO_E_VAL_LOW;
-            }
-            if (s > e->max) {
-                return CO_E_VAL_HIGH;
-            }
-        } else {
-            if (v < (uint32_t)e->min) {
-                return CO_E_VAL_LOW;
-            }
-            if (v > (uint32_t)e->max) {
-                return CO_E_VAL_HIGH;
+    const co_od_ext_t *x = e->ext;
+    co_od_write_fn write = NULL;
+    if (x != NULL) {
+        if (x->min != x->max) {
+            if (is_signed(e)) {
+                int32_t s = (int32_t)v;
+                if (s < x->min) {
+                    return CO_E_VAL_LOW;
+                }
+                if (s > x->max) {
+                    return CO_E_VAL_HIGH;
+                }
+            } else {
+                if (v < (uint32_t)x->min) {
+                    return CO_E_VAL_LOW;
+                }
+                if (v > (uint32_t)x->max) {
+                    return CO_E_VAL_HIGH;
+                }
             }
         }
+        write = x->write;
     }
-    co_res_t r = e->write != NULL ? e->write(node, e, v) : co_od_store(node, e, v);
+    co_res_t r = write != NULL ? write(node, e, v) : co_od_store(node, e, v);
     if (r == CO_OK && node->cfg->autosave && (e->cls == CO_CLS_PARA || e->cls == CO_CLS_LSS)) {
         r = co_store_save(node, (co_cls_t)e->cls); /* the product stores every change */
     }

@@ -36,7 +36,9 @@ uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len)
 
 uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls)
 {
-    /* FNV-1a over (index, sub, size, offset) of every entry with RAM in cls. */
+    /* FNV-1a over (index, sub, size, offset) of every entry with RAM in cls.
+     * Size and offset hash as 16-bit numbers (high bytes 0), as when the
+     * entries held them so: sets stored by older firmware stay valid. */
     uint32_t h = 2166136261u;
     const co_od_t *od = node->cfg->od;
     for (uint16_t i = 0; i < od->count; i++) {
@@ -44,9 +46,7 @@ uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls)
         if (e->cls != cls) {
             continue;
         }
-        uint8_t k[7] = {(uint8_t)e->index, (uint8_t)(e->index >> 8), e->sub,
-                        (uint8_t)e->size, (uint8_t)(e->size >> 8), (uint8_t)e->off,
-                        (uint8_t)(e->off >> 8)};
+        uint8_t k[7] = {(uint8_t)e->index, (uint8_t)(e->index >> 8), e->sub, e->size, 0, e->off, 0};
         for (unsigned j = 0; j < sizeof(k); j++) {
             h = (h ^ k[j]) * 16777619u;
         }

@@ -22,8 +22,8 @@ SOURCES = sorted(ROOT.glob("src/*.c")) + sorted(ROOT.glob("od/*.c")) + sorted(RO
 def origin_of(path):
     """stack, od or board, from a source path."""
     parts = Path(path).parts
-    if "src" in parts and "boards" not in parts:
-        return "stack"
+    if ("src" in parts or "include" in parts) and "boards" not in parts:
+        return "stack"  # include/: the stack's inline functions
     if "od" in parts:
         return "od"
     return "board"
@@ -43,12 +43,16 @@ def shares(elf, nm_tool, flash):
     out = {"stack": 0, "od": 0, "board": 0}
     lines = subprocess.run([nm_tool, "-l", "-S", str(elf)], check=True, capture_output=True,
                            text=True).stdout.splitlines()
+    seen = set()
     for line in lines:
-        m = re.match(r"^[0-9a-f]+ ([0-9a-f]+) ([TtRrDd]) (\S+)(?:\t(\S+):\d+)?$", line)
-        if not m:
-            continue  # no size, or not in flash (.bss)
-        size, name, path = int(m.group(1), 16), m.group(3), m.group(4)
-        if path is None:
+        m = re.match(r"^([0-9a-f]+) ([0-9a-f]+) ([TtRrDd]) (\S+)(?:\t(\S+):\d+)?$", line)
+        if not m or m.group(1) in seen:
+            continue  # no size, not in flash (.bss), or an alias of bytes counted
+        seen.add(m.group(1))
+        size, name, path = int(m.group(2), 16), m.group(4), m.group(5)
+        if name.startswith("__compound_literal"):
+            path = "od/"  # only the dictionaries' limits and hooks (CO_EXT) are ones
+        elif path is None:
             path = defined_in(name.split(".")[0])
         if path is not None:
             out[origin_of(path)] += size

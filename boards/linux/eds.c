@@ -50,14 +50,14 @@ static void entry_body(FILE *f, const co_od_entry_t *e, const char *name)
         fprintf(f, "DefaultValue=%.*s\n", (int)e->size, (const char *)e->cdata);
     } else if ((e->attr & CO_A_NODEID) != 0u) {
         fprintf(f, "DefaultValue=$NODEID+0x%lX\n", (unsigned long)e->def);
-    } else if (e->read != NULL) {
+    } else if (co_od_read_hook(e) != NULL) {
         fprintf(f, "DefaultValue=0\n"); /* computed at run time */
     } else {
         value(f, "DefaultValue", e, e->def);
     }
-    if (e->min != e->max) {
-        value(f, "LowLimit", e, (uint32_t)e->min);
-        value(f, "HighLimit", e, (uint32_t)e->max);
+    if (e->ext != NULL && e->ext->min != e->ext->max) {
+        value(f, "LowLimit", e, (uint32_t)e->ext->min);
+        value(f, "HighLimit", e, (uint32_t)e->ext->max);
     }
     fprintf(f, "PDOMapping=%d\n\n", (e->attr & CO_A_PDO) != 0u ? 1 : 0);
 }

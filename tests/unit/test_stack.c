@@ -36,42 +36,42 @@ typedef struct t_dev {
 
 #define P(f) CO_AT(CO_CLS_PARA, t_para_t, f)
 #define V(f) CO_AT(CO_CLS_VOL, t_vol_t, f)
-#define TPW .write = co_tpdo_write_hook
+#define TPW CO_EXT(.write = co_tpdo_write_hook)
 
 static const co_od_entry_t t_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x12345678u},
-    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .read = co_emcy_register_read},
-    {.index = 0x1003, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, .read = co_emcy_hist_read, .write = co_emcy_hist_write},
-    {.index = 0x1003, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .read = co_emcy_hist_read},
-    {.index = 0x1003, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, .read = co_emcy_hist_read},
-    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(sync_cob), .def = 0x80, .write = co_sync_write_hook},
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_register_read)},
+    {.index = 0x1003, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, CO_EXT(.write = co_emcy_hist_write, .read = co_emcy_hist_read)},
+    {.index = 0x1003, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, CO_EXT(.read = co_emcy_hist_read)},
+    {.index = 0x1003, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, CO_EXT(.read = co_emcy_hist_read)},
+    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(sync_cob), .def = 0x80, CO_EXT(.write = co_sync_write_hook)},
     {.index = 0x1008, .sub = 0, CO_TYPE_STR("A long device name for segmented transfer"), .attr = CO_A_R | CO_A_CONST},
     {.index = 0x100C, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(guard_ms), .def = 0},
     {.index = 0x100D, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, P(life_factor), .def = 0},
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
-    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = CO_A_W, .write = co_store_save_hook},
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = CO_A_W, CO_EXT(.write = co_store_save_hook)},
     {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
-    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, .def = 1, .write = co_store_load_hook},
-    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, P(emcy_cob), .def = 0x80, .write = co_emcy_cobid_write},
-    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(hb), .def = 0, .write = co_hb_write_hook},
+    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, .def = 1, CO_EXT(.write = co_store_load_hook)},
+    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, P(emcy_cob), .def = 0x80, CO_EXT(.write = co_emcy_cobid_write)},
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(hb), .def = 0, CO_EXT(.write = co_hb_write_hook)},
     {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 5},
     {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, TPW, P(cob[0]), .def = 0x180},
     {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = CO_A_RW, TPW, P(type[0]), .def = 254},
     {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = CO_A_RW, TPW, P(inhibit[0]), .def = 0},
     {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = CO_A_RW, TPW, P(event[0]), .def = 100},
     {.index = 0x1801, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 5},
-    {.index = 0x1801, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, .write = co_tpdo_cobid_write_hook, P(cob[1]), .def = 0x280},
+    {.index = 0x1801, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, P(cob[1]), .def = 0x280, CO_EXT(.write = co_tpdo_cobid_write_hook)},
     {.index = 0x1801, .sub = 2, CO_TYPE_U8, .attr = CO_A_RW, TPW, P(type[1]), .def = 1},
     {.index = 0x1801, .sub = 3, CO_TYPE_U16, .attr = CO_A_RW, TPW, P(inhibit[1]), .def = 0},
     {.index = 0x1801, .sub = 5, CO_TYPE_U16, .attr = CO_A_RW, TPW, P(event[1]), .def = 0},
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 2},
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21000020u},
     {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, .def = 0x20010010u},
-    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, P(map1_count), .def = 1, .write = co_tpdo_map_write_hook},
-    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, P(map1[0]), .def = 0x20020020u, .write = co_tpdo_map_write_hook}, /* not mappable */
-    {.index = 0x1A01, .sub = 2, CO_TYPE_U32, .attr = CO_A_RW, P(map1[1]), .def = 0, .write = co_tpdo_map_write_hook},
-    {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(u32), .def = 100, .min = 10, .max = 1000},
-    {.index = 0x2001, .sub = 0, CO_TYPE_I16, .attr = CO_A_RW | CO_A_PDO, P(i16), .def = (uint32_t)-5, .min = -100, .max = 100},
+    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, P(map1_count), .def = 1, CO_EXT(.write = co_tpdo_map_write_hook)},
+    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, P(map1[0]), .def = 0x20020020u, CO_EXT(.write = co_tpdo_map_write_hook)}, /* not mappable */
+    {.index = 0x1A01, .sub = 2, CO_TYPE_U32, .attr = CO_A_RW, P(map1[1]), .def = 0, CO_EXT(.write = co_tpdo_map_write_hook)},
+    {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(u32), .def = 100, CO_EXT(.min = 10, .max = 1000)},
+    {.index = 0x2001, .sub = 0, CO_TYPE_I16, .attr = CO_A_RW | CO_A_PDO, P(i16), .def = (uint32_t)-5, CO_EXT(.min = -100, .max = 100)},
     {.index = 0x2002, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, V(scratch), .def = 7},
     {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, V(counter), .def = 0},
 };
