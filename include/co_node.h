@@ -129,6 +129,19 @@ struct co_node {
 };
 
 /*
+ * The node's config. An MCU image of one product may fix it at build time
+ * (-DCO_FIXED_CFG=<config symbol>): every flag and hook of the config is
+ * then a constant to the compiler, which drops the code that product never
+ * runs. co_node_init() must then be given that same config.
+ */
+#ifdef CO_FIXED_CFG
+extern const co_node_cfg_t CO_FIXED_CFG;
+#define co_cfg(node) ((void)(node), &CO_FIXED_CFG)
+#else
+#define co_cfg(node) ((node)->cfg)
+#endif
+
+/*
  * Prepare a node; nothing is sent. cfg, port, app and the ram structs are
  * owned by the caller and must outlive the node. ram has CO_CLS_COUNT
  * entries (NULL where cfg->ram_size is 0).

@@ -77,5 +77,7 @@ co_res_t jd_read_slope(co_node_t *n, const co_od_entry_t *e, uint32_t *v);
 co_res_t jd_read_sensor(co_node_t *n, const co_od_entry_t *e, uint32_t *v);
 
 extern const product_t jd1xxx, jd2xxx;
+/* Node configs (dictionary and hooks) of the two models. */
+extern const co_node_cfg_t jd1_cfg, jd2_cfg;
 
 #endif /* JD_H */

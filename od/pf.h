@@ -63,5 +63,7 @@ typedef struct pf_variant {
 } pf_variant_t;
 
 extern const product_t pf_inx360d, pf_iny360d;
+/* Node configs (dictionary and hooks) of the two models. */
+extern const co_node_cfg_t pf_inx_cfg, pf_iny_cfg;
 
 #endif /* PF_H */

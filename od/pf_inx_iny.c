@@ -92,25 +92,25 @@ static const co_service_t *const pf_services[] = {&co_guard_service, &co_rtr_ser
      .ram_size = {0, 0, sizeof(pf_para_t), sizeof(co_lss_para_t)},                   \
      .default_node_id = 1, .default_bitrate = PF_BR_250K, .tpdo_dlc = 0,             \
      .autosave = true /* G2 */, .load_keeps_lss = true /* G2, R51 */}
-static const co_node_cfg_t inx_cfg = PF_CFG(&inx_od);
-static const co_node_cfg_t iny_cfg = PF_CFG(&iny_od);
+const co_node_cfg_t pf_inx_cfg = PF_CFG(&inx_od);
+const co_node_cfg_t pf_iny_cfg = PF_CFG(&iny_od);
 
 #define PF_EDS_BITRATES (PRODUCT_BR_125K | PRODUCT_BR_250K | PRODUCT_BR_500K | PRODUCT_BR_1000K)
 
-static const pf_variant_t v_inx = {.cfg = &inx_cfg, .axes = 1};
-static const pf_variant_t v_iny = {.cfg = &iny_cfg, .axes = 2};
+static const pf_variant_t v_inx = {.cfg = &pf_inx_cfg, .axes = 1};
+static const pf_variant_t v_iny = {.cfg = &pf_iny_cfg, .axes = 2};
 
 const product_t pf_inx360d = {
     .id = "inx360d", .summary = "Pepperl+Fuchs INX360D single axis 0..359.9 deg (CiA 410)",
     .inputs = {{"x", "deg", 0, 3600}},
     .faults = {"range-x", "range-y", "undervoltage", NULL},
     .nodes = 1, .inst_size = sizeof(pf_dev_t), .create = pf_create, .sample = pf_sample,
-    .variant = &v_inx, .cfg = &inx_cfg, .vendor = "Pepperl+Fuchs", .bitrates = PF_EDS_BITRATES,
+    .variant = &v_inx, .cfg = &pf_inx_cfg, .vendor = "Pepperl+Fuchs", .bitrates = PF_EDS_BITRATES,
     .kbps = product_kbps_pf};
 const product_t pf_iny360d = {
     .id = "iny360d", .summary = "Pepperl+Fuchs INY360D dual axis 0..359.9 deg (CiA 410)",
     .inputs = {{"x", "deg", 0, 3600}, {"y", "deg", 0, 3600}},
     .faults = {"range-x", "range-y", "undervoltage", NULL},
     .nodes = 1, .inst_size = sizeof(pf_dev_t), .create = pf_create, .sample = pf_sample,
-    .variant = &v_iny, .cfg = &iny_cfg, .vendor = "Pepperl+Fuchs", .bitrates = PF_EDS_BITRATES,
+    .variant = &v_iny, .cfg = &pf_iny_cfg, .vendor = "Pepperl+Fuchs", .bitrates = PF_EDS_BITRATES,
     .kbps = product_kbps_pf};

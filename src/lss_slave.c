@@ -138,8 +138,8 @@ static void store(co_node_t *node)
     co_lss_t *l = &node->lss;
     uint8_t err = 0;
     uint8_t id = l->pending_id != 0u ? l->pending_id : node->node_id;
-    if (node->cfg->ops != NULL && node->cfg->ops->lss_store != NULL) {
-        err = node->cfg->ops->lss_store(node, id, l->pending_br);
+    if (co_cfg(node)->ops != NULL && co_cfg(node)->ops->lss_store != NULL) {
+        err = co_cfg(node)->ops->lss_store(node, id, l->pending_br);
     } else {
         co_lss_para_t *p = node->ram[CO_CLS_LSS];
         if (p == NULL) {
@@ -161,7 +161,7 @@ bool co_lss_receive(co_node_t *node, const co_frame_t *f)
     if (f->id != 0x7E5u || f->rtr) {
         return false;
     }
-    if (f->dlc != 8u || !node->cfg->lss) {
+    if (f->dlc != 8u || !co_cfg(node)->lss) {
         return true;
     }
     co_lss_t *l = &node->lss;
@@ -222,7 +222,7 @@ bool co_lss_receive(co_node_t *node, const co_frame_t *f)
         break;
     }
     case CS_CONFIG_BIT_TIMING: {
-        bool ok = d[1] == 0u && d[2] < 16u && ((node->cfg->lss_bitrates >> d[2]) & 1u) != 0u;
+        bool ok = d[1] == 0u && d[2] < 16u && ((co_cfg(node)->lss_bitrates >> d[2]) & 1u) != 0u;
         if (ok) {
             l->pending_br = d[2];
         }

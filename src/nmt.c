@@ -25,8 +25,8 @@ void co_nmt_enter(co_node_t *node, co_nmt_state_t state)
     } else if (old == CO_NMT_OPERATIONAL) {
         co_tpdo_stop(node);
     }
-    if (node->cfg->ops != NULL && node->cfg->ops->state != NULL) {
-        node->cfg->ops->state(node, (co_nmt_state_t)old);
+    if (co_cfg(node)->ops != NULL && co_cfg(node)->ops->state != NULL) {
+        co_cfg(node)->ops->state(node, (co_nmt_state_t)old);
     }
 }
 

@@ -25,7 +25,7 @@ void co_node_init(co_node_t *node, const co_node_cfg_t *cfg, void *port, void *a
 
 const co_od_entry_t *co_node_entry(const co_node_t *node, uint16_t index, uint8_t sub)
 {
-    return co_od_find(node->cfg->od, index, sub, NULL);
+    return co_od_find(co_cfg(node)->od, index, sub, NULL);
 }
 
 bool co_node_send(co_node_t *node, const co_frame_t *f)
@@ -50,27 +50,27 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
     } else {
         co_od_defaults(node, CO_CLS_VOL, 0x1000, 0x1FFF);
         (void)co_store_restore(node, CO_CLS_PARA, 0x1000, 0x1FFF);
-        if (node->cfg->comm_reset_applies_id) {
+        if (co_cfg(node)->comm_reset_applies_id) {
             (void)co_store_restore(node, CO_CLS_LSS, 0x0000, 0xFFFF);
         }
     }
     const co_lss_para_t *lss = node->ram[CO_CLS_LSS];
-    if (kind == CO_RESET_NODE || node->cfg->comm_reset_applies_id) {
+    if (kind == CO_RESET_NODE || co_cfg(node)->comm_reset_applies_id) {
         bool id_ok = lss != NULL && lss->node_id >= 1u && lss->node_id <= 127u;
-        node->node_id = id_ok ? lss->node_id : node->cfg->default_node_id;
-        node->bitrate = lss != NULL ? lss->bitrate : node->cfg->default_bitrate;
+        node->node_id = id_ok ? lss->node_id : co_cfg(node)->default_node_id;
+        node->bitrate = lss != NULL ? lss->bitrate : co_cfg(node)->default_bitrate;
     }
     co_sdo_init(&node->sdo);
     node->autostart = false;
-    if (node->cfg->ops != NULL && node->cfg->ops->reset != NULL) {
-        node->cfg->ops->reset(node, kind); /* may set the node-ID from its own objects */
+    if (co_cfg(node)->ops != NULL && co_cfg(node)->ops->reset != NULL) {
+        co_cfg(node)->ops->reset(node, kind); /* may set the node-ID from its own objects */
     }
     if (node->lss.pending_id != 0u) {
         /* CiA 305: an LSS-configured node-ID is active from reset communication on. */
         node->node_id = node->lss.pending_id;
         node->lss.pending_id = 0;
     }
-    for (const co_service_t *const *sv = node->cfg->services; sv != NULL && *sv != NULL; sv++) {
+    for (const co_service_t *const *sv = co_cfg(node)->services; sv != NULL && *sv != NULL; sv++) {
         if ((*sv)->reset != NULL) {
             (*sv)->reset(node);
         }
@@ -100,7 +100,7 @@ void co_node_start(co_node_t *node, uint32_t now)
 /* Offer f to the optional services of the given kind (always or not). */
 static bool services_receive(co_node_t *node, const co_frame_t *f, bool always)
 {
-    for (const co_service_t *const *sv = node->cfg->services; sv != NULL && *sv != NULL; sv++) {
+    for (const co_service_t *const *sv = co_cfg(node)->services; sv != NULL && *sv != NULL; sv++) {
         if ((*sv)->always == always && (*sv)->receive != NULL && (*sv)->receive(node, f)) {
             return true;
         }
@@ -144,13 +144,13 @@ uint32_t co_node_poll(co_node_t *node, uint32_t now)
     }
     uint32_t next = co_sdo_poll(node, now);
     next = co_min_u32(next, co_hb_poll(node, now));
-    for (const co_service_t *const *sv = node->cfg->services; sv != NULL && *sv != NULL; sv++) {
+    for (const co_service_t *const *sv = co_cfg(node)->services; sv != NULL && *sv != NULL; sv++) {
         if ((*sv)->poll != NULL) {
             next = co_min_u32(next, (*sv)->poll(node, now));
         }
     }
-    if (node->cfg->ops != NULL && node->cfg->ops->poll != NULL) {
-        next = co_min_u32(next, node->cfg->ops->poll(node, now));
+    if (co_cfg(node)->ops != NULL && co_cfg(node)->ops->poll != NULL) {
+        next = co_min_u32(next, co_cfg(node)->ops->poll(node, now));
     }
     next = co_min_u32(next, co_tpdo_poll(node, now));
     /* Nothing can fall due before next unless something happens first.
@@ -168,8 +168,8 @@ void co_node_set_can_state(co_node_t *node, co_can_state_t s)
     }
     node->can_state = (uint8_t)s;
     co_node_wake(node);
-    if (node->cfg->ops != NULL && node->cfg->ops->can_state != NULL) {
-        node->cfg->ops->can_state(node, old);
+    if (co_cfg(node)->ops != NULL && co_cfg(node)->ops->can_state != NULL) {
+        co_cfg(node)->ops->can_state(node, old);
     }
 }
 
@@ -204,8 +204,8 @@ void co_node_led_patterns(co_node_t *node, co_led_pattern_t *green, co_led_patte
         r = CO_LED_OFF;
         break;
     }
-    if (node->cfg->ops != NULL && node->cfg->ops->leds != NULL) {
-        node->cfg->ops->leds(node, &g, &r);
+    if (co_cfg(node)->ops != NULL && co_cfg(node)->ops->leds != NULL) {
+        co_cfg(node)->ops->leds(node, &g, &r);
     }
     *green = g;
     *red = r;
@@ -236,7 +236,7 @@ void co_node_leds(co_node_t *node, uint32_t now, bool *green, bool *red, uint32_
     co_led_pattern_t g;
     co_led_pattern_t r;
     co_node_led_patterns(node, &g, &r);
-    const co_led_timing_t *t = node->cfg->led != NULL ? node->cfg->led : &co_led_cia303;
+    const co_led_timing_t *t = co_cfg(node)->led != NULL ? co_cfg(node)->led : &co_led_cia303;
     uint32_t ng;
     uint32_t nr;
     *green = co_led_level(g, t, now, &ng);

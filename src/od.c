@@ -239,7 +239,7 @@ co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf
         write = x->write;
     }
     co_res_t r = write != NULL ? write(node, e, v) : co_od_store(node, e, v);
-    if (r == CO_OK && node->cfg->autosave && (e->cls == CO_CLS_PARA || e->cls == CO_CLS_LSS)) {
+    if (r == CO_OK && co_cfg(node)->autosave && (e->cls == CO_CLS_PARA || e->cls == CO_CLS_LSS)) {
         r = co_store_save(node, (co_cls_t)e->cls); /* the product stores every change */
     }
     return r;
@@ -247,7 +247,7 @@ co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf
 
 void co_od_defaults(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)
 {
-    const co_od_t *od = node->cfg->od;
+    const co_od_t *od = co_cfg(node)->od;
     for (uint16_t i = 0; i < od->count; i++) {
         const co_od_entry_t *e = &od->entries[i];
         uint8_t *p = ram_of(node, e);

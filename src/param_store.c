@@ -40,7 +40,7 @@ uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls)
      * Size and offset hash as 16-bit numbers (high bytes 0), as when the
      * entries held them so: sets stored by older firmware stay valid. */
     uint32_t h = 2166136261u;
-    const co_od_t *od = node->cfg->od;
+    const co_od_t *od = co_cfg(node)->od;
     for (uint16_t i = 0; i < od->count; i++) {
         const co_od_entry_t *e = &od->entries[i];
         if (e->cls != cls) {
@@ -51,7 +51,7 @@ uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls)
             h = (h ^ k[j]) * 16777619u;
         }
     }
-    return h ^ node->cfg->ram_size[cls];
+    return h ^ co_cfg(node)->ram_size[cls];
 }
 
 static uint32_t slot_addr(const co_node_t *node, co_cls_t cls, unsigned copy)
@@ -62,7 +62,7 @@ static uint32_t slot_addr(const co_node_t *node, co_cls_t cls, unsigned copy)
 
 static bool stored_class(const co_node_t *node, co_cls_t cls)
 {
-    return (cls == CO_CLS_PARA || cls == CO_CLS_LSS) && node->cfg->ram_size[cls] != 0u &&
+    return (cls == CO_CLS_PARA || cls == CO_CLS_LSS) && co_cfg(node)->ram_size[cls] != 0u &&
            node->ram[cls] != NULL;
 }
 
@@ -85,7 +85,7 @@ static slot_info_t check_slot(co_node_t *node, co_cls_t cls, unsigned copy, bool
     s.len = co_get_u16(&h[16]);
     s.flags = h[18];
     bool defaults = (s.flags & FLAG_DEFAULTS) != 0u;
-    uint32_t want = defaults ? 0u : node->cfg->ram_size[cls];
+    uint32_t want = defaults ? 0u : co_cfg(node)->ram_size[cls];
     if (h[19] != (uint8_t)cls || s.len != want ||
         co_get_u32(&h[4]) != co_store_layout_hash(node, cls)) {
         return s;
@@ -141,8 +141,8 @@ static void set_defaults(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi
     co_od_defaults(node, cls, lo, hi);
     if (cls == CO_CLS_LSS) {
         co_lss_para_t *l = node->ram[CO_CLS_LSS];
-        l->node_id = node->cfg->default_node_id;
-        l->bitrate = node->cfg->default_bitrate;
+        l->node_id = co_cfg(node)->default_node_id;
+        l->bitrate = co_cfg(node)->default_bitrate;
     }
 }
 
@@ -179,7 +179,7 @@ co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, u
         node->store.status[cls] = (uint8_t)st;
         return st;
     }
-    const co_od_t *od = node->cfg->od;
+    const co_od_t *od = co_cfg(node)->od;
     for (uint16_t i = 0; i < od->count; i++) {
         const co_od_entry_t *e = &od->entries[i];
         if (e->cls == cls && e->index >= lo && e->index <= hi) {
@@ -197,7 +197,7 @@ co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, u
 
 bool co_store_limit_reached(const co_node_t *node)
 {
-    uint32_t lim = node->cfg->store_write_limit;
+    uint32_t lim = co_cfg(node)->store_write_limit;
     return lim != 0u && node->store.writes >= lim;
 }
 
@@ -218,7 +218,7 @@ static bool record_chunk(co_node_t *node, co_cls_t cls, const group_t *g, uint32
     if (g == NULL) {
         return true;
     }
-    const co_od_t *od = node->cfg->od;
+    const co_od_t *od = co_cfg(node)->od;
     for (uint16_t i = 0; i < od->count; i++) {
         const co_od_entry_t *e = &od->entries[i];
         if (e->cls != cls || e->off + e->size <= at || e->off >= at + n) {
@@ -261,7 +261,7 @@ static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags, group
     int k = newest(s);
     unsigned target = (k == 0) ? 1u : 0u;
     uint32_t seq = (k < 0) ? 1u : s[k].seq + 1u;
-    uint32_t len = (flags & FLAG_DEFAULTS) != 0u ? 0u : node->cfg->ram_size[cls];
+    uint32_t len = (flags & FLAG_DEFAULTS) != 0u ? 0u : co_cfg(node)->ram_size[cls];
     if (g != NULL) {
         g->from = (k >= 0 && (s[k].flags & FLAG_DEFAULTS) == 0u) ? k : -1;
     }
@@ -342,8 +342,8 @@ static bool same_as_stored(co_node_t *node, co_cls_t cls)
 
 static void notify(co_node_t *node, uint32_t sig)
 {
-    if (node->cfg->ops != NULL && node->cfg->ops->stored != NULL) {
-        node->cfg->ops->stored(node, sig);
+    if (co_cfg(node)->ops != NULL && co_cfg(node)->ops->stored != NULL) {
+        co_cfg(node)->ops->stored(node, sig);
     }
 }
 
@@ -356,7 +356,7 @@ static const uint16_t group_hi[5] = {0, 0, 0x1FFF, 0x9FFF, 0x5FFF};
 static co_res_t group_op(co_node_t *node, uint8_t sub, bool defaults)
 {
     co_res_t r = co_store_save_group(node, CO_CLS_PARA, group_lo[sub], group_hi[sub], defaults);
-    if (r == CO_OK && node->cfg->save_includes_lss && stored_class(node, CO_CLS_LSS)) {
+    if (r == CO_OK && co_cfg(node)->save_includes_lss && stored_class(node, CO_CLS_LSS)) {
         r = co_store_save_group(node, CO_CLS_LSS, group_lo[sub], group_hi[sub], defaults);
     }
     return r;
@@ -371,7 +371,7 @@ co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
     /* "Save all parameters"; the LSS set too where the product keeps
      * node-ID and bit rate among the saved parameters. */
     co_res_t r = co_store_save(node, CO_CLS_PARA);
-    if (r == CO_OK && node->cfg->save_includes_lss && stored_class(node, CO_CLS_LSS) &&
+    if (r == CO_OK && co_cfg(node)->save_includes_lss && stored_class(node, CO_CLS_LSS) &&
         !same_as_stored(node, CO_CLS_LSS)) {
         r = co_store_save(node, CO_CLS_LSS); /* unchanged: no write cycle spent */
     }
@@ -388,7 +388,7 @@ co_res_t co_store_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
         return CO_E_STORE;
     }
     co_res_t r = co_store_request_defaults(node, CO_CLS_PARA);
-    if (r == CO_OK && stored_class(node, CO_CLS_LSS) && !node->cfg->load_keeps_lss) {
+    if (r == CO_OK && stored_class(node, CO_CLS_LSS) && !co_cfg(node)->load_keeps_lss) {
         r = co_store_request_defaults(node, CO_CLS_LSS);
     }
     if (r == CO_OK) {

@@ -54,7 +54,7 @@ void co_sdo_restart(co_sdo_t *sdo)
 const co_od_entry_t *co_sdo_find(co_node_t *node, const uint8_t *d)
 {
     co_res_t r;
-    const co_od_entry_t *e = co_od_find(node->cfg->od, co_get_u16(&d[1]), d[3], &r);
+    const co_od_entry_t *e = co_od_find(co_cfg(node)->od, co_get_u16(&d[1]), d[3], &r);
     if (e == NULL) {
         co_sdo_abort(node, d, r);
     }
@@ -247,8 +247,8 @@ bool co_sdo_receive(co_node_t *node, const co_frame_t *f)
         sdo->state = SDO_IDLE; /* the client gave up; no answer */
         return true;
     }
-    if (sdo->state >= SDO_BLK_DL && node->cfg->sdo_block != NULL) {
-        (void)node->cfg->sdo_block(node, d); /* a block transfer in progress */
+    if (sdo->state >= SDO_BLK_DL && co_cfg(node)->sdo_block != NULL) {
+        (void)co_cfg(node)->sdo_block(node, d); /* a block transfer in progress */
         return true;
     }
     switch (d[0] >> 5) {
@@ -276,7 +276,7 @@ bool co_sdo_receive(co_node_t *node, const co_frame_t *f)
     case CCS_BLOCK_DOWNLOAD:
     case CCS_BLOCK_UPLOAD:
         /* Offered where the product links it; otherwise not a valid command. */
-        if (node->cfg->sdo_block == NULL || !node->cfg->sdo_block(node, d)) {
+        if (co_cfg(node)->sdo_block == NULL || !co_cfg(node)->sdo_block(node, d)) {
             co_sdo_abort(node, d, CO_E_CMD);
         }
         break;

@@ -45,7 +45,7 @@ static void start_one(co_node_t *node, co_tpdo_t *t)
 static co_res_t resolve_map(co_node_t *node, uint32_t m, const co_od_entry_t **e, uint8_t *bytes)
 {
     co_res_t r;
-    *e = co_od_find(node->cfg->od, (uint16_t)(m >> 16), (uint8_t)(m >> 8), &r);
+    *e = co_od_find(co_cfg(node)->od, (uint16_t)(m >> 16), (uint8_t)(m >> 8), &r);
     uint32_t bits = m & 0xFFu;
     if (*e == NULL) {
         return CO_E_NO_OBJ;
@@ -217,14 +217,14 @@ static inline void build_mapped(co_node_t *node, unsigned n, co_frame_t *f)
     }
     co_put_u32(&f->data[0], (uint32_t)data);
     co_put_u32(&f->data[4], (uint32_t)(data >> 32));
-    f->dlc = node->cfg->tpdo_dlc != 0u ? node->cfg->tpdo_dlc : t->len;
+    f->dlc = co_cfg(node)->tpdo_dlc != 0u ? co_cfg(node)->tpdo_dlc : t->len;
 }
 
 void co_tpdo_build(co_node_t *node, unsigned n, co_frame_t *f)
 {
     build_mapped(node, n, f);
-    if (node->cfg->ops != NULL && node->cfg->ops->tpdo_fill != NULL) {
-        node->cfg->ops->tpdo_fill(node, n, f);
+    if (co_cfg(node)->ops != NULL && co_cfg(node)->ops->tpdo_fill != NULL) {
+        co_cfg(node)->ops->tpdo_fill(node, n, f);
     }
 }
 
@@ -324,7 +324,7 @@ void co_tpdo_event(co_node_t *node, unsigned n)
 
 static uint32_t inhibit_us(const co_node_t *node, const co_tpdo_t *t)
 {
-    uint32_t unit = node->cfg->inhibit_unit_us != 0u ? node->cfg->inhibit_unit_us : 100u;
+    uint32_t unit = co_cfg(node)->inhibit_unit_us != 0u ? co_cfg(node)->inhibit_unit_us : 100u;
     return (uint32_t)t->inhibit * unit;
 }
 

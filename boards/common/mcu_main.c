@@ -39,6 +39,15 @@ int main(void)
         }
     }
     p->create(p, mem, ports, nodes);
+#ifdef CO_FIXED_CFG
+    for (unsigned i = 0; i < p->nodes; i++) {
+        if (nodes[i]->cfg != &CO_FIXED_CFG) { /* the build paired it with another config */
+            for (;;) {
+                board_leds(false, true);
+            }
+        }
+    }
+#endif
     board_sensor(p, values, &faults);
     p->sample(mem, values, faults);
     uint32_t now = board_now_us();
