@@ -83,8 +83,10 @@ typedef struct co_node_cfg {
     const co_node_ops_t *ops;
     const co_led_timing_t *led;
     const co_service_t *const *services; /* optional services, NULL-ended (may be NULL) */
-    /* SDO block transfer (co_sdo_block, in sdo_block.c), or NULL: not offered. */
-    bool (*sdo_block)(co_node_t *node, const uint8_t *d);
+    /* SDO segmented (co_sdo_segmented) and block (co_sdo_block) transfer,
+     * or NULL: not offered, such requests are aborted with 0x05040001. */
+    co_sdo_proto_fn sdo_segmented;
+    co_sdo_proto_fn sdo_block;
     uint16_t ram_size[CO_CLS_COUNT]; /* sizeof each class struct (0: none) */
     uint8_t default_node_id;
     uint8_t default_bitrate;    /* product's code for its default bit rate */

@@ -1,6 +1,6 @@
 /*
- * co_sdo.h - SDO server (CiA 301 7.2.4): expedited, segmented and block
- * upload and download (block: CRC-16-CCITT when the client wants it; one
+ * co_sdo.h - SDO server (CiA 301 7.2.4): expedited, and where the product
+ * links them segmented and block upload and download (block: CRC-16-CCITT when the client wants it; one
  * block carries any object, the protocol-switch threshold is not used),
  * toggle and sequence checks, timeout, abort codes from co_res_t.
  */
@@ -33,6 +33,14 @@ typedef struct co_sdo {
     uint32_t blk_start; /* block upload: byte position of the current block */
     uint8_t buf[CO_SDO_BUF];
 } co_sdo_t;
+
+/* An optional SDO protocol: handles the request d, or returns false when
+ * it is none of its own (the server then aborts with 0x05040001). */
+typedef bool (*co_sdo_proto_fn)(co_node_t *node, const uint8_t *d);
+
+/* SDO segmented transfer (sdo_segment.c): set as co_node_cfg_t.sdo_segmented
+ * to offer it. Needed by any product with an object of more than 4 bytes. */
+bool co_sdo_segmented(co_node_t *node, const uint8_t *d);
 
 /* SDO block transfer (sdo_block.c): set as co_node_cfg_t.sdo_block to offer it. */
 bool co_sdo_block(co_node_t *node, const uint8_t *d);

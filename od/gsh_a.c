@@ -75,7 +75,8 @@ _Static_assert(sizeof(gsh_para_t) <= CO_STORE_MAX_DATA, "PARA set must fit one s
 _Static_assert(sizeof(gsh_dev_t) <= PRODUCT_INST_MAX, "instance must fit PRODUCT_INST_MAX");
 
 #define GSH_CFG(odp, id)                                                             \
-    {.od = (odp), .ops = &gsh_ops, .led = NULL, .sdo_block = co_sdo_block,             \
+    {.od = (odp), .ops = &gsh_ops, .led = NULL,                                        \
+     .sdo_segmented = co_sdo_segmented, .sdo_block = co_sdo_block,                     \
      .ram_size = {0, 0, sizeof(gsh_para_t), sizeof(co_lss_para_t)},                    \
      .default_node_id = (id), .default_bitrate = 3, .tpdo_dlc = 8,                     \
      .store_write_limit = 100000u /* L308 */, .save_includes_lss = true /* C-21 */,    \

@@ -88,7 +88,8 @@ static const co_service_t *const pf_services[] = {&co_guard_service, &co_rtr_ser
 
 #define PF_CFG(odp)                                                                 \
     {.od = (odp), .ops = &pf_ops, .led = NULL /* CiA 303-3 timing (1.1) */,        \
-     .services = pf_services, .sdo_block = co_sdo_block,                             \
+     .services = pf_services,                                                        \
+     .sdo_segmented = co_sdo_segmented, .sdo_block = co_sdo_block,                   \
      .ram_size = {0, 0, sizeof(pf_para_t), sizeof(co_lss_para_t)},                   \
      .default_node_id = 1, .default_bitrate = PF_BR_250K, .tpdo_dlc = 0,             \
      .autosave = true /* G2 */, .load_keeps_lss = true /* G2, R51 */}

@@ -1,5 +1,7 @@
 /*
- * sdo_server.c - SDO server, expedited and segmented. See co_sdo.h.
+ * sdo_server.c - SDO server: expedited transfer, the dispatch to the
+ * optional segmented (sdo_segment.c) and block (sdo_block.c) protocols,
+ * their timeout. See co_sdo.h.
  */
 #include "co_sdo.h"
 
@@ -7,8 +9,6 @@
 
 #include "co_node.h"
 #include "sdo_internal.h"
-
-
 
 void co_sdo_init(co_sdo_t *sdo)
 {
@@ -85,150 +85,63 @@ const co_od_entry_t *co_sdo_download_target(co_node_t *node, const uint8_t *d, b
     return e;
 }
 
-static void initiate_download(co_node_t *node, const uint8_t *d)
+static void download_expedited(co_node_t *node, const uint8_t *d)
 {
-    co_sdo_t *sdo = &node->sdo;
-    bool expedited = (d[0] & 0x02u) != 0u;
-    bool sized = (d[0] & 0x01u) != 0u;
-    if (expedited) {
-        const co_od_entry_t *e = co_sdo_find(node, d);
-        if (e == NULL) {
-            return;
-        }
-        if ((e->attr & CO_A_W) == 0u) {
-            co_sdo_abort(node, d, CO_E_RO);
-            return;
-        }
-        /* Size not indicated (0x22): the object's own size, at most 4. */
-        uint32_t len = sized ? 4u - ((d[0] >> 2) & 0x03u) : co_min_u32(co_od_size(e), 4u);
-        co_res_t r = co_od_write(node, e, &d[4], len);
-        if (r != CO_OK) {
-            co_sdo_abort(node, d, r);
-        } else {
-            co_sdo_reply_head(node, 0x60, d, 0);
-        }
-        return;
-    }
-    const co_od_entry_t *e = co_sdo_download_target(node, d, sized);
-    if (e == NULL) {
-        return;
-    }
-    sdo->state = SDO_DOWNLOAD;
-    sdo->e = e;
-    sdo->size = co_od_size(e);
-    sdo->pos = 0;
-    sdo->toggle = 0;
-    co_sdo_restart(sdo);
-    co_sdo_reply_head(node, 0x60, d, 0);
-}
-
-static void download_segment(co_node_t *node, const uint8_t *d)
-{
-    co_sdo_t *sdo = &node->sdo;
-    uint8_t mux[4];
-    co_sdo_mux(sdo, mux);
-    if ((d[0] & 0x10u) != sdo->toggle) {
-        co_sdo_abort(node, mux, CO_E_TOGGLE);
-        return;
-    }
-    uint32_t n = 7u - ((d[0] >> 1) & 0x07u);
-    if (sdo->pos + n > sdo->size) {
-        co_sdo_abort(node, mux, CO_E_LEN_HIGH);
-        return;
-    }
-    memcpy(&sdo->buf[sdo->pos], &d[1], n);
-    sdo->pos += n;
-    uint8_t ack[8] = {(uint8_t)(0x20u | sdo->toggle), 0, 0, 0, 0, 0, 0, 0};
-    sdo->toggle ^= 0x10u;
-    if ((d[0] & 0x01u) == 0u) { /* more segments follow */
-        co_sdo_restart(sdo);
-        co_sdo_reply(node, ack);
-        return;
-    }
-    sdo->state = SDO_IDLE;
-    if (sdo->pos != sdo->size) {
-        co_sdo_abort(node, mux, sdo->pos < sdo->size ? CO_E_LEN_LOW : CO_E_LEN_HIGH);
-        return;
-    }
-    co_res_t r = co_od_write(node, sdo->e, sdo->buf, sdo->pos);
-    if (r != CO_OK) {
-        co_sdo_abort(node, mux, r);
-        return;
-    }
-    co_sdo_reply(node, ack);
-}
-
-static void initiate_upload(co_node_t *node, const uint8_t *d)
-{
-    co_sdo_t *sdo = &node->sdo;
     const co_od_entry_t *e = co_sdo_find(node, d);
     if (e == NULL) {
         return;
     }
-    uint32_t size = co_od_size(e);
-    if (size <= 4u && e->type != CO_T_VSTR) {
-        /* A number: expedited, size indicated (0x4F / 0x4B / 0x47 / 0x43). */
-        uint32_t v;
-        co_res_t r = (e->attr & CO_A_R) == 0u ? CO_E_WO : co_od_get(node, e, &v);
-        if (r != CO_OK) {
-            co_sdo_abort(node, d, r);
-            return;
-        }
-        if (size < 4u) {
-            v &= (1u << (8u * size)) - 1u; /* only the object's own bytes */
-        }
-        co_sdo_reply_head(node, (uint8_t)(0x43u | ((4u - size) << 2)), d, v);
+    if ((e->attr & CO_A_W) == 0u) {
+        co_sdo_abort(node, d, CO_E_RO);
         return;
     }
-    uint8_t out[8] = {0, d[1], d[2], d[3], 0, 0, 0, 0};
-    uint32_t len;
-    co_res_t r = co_od_read(node, e, 0, &out[4], 4, &len);
+    /* Size not indicated (0x22): the object's own size, at most 4. */
+    uint32_t len = (d[0] & 0x01u) != 0u ? 4u - ((d[0] >> 2) & 0x03u)
+                                         : co_min_u32(co_od_size(e), 4u);
+    co_res_t r = co_od_write(node, e, &d[4], len);
     if (r != CO_OK) {
         co_sdo_abort(node, d, r);
-        return;
-    }
-    if (size <= 4u) {
-        out[0] = (uint8_t)(0x43u | ((4u - size) << 2)); /* a short string */
-        co_sdo_reply(node, out);
-        return;
-    }
-    sdo->state = SDO_UPLOAD;
-    sdo->e = e;
-    sdo->size = size;
-    sdo->pos = 0;
-    sdo->toggle = 0;
-    co_sdo_restart(sdo);
-    co_sdo_reply_head(node, 0x41, d, size);
-}
-
-static void upload_segment(co_node_t *node, const uint8_t *d)
-{
-    co_sdo_t *sdo = &node->sdo;
-    uint8_t mux[4];
-    co_sdo_mux(sdo, mux);
-    if ((d[0] & 0x10u) != sdo->toggle) {
-        co_sdo_abort(node, mux, CO_E_TOGGLE);
-        return;
-    }
-    uint8_t out[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-    uint32_t n;
-    co_res_t r = co_od_read(node, sdo->e, sdo->pos, &out[1], 7, &n);
-    if (r != CO_OK) {
-        co_sdo_abort(node, mux, r);
-        return;
-    }
-    sdo->pos += n;
-    bool last = sdo->pos >= sdo->size;
-    out[0] = (uint8_t)(sdo->toggle | ((7u - n) << 1) | (last ? 1u : 0u));
-    sdo->toggle ^= 0x10u;
-    if (last) {
-        sdo->state = SDO_IDLE;
     } else {
-        co_sdo_restart(sdo);
+        co_sdo_reply_head(node, 0x60, d, 0);
     }
-    co_sdo_reply(node, out);
 }
 
+/* An upload; false when the object needs the segmented protocol. */
+static bool upload_expedited(co_node_t *node, const uint8_t *d, const co_od_entry_t *e)
+{
+    uint32_t size = co_od_size(e);
+    if (size > 4u) {
+        return false;
+    }
+    uint32_t v = 0;
+    co_res_t r;
+    if (e->type == CO_T_VSTR) { /* a short string */
+        uint8_t b[4] = {0, 0, 0, 0};
+        uint32_t len;
+        r = co_od_read(node, e, 0, b, 4, &len);
+        v = co_get_u32(b);
+    } else {
+        r = (e->attr & CO_A_R) == 0u ? CO_E_WO : co_od_get(node, e, &v);
+    }
+    if (r != CO_OK) {
+        co_sdo_abort(node, d, r);
+        return true;
+    }
+    if (size < 4u) {
+        v &= (1u << (8u * size)) - 1u; /* only the object's own bytes */
+    }
+    /* Expedited, size indicated (0x4F / 0x4B / 0x47 / 0x43). */
+    co_sdo_reply_head(node, (uint8_t)(0x43u | ((4u - size) << 2)), d, v);
+    return true;
+}
+
+/* The optional protocols (segmented, block) where the product links them. */
+static void optional(co_node_t *node, const uint8_t *d, co_sdo_proto_fn proto)
+{
+    if (proto == NULL || !proto(node, d)) {
+        co_sdo_abort(node, d, CO_E_CMD);
+    }
+}
 
 bool co_sdo_receive(co_node_t *node, const co_frame_t *f)
 {
@@ -254,31 +167,27 @@ bool co_sdo_receive(co_node_t *node, const co_frame_t *f)
     switch (d[0] >> 5) {
     case CCS_DOWNLOAD_INITIATE:
         sdo->state = SDO_IDLE; /* a new request replaces an unfinished one */
-        initiate_download(node, d);
-        break;
-    case CCS_UPLOAD_INITIATE:
-        sdo->state = SDO_IDLE;
-        initiate_upload(node, d);
-        break;
-    case CCS_DOWNLOAD_SEGMENT:
-    case CCS_UPLOAD_SEGMENT: {
-        /* A segment belongs to the transfer in progress, of the same direction. */
-        bool download = (d[0] >> 5) == CCS_DOWNLOAD_SEGMENT;
-        if (sdo->state != (download ? SDO_DOWNLOAD : SDO_UPLOAD)) {
-            co_sdo_abort(node, d, CO_E_CMD);
-        } else if (download) {
-            download_segment(node, d);
+        if ((d[0] & 0x02u) != 0u) {
+            download_expedited(node, d);
         } else {
-            upload_segment(node, d);
+            optional(node, d, co_cfg(node)->sdo_segmented);
+        }
+        break;
+    case CCS_UPLOAD_INITIATE: {
+        sdo->state = SDO_IDLE;
+        const co_od_entry_t *e = co_sdo_find(node, d);
+        if (e != NULL && !upload_expedited(node, d, e)) {
+            optional(node, d, co_cfg(node)->sdo_segmented);
         }
         break;
     }
+    case CCS_DOWNLOAD_SEGMENT:
+    case CCS_UPLOAD_SEGMENT:
+        optional(node, d, co_cfg(node)->sdo_segmented);
+        break;
     case CCS_BLOCK_DOWNLOAD:
     case CCS_BLOCK_UPLOAD:
-        /* Offered where the product links it; otherwise not a valid command. */
-        if (co_cfg(node)->sdo_block == NULL || !co_cfg(node)->sdo_block(node, d)) {
-            co_sdo_abort(node, d, CO_E_CMD);
-        }
+        optional(node, d, co_cfg(node)->sdo_block);
         break;
     default:
         co_sdo_abort(node, d, CO_E_CMD); /* reserved command specifier */

@@ -422,6 +422,16 @@ static void test_derived_rejections(void)
     SDO(d, "23 14 10 00 FF 00 00 40", "80 14 10 00 30 00 09 06"); /* bit 30 */
     SDO(d, "22 01 20 00 01 00 00 00", "60 01 20 00 00 00 00 00"); /* B-39 */
     SDO(d, "2B 01 20 00 01 00 00 00", "80 01 20 00 12 00 07 06"); /* length high */
+    /* B-33, B-36: expedited transfer only; segmented and block requests
+     * are unsupported command specifiers, and change nothing. */
+    SDO(d, "21 01 20 00 01 00 00 00", "80 01 20 00 01 00 04 05"); /* segmented download */
+    SDO(d, "20 01 20 00 00 00 00 00", "80 01 20 00 01 00 04 05"); /* size not indicated */
+    SDO(d, "00 02 00 00 00 00 00 00", "80 02 00 00 01 00 04 05"); /* a download segment */
+    SDO(d, "60 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05"); /* an upload segment */
+    SDO(d, "C6 01 20 00 01 00 00 00", "80 01 20 00 01 00 04 05"); /* block download */
+    SDO(d, "A4 08 10 00 7F 00 00 00", "80 08 10 00 01 00 04 05"); /* block upload */
+    SDO(d, "40 01 20 00 00 00 00 00", "4F 01 20 00 01 00 00 00"); /* 0x2001 kept */
+    SDO(d, "40 08 10 00 00 00 00 00", "47 08 10 00 47 49 42 00"); /* "GIB" still expedited */
 }
 
 static void test_derived_pdo_coding(void)

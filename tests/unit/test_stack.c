@@ -83,7 +83,7 @@ static const co_service_t *const t_services[] = {&co_guard_service, &co_rtr_serv
 static const co_node_cfg_t t_cfg = {
     .od = &t_od,
     .services = t_services,
-    .sdo_block = co_sdo_block,
+    .sdo_segmented = co_sdo_segmented, .sdo_block = co_sdo_block,
     .ram_size = {0, sizeof(t_vol_t), sizeof(t_para_t), sizeof(co_lss_para_t)},
     .default_node_id = 0x10,
 };
@@ -131,6 +131,10 @@ static void test_od_find(void)
     for (size_t i = 0; product_list[i] != NULL; i++) {
         h_boot(d, product_list[i], false);
         const co_od_t *od = d->node->cfg->od;
+        /* Without segmented transfer every object must fit an expedited one. */
+        for (uint16_t k = 0; k < od->count && d->node->cfg->sdo_segmented == NULL; k++) {
+            CHECK(od->entries[k].size <= 4u);
+        }
         for (uint16_t k = 1; k < od->count; k++) {
             uint32_t a = ((uint32_t)od->entries[k - 1].index << 8) | od->entries[k - 1].sub;
             uint32_t b = ((uint32_t)od->entries[k].index << 8) | od->entries[k].sub;
