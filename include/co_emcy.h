@@ -32,8 +32,14 @@ enum {
     CO_ER_MANUFACTURER = 0x80,
 };
 
+/* Active errors and 0x1003 history depth a node has room for (at least 1);
+ * an MCU image may set less (boards/CMakeLists.txt). */
+#ifndef CO_EMCY_ACTIVE_MAX
 #define CO_EMCY_ACTIVE_MAX 8u
+#endif
+#ifndef CO_EMCY_HIST_MAX
 #define CO_EMCY_HIST_MAX 8u
+#endif
 
 typedef struct co_emcy {
     uint8_t nactive;

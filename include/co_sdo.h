@@ -14,7 +14,9 @@ typedef struct co_node co_node_t;
 
 /* Largest object a segmented or block download can write, or a block
  * upload can read (bytes); the RAM cost of the SDO server is about this. */
-#define CO_SDO_BUF 64u
+#ifndef CO_SDO_BUF
+#define CO_SDO_BUF 64u /* an MCU image may set less (boards/CMakeLists.txt) */
+#endif
 /* Default SDO timeout between segments (CiA 301 leaves it to the device). */
 #define CO_SDO_TIMEOUT_US 1000000u
 

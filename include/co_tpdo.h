@@ -4,7 +4,8 @@
  * Communication parameters (0x1800 + n) and mapping (0x1A00 + n) are read
  * from the dictionary when a TPDO is configured (reset, or a write through
  * one of the hooks below) and cached here, with the mapped entries
- * resolved to table pointers so that sending is a straight copy.
+ * resolved to their positions in the table so that sending is a straight
+ * copy (a mappable entry must be among a table's first 256).
  *
  * Transmission types:
  *   0        acyclic synchronous: at a SYNC, if the data changed since the
@@ -25,7 +26,11 @@
 #include "co_common.h"
 #include "co_od.h"
 
+/* TPDOs a node has room for (0x1800 + n for n below it). An MCU image of
+ * one product may set fewer (boards/CMakeLists.txt, CO_MCU_SIZES_*). */
+#ifndef CO_TPDO_MAX
 #define CO_TPDO_MAX 2u
+#endif
 #define CO_PDO_MAP_MAX 8u
 
 typedef struct co_tpdo {
@@ -42,7 +47,7 @@ typedef struct co_tpdo {
     uint16_t inhibit;      /* inhibit time, in the product's unit (co_node_cfg_t) */
     uint32_t next_event;   /* time of the next event-timer send */
     uint32_t inhibit_end;  /* earliest time of the next event-driven send */
-    const co_od_entry_t *map[CO_PDO_MAP_MAX];
+    uint8_t map[CO_PDO_MAP_MAX];       /* mapped entries: positions in the table */
     uint8_t map_bytes[CO_PDO_MAP_MAX];
     uint8_t len;           /* mapped bytes */
     uint8_t last[8];

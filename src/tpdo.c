@@ -78,11 +78,14 @@ void co_tpdo_reconfig(co_node_t *node, unsigned n)
         return;
     }
     uint32_t len = 0;
+    const co_od_entry_t *table = co_cfg(node)->od->entries;
     for (uint8_t i = 0; i < count; i++) {
         uint32_t m = get_or(node, mapi, (uint8_t)(i + 1u), 0);
-        if (resolve_map(node, m, &t->map[i], &t->map_bytes[i]) != CO_OK) {
+        const co_od_entry_t *e;
+        if (resolve_map(node, m, &e, &t->map_bytes[i]) != CO_OK || e - table > 0xFF) {
             return; /* unusable mapping: the PDO stays invalid */
         }
+        t->map[i] = (uint8_t)(e - table);
         len += t->map_bytes[i];
     }
     if (len > 8u) {
@@ -198,13 +201,14 @@ static uint32_t reverse_bytes(uint32_t v, unsigned nb)
 static inline void build_mapped(co_node_t *node, unsigned n, co_frame_t *f)
 {
     const co_tpdo_t *t = &node->tpdo[n];
+    const co_od_entry_t *table = co_cfg(node)->od->entries;
     f->id = t->cob_id;
     f->rtr = false;
     uint64_t data = 0;
     unsigned pos = 0;
     for (unsigned i = 0; i < t->nmap; i++) {
         uint32_t v = 0;
-        (void)co_od_get(node, t->map[i], &v);
+        (void)co_od_get(node, &table[t->map[i]], &v);
         unsigned nb = t->map_bytes[i]; /* 1..4: every mapped object is at most 32 bits */
         if (nb < 4u) {
             v &= (1u << (8u * nb)) - 1u;
