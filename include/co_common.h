@@ -34,6 +34,14 @@ typedef enum co_can_state {
     CO_CAN_BUSOFF,
 } co_can_state_t;
 
+/* Keep a function out of its callers: its locals then share the stack with
+ * its siblings' instead of adding to the caller's frame (param_store.c). */
+#if defined(__GNUC__)
+#define CO_NOINLINE __attribute__((noinline))
+#else
+#define CO_NOINLINE
+#endif
+
 /* "No deadline" returned by poll functions. */
 #define CO_NEVER UINT32_MAX
 

@@ -12,6 +12,7 @@
 #define STORE_MAGIC 0x53506F43u /* "CoPS" */
 #define FLAG_DEFAULTS 0x01u
 
+/* What one slot holds, from check_slot(). */
 typedef struct slot_info {
     bool present; /* the magic is there */
     bool valid;   /* header, length, layout and CRC all check out */
@@ -20,6 +21,17 @@ typedef struct slot_info {
     uint32_t writes;
     uint32_t len;
 } slot_info_t;
+
+/* The newest valid record of a class, from newest(). */
+typedef struct newest {
+    int8_t k;      /* its slot, -1: none */
+    bool present;  /* some slot has the magic (a record, maybe a broken one) */
+    bool hw;       /* a read failed */
+    uint8_t flags;
+    uint32_t seq;
+    uint32_t writes;
+    uint32_t len;
+} newest_t;
 
 uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len)
 {
@@ -66,7 +78,8 @@ static bool stored_class(const co_node_t *node, co_cls_t cls)
            node->ram[cls] != NULL;
 }
 
-/* Read and verify one slot without touching any live value. */
+/* Read and verify one slot without touching any live value. The header
+ * buffer is reused for the data and the CRC once the header is parsed. */
 static slot_info_t check_slot(co_node_t *node, co_cls_t cls, unsigned copy, bool *hw_error)
 {
     slot_info_t s = {0};
@@ -91,45 +104,50 @@ static slot_info_t check_slot(co_node_t *node, co_cls_t cls, unsigned copy, bool
         return s;
     }
     uint32_t crc = co_crc32(0, h, sizeof(h));
-    uint8_t chunk[16];
-    for (uint32_t at = 0; at < s.len; at += sizeof(chunk)) {
-        uint32_t n = co_min_u32(sizeof(chunk), s.len - at);
-        if (!co_port_nvm_read(node->port, a + CO_STORE_HDR + at, chunk, n)) {
+    for (uint32_t at = 0; at < s.len; at += sizeof(h)) {
+        uint32_t n = co_min_u32(sizeof(h), s.len - at);
+        if (!co_port_nvm_read(node->port, a + CO_STORE_HDR + at, h, n)) {
             *hw_error = true;
             return s;
         }
-        crc = co_crc32(crc, chunk, n);
+        crc = co_crc32(crc, h, n);
     }
-    uint8_t c[4];
-    if (!co_port_nvm_read(node->port, a + CO_STORE_HDR + s.len, c, 4)) {
+    if (!co_port_nvm_read(node->port, a + CO_STORE_HDR + s.len, h, 4)) {
         *hw_error = true;
         return s;
     }
-    s.valid = co_get_u32(c) == crc;
+    s.valid = co_get_u32(h) == crc;
     return s;
 }
 
-/* Index of the newest valid copy, or -1. */
-static int newest(const slot_info_t s[2])
+/* Both slots checked: the newest valid one. Not inlined, so that its
+ * buffers are off the stack again before a caller writes a record. */
+static CO_NOINLINE newest_t newest(co_node_t *node, co_cls_t cls)
 {
-    if (s[0].valid && s[1].valid) {
-        return (int32_t)(s[1].seq - s[0].seq) > 0 ? 1 : 0;
+    newest_t r = {.k = -1};
+    for (unsigned copy = 0; copy < 2u; copy++) {
+        slot_info_t s = check_slot(node, cls, copy, &r.hw);
+        r.present = r.present || s.present;
+        if (s.valid && (r.k < 0 || (int32_t)(s.seq - r.seq) > 0)) {
+            r.k = (int8_t)copy;
+            r.flags = s.flags;
+            r.seq = s.seq;
+            r.writes = s.writes;
+            r.len = s.len;
+        }
     }
-    return s[0].valid ? 0 : (s[1].valid ? 1 : -1);
+    return r;
 }
 
 void co_store_init(co_node_t *node)
 {
+    /* Every save counts once, in every class's newest record from then on. */
     node->store.writes = 0;
     for (unsigned cls = CO_CLS_PARA; cls <= CO_CLS_LSS; cls++) {
-        if (!stored_class(node, (co_cls_t)cls)) {
-            continue;
-        }
-        for (unsigned copy = 0; copy < 2u; copy++) {
-            bool hw = false;
-            slot_info_t s = check_slot(node, (co_cls_t)cls, copy, &hw);
-            if (s.valid && s.writes > node->store.writes) {
-                node->store.writes = s.writes;
+        if (stored_class(node, (co_cls_t)cls)) {
+            newest_t nw = newest(node, (co_cls_t)cls);
+            if (nw.k >= 0 && nw.writes > node->store.writes) {
+                node->store.writes = nw.writes;
             }
         }
     }
@@ -151,15 +169,12 @@ co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, u
     if (!stored_class(node, cls)) {
         return CO_STORE_BLANK;
     }
-    slot_info_t s[2];
-    bool hw = false;
-    s[0] = check_slot(node, cls, 0, &hw);
-    s[1] = check_slot(node, cls, 1, &hw);
-    int k = newest(s);
+    newest_t nw = newest(node, cls);
+    int k = nw.k;
     co_store_status_t st;
     if (k < 0) {
-        st = hw ? CO_STORE_HW : (s[0].present || s[1].present) ? CO_STORE_CORRUPT : CO_STORE_BLANK;
-    } else if ((s[k].flags & FLAG_DEFAULTS) != 0u) {
+        st = nw.hw ? CO_STORE_HW : nw.present ? CO_STORE_CORRUPT : CO_STORE_BLANK;
+    } else if ((nw.flags & FLAG_DEFAULTS) != 0u) {
         st = CO_STORE_DEFAULTS;
     } else {
         st = CO_STORE_OK;
@@ -172,7 +187,7 @@ co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, u
     /* Verified: now copy what was asked for, straight from NVM. */
     uint32_t data = slot_addr(node, cls, (unsigned)k) + CO_STORE_HDR;
     if (lo == 0u && hi == 0xFFFFu) {
-        if (!co_port_nvm_read(node->port, data, node->ram[cls], s[k].len)) {
+        if (!co_port_nvm_read(node->port, data, node->ram[cls], nw.len)) {
             set_defaults(node, cls, lo, hi);
             st = CO_STORE_HW;
         }
@@ -246,26 +261,12 @@ static bool record_chunk(co_node_t *node, co_cls_t cls, const group_t *g, uint32
     return true;
 }
 
-static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags, group_t *g)
+/* Write a record with sequence seq into slot target: header, data, CRC.
+ * Not inlined: its buffers never share the stack with newest()'s. */
+static CO_NOINLINE co_res_t write_slot(co_node_t *node, co_cls_t cls, unsigned target,
+                                       uint32_t seq, uint8_t flags, const group_t *g)
 {
-    if (!stored_class(node, cls)) {
-        return CO_E_STORE;
-    }
-    if (co_store_limit_reached(node)) {
-        return CO_E_STORE;
-    }
-    slot_info_t s[2];
-    bool hw = false;
-    s[0] = check_slot(node, cls, 0, &hw);
-    s[1] = check_slot(node, cls, 1, &hw);
-    int k = newest(s);
-    unsigned target = (k == 0) ? 1u : 0u;
-    uint32_t seq = (k < 0) ? 1u : s[k].seq + 1u;
     uint32_t len = (flags & FLAG_DEFAULTS) != 0u ? 0u : co_cfg(node)->ram_size[cls];
-    if (g != NULL) {
-        g->from = (k >= 0 && (s[k].flags & FLAG_DEFAULTS) == 0u) ? k : -1;
-    }
-
     uint8_t h[CO_STORE_HDR] = {0};
     co_put_u32(&h[0], STORE_MAGIC);
     co_put_u32(&h[4], co_store_layout_hash(node, cls));
@@ -279,19 +280,37 @@ static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags, group
     if (!co_port_nvm_write(node->port, a, h, sizeof(h))) {
         return CO_E_HW;
     }
-    uint8_t chunk[16];
-    for (uint32_t at = 0; at < len; at += sizeof(chunk)) {
-        uint32_t n = co_min_u32(sizeof(chunk), len - at);
-        if (!record_chunk(node, cls, g, at, chunk, n) ||
-            !co_port_nvm_write(node->port, a + CO_STORE_HDR + at, chunk, n)) {
+    for (uint32_t at = 0; at < len; at += sizeof(h)) { /* the header's buffer, reused */
+        uint32_t n = co_min_u32(sizeof(h), len - at);
+        if (!record_chunk(node, cls, g, at, h, n) ||
+            !co_port_nvm_write(node->port, a + CO_STORE_HDR + at, h, n)) {
             return CO_E_HW;
         }
-        crc = co_crc32(crc, chunk, n);
+        crc = co_crc32(crc, h, n);
     }
-    uint8_t c[4];
-    co_put_u32(c, crc);
-    if (!co_port_nvm_write(node->port, a + CO_STORE_HDR + len, c, sizeof(c))) {
+    co_put_u32(h, crc);
+    if (!co_port_nvm_write(node->port, a + CO_STORE_HDR + len, h, 4)) {
         return CO_E_HW;
+    }
+    return CO_OK;
+}
+
+static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags, group_t *g)
+{
+    if (!stored_class(node, cls)) {
+        return CO_E_STORE;
+    }
+    if (co_store_limit_reached(node)) {
+        return CO_E_STORE;
+    }
+    newest_t nw = newest(node, cls);
+    if (g != NULL) {
+        g->from = (nw.k >= 0 && (nw.flags & FLAG_DEFAULTS) == 0u) ? nw.k : -1;
+    }
+    /* Into the other slot than the newest record's, one sequence number on. */
+    co_res_t r = write_slot(node, cls, nw.k == 0 ? 1u : 0u, nw.k < 0 ? 1u : nw.seq + 1u, flags, g);
+    if (r != CO_OK) {
+        return r;
     }
     node->store.writes++;
     if (node->store.status[cls] != CO_STORE_OK && flags == 0u && g == NULL) {
@@ -320,19 +339,15 @@ co_res_t co_store_save_group(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_
 /* The class's RAM struct equals its newest valid stored record. */
 static bool same_as_stored(co_node_t *node, co_cls_t cls)
 {
-    slot_info_t s[2];
-    bool hw = false;
-    s[0] = check_slot(node, cls, 0, &hw);
-    s[1] = check_slot(node, cls, 1, &hw);
-    int k = newest(s);
-    if (k < 0 || s[k].flags != 0u) {
+    newest_t nw = newest(node, cls);
+    if (nw.k < 0 || nw.flags != 0u) {
         return false;
     }
-    uint32_t a = slot_addr(node, cls, (unsigned)k) + CO_STORE_HDR;
+    uint32_t a = slot_addr(node, cls, (unsigned)nw.k) + CO_STORE_HDR;
     const uint8_t *ram = node->ram[cls];
     uint8_t chunk[16];
-    for (uint32_t at = 0; at < s[k].len; at += sizeof(chunk)) {
-        uint32_t n = co_min_u32(sizeof(chunk), s[k].len - at);
+    for (uint32_t at = 0; at < nw.len; at += sizeof(chunk)) {
+        uint32_t n = co_min_u32(sizeof(chunk), nw.len - at);
         if (!co_port_nvm_read(node->port, a + at, chunk, n) || memcmp(chunk, ram + at, n) != 0) {
             return false;
         }
