@@ -37,11 +37,20 @@ typedef struct co_incl_para {
     int16_t diff[2];
 } co_incl_para_t;
 
+/* Circular outputs (0 .. one turn - 1 LSB, the P+F and GSH-A mode). An MCU
+ * image of a product without them sets 0 (boards/CMakeLists.txt): the mode's
+ * code is left out, and a product that sets incl.circular does not build. */
+#ifndef CO_INCL_CIRCULAR
+#define CO_INCL_CIRCULAR 1
+#endif
+
 typedef struct co_incl {
     co_incl_para_t *p;
     uint8_t axes;        /* 1 (single axis) or 2 */
     bool wrap;           /* full turn: the angle wraps at +-180 deg */
+#if CO_INCL_CIRCULAR
     bool circular;       /* outputs 0..full turn - 1 LSB, modulo a full turn (P+F) */
+#endif
     bool fault;          /* sensor element error: outputs hold */
     int32_t limit_mdeg;  /* output stops here, error beyond it; 0: none */
     uint8_t shift;       /* active filter shift */

@@ -93,6 +93,7 @@ static int32_t signed_measure(const co_incl_t *incl, unsigned axis)
     return (incl->p->op[axis] & CO_INCL_OP_INVERT) != 0u ? -m : m;
 }
 
+#if CO_INCL_CIRCULAR
 /* Non-negative a mod m (m > 0). */
 static int32_t mod_pos(int32_t a, int32_t m)
 {
@@ -115,8 +116,11 @@ static int32_t circular_a1(const co_incl_t *incl, unsigned axis)
     return (incl->p->op[axis] & CO_INCL_OP_INVERT) != 0u ? mod_pos(f - m, f) : m;
 }
 
+#endif
+
 static int16_t compute_slope(const co_incl_t *incl, unsigned axis)
 {
+#if CO_INCL_CIRCULAR
     if (incl->circular) {
         int32_t a1 = circular_a1(incl, axis);
         if ((incl->p->op[axis] & CO_INCL_OP_SCALING) != 0u) {
@@ -124,6 +128,7 @@ static int16_t compute_slope(const co_incl_t *incl, unsigned axis)
         }
         return (int16_t)a1;
     }
+#endif
     int32_t v = signed_measure(incl, axis);
     if ((incl->p->op[axis] & CO_INCL_OP_SCALING) != 0u) {
         v += incl->p->offset[axis] + incl->p->diff[axis];
@@ -170,6 +175,7 @@ co_res_t co_incl_set_resolution(co_incl_t *incl, uint16_t res)
 
 void co_incl_set_preset(co_incl_t *incl, unsigned axis, int16_t preset)
 {
+#if CO_INCL_CIRCULAR
     if (incl->circular) {
         int32_t a1 = circular_a1(incl, axis);
         incl->p->preset[axis] = preset;
@@ -177,6 +183,7 @@ void co_incl_set_preset(co_incl_t *incl, unsigned axis, int16_t preset)
             (int16_t)mod_pos((int32_t)preset - a1 - incl->p->diff[axis], turn(incl));
         return;
     }
+#endif
     int32_t off = (int32_t)preset - signed_measure(incl, axis);
     if (off > INT16_MAX) {
         off = INT16_MAX;
