@@ -85,20 +85,23 @@ const co_node_cfg_t gsh_ch1_cfg = GSH_CFG(&ch1_od, 0x13);
 const co_node_cfg_t gsh_ch2_cfg = GSH_CFG(&ch2_od, 0x14);
 
 #define GSH_INPUTS                                                                       \
-    {{"length", "mm", 0, 100000}, {"angle", "deg", 0, 3600}, {"field", "%", 100000, 1000}}
-#define GSH_FAULTS {"extension-element", "tilt-element", NULL, NULL}
+    {{"length", PRODUCT_TEXT("mm"), 0, 100000},                                          \
+     {"angle", PRODUCT_TEXT("deg"), 0, 3600},                                            \
+     {"field", PRODUCT_TEXT("%"), 100000, 1000}}
+#define GSH_FAULTS {PRODUCT_TEXT("extension-element"), PRODUCT_TEXT("tilt-element"), NULL, NULL}
 #define GSH_BITRATES                                                                     \
     (PRODUCT_BR_20K | PRODUCT_BR_50K | PRODUCT_BR_125K | PRODUCT_BR_250K | PRODUCT_BR_500K | \
      PRODUCT_BR_800K | PRODUCT_BR_1000K)
 
 const product_t gsh_a = {
-    .id = "gsh-a", .summary = "Gefran GSH-A draw-wire + tilt, node 0x13 (CiA 406 + 410)",
+    .id = PRODUCT_TEXT("gsh-a"),
+    .summary = PRODUCT_TEXT("Gefran GSH-A draw-wire + tilt, node 0x13 (CiA 406 + 410)"),
     .inputs = GSH_INPUTS, .faults = GSH_FAULTS, .nodes = 1, .inst_size = sizeof(gsh_dev_t),
-    .create = gsh_create, .sample = gsh_sample, .cfg = &gsh_ch1_cfg, .vendor = "Gefran",
+    .create = gsh_create, .sample = gsh_sample, .cfg = &gsh_ch1_cfg, .vendor = PRODUCT_TEXT("Gefran"),
     .bitrates = GSH_BITRATES, .kbps = product_kbps_cia};
 const product_t gsh_a_redundant = {
-    .id = "gsh-a-redundant",
-    .summary = "Gefran GSH-A redundant: two nodes 0x13 + 0x14 (--iface A or A,B)",
+    .id = PRODUCT_TEXT("gsh-a-redundant"),
+    .summary = PRODUCT_TEXT("Gefran GSH-A redundant: two nodes 0x13 + 0x14 (--iface A or A,B)"),
     .inputs = GSH_INPUTS, .faults = GSH_FAULTS, .nodes = 2, .inst_size = sizeof(gsh_dev_t),
-    .create = gsh_create, .sample = gsh_sample, .cfg = &gsh_ch1_cfg, .vendor = "Gefran",
+    .create = gsh_create, .sample = gsh_sample, .cfg = &gsh_ch1_cfg, .vendor = PRODUCT_TEXT("Gefran"),
     .bitrates = GSH_BITRATES, .kbps = product_kbps_cia};

@@ -160,14 +160,15 @@ static const uint8_t axes1 = 1;
      PRODUCT_BR_800K | PRODUCT_BR_1000K)
 
 const product_t jd2xxx = {
-    .id = "jd2xxx", .summary = "ifm JD2xxx dual axis +-90 deg, LSS (CiA 410)",
-    .inputs = {{"x", "deg", 0, 3600}, {"y", "deg", 0, 3600}, {"temp", "degC", 25000, 200}},
+    .id = PRODUCT_TEXT("jd2xxx"), .summary = PRODUCT_TEXT("ifm JD2xxx dual axis +-90 deg, LSS (CiA 410)"),
+    .inputs = {{"x", PRODUCT_TEXT("deg"), 0, 3600}, {"y", PRODUCT_TEXT("deg"), 0, 3600},
+               {"temp", PRODUCT_TEXT("degC"), 25000, 200}},
     .nodes = 1, .inst_size = sizeof(jd_dev_t), .create = jd_create, .sample = jd_sample,
-    .variant = &axes2, .cfg = &jd2_cfg, .vendor = "ifm electronic", .bitrates = JD_BITRATES,
+    .variant = &axes2, .cfg = &jd2_cfg, .vendor = PRODUCT_TEXT("ifm electronic"), .bitrates = JD_BITRATES,
     .lss = true, .kbps = product_kbps_ifm};
 const product_t jd1xxx = {
-    .id = "jd1xxx", .summary = "ifm JD1xxx single axis 0..360 deg, LSS (CiA 410)",
-    .inputs = {{"z", "deg", 0, 3600}, {"temp", "degC", 25000, 200}},
+    .id = PRODUCT_TEXT("jd1xxx"), .summary = PRODUCT_TEXT("ifm JD1xxx single axis 0..360 deg, LSS (CiA 410)"),
+    .inputs = {{"z", PRODUCT_TEXT("deg"), 0, 3600}, {"temp", PRODUCT_TEXT("degC"), 25000, 200}},
     .nodes = 1, .inst_size = sizeof(jd_dev_t), .create = jd_create, .sample = jd_sample,
-    .variant = &axes1, .cfg = &jd1_cfg, .vendor = "ifm electronic", .bitrates = JD_BITRATES,
+    .variant = &axes1, .cfg = &jd1_cfg, .vendor = PRODUCT_TEXT("ifm electronic"), .bitrates = JD_BITRATES,
     .lss = true, .kbps = product_kbps_ifm};

@@ -20,6 +20,15 @@
 
 typedef struct product product_t;
 
+/* Texts for people (ID, summary, vendor, units, fault names): an MCU image
+ * prints none of them and leaves them out (CO_OD_NO_NAMES, as the
+ * dictionary's names); input names stay, they end the input list. */
+#ifdef CO_OD_NO_NAMES
+#define PRODUCT_TEXT(s) NULL
+#else
+#define PRODUCT_TEXT(s) (s)
+#endif
+
 /* One simulated physical input. */
 typedef struct product_input {
     const char *name;  /* "x", "length"; NULL ends the list */
