@@ -32,8 +32,10 @@ enum {
     CO_ER_MANUFACTURER = 0x80,
 };
 
-/* Active errors and 0x1003 history depth a node has room for (at least 1);
- * an MCU image may set less (boards/CMakeLists.txt). */
+/* Active errors (at least 1) and 0x1003 history depth a node has room for;
+ * an MCU image may set less (boards/CMakeLists.txt). History depth 0: no
+ * history is kept, and the 0x1003 hooks do not exist (a product with 0x1003
+ * does not link). */
 #ifndef CO_EMCY_ACTIVE_MAX
 #define CO_EMCY_ACTIVE_MAX 8u
 #endif
@@ -45,8 +47,10 @@ typedef struct co_emcy {
     uint8_t nactive;
     uint16_t code[CO_EMCY_ACTIVE_MAX];
     uint8_t bits[CO_EMCY_ACTIVE_MAX];
+#if CO_EMCY_HIST_MAX > 0
     uint8_t nhist;                     /* entries in hist, newest first */
     uint32_t hist[CO_EMCY_HIST_MAX];   /* 0x1003: code | additional info << 16 */
+#endif
 } co_emcy_t;
 
 /*
@@ -83,8 +87,10 @@ void co_emcy_can_state(co_node_t *node, co_can_state_t old_state);
 /* Read hook for 0x1001 (error register from the error table). */
 co_res_t co_emcy_register_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
 /* Hooks for 0x1003: sub 0 count (write 0 clears), sub n the n-th newest. */
+#if CO_EMCY_HIST_MAX > 0
 co_res_t co_emcy_hist_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
 co_res_t co_emcy_hist_write(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+#endif
 /* Write hook for 0x1014: CiA 301 rules (bits 30..11 zero, CAN-ID changes
  * only while bit 31 is set). */
 co_res_t co_emcy_cobid_write(co_node_t *node, const co_od_entry_t *e, uint32_t value);

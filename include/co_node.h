@@ -102,12 +102,8 @@ typedef struct co_node_cfg {
 } co_node_cfg_t;
 
 struct co_node {
-    const co_node_cfg_t *cfg;
-    void *port;                 /* board context for co_port_* */
-    void *app;                  /* product context for its hooks */
-    void *ram[CO_CLS_COUNT];    /* the class structs, owned by the caller */
-    uint32_t nvm_base;          /* where this node's records start in NVM */
-    uint32_t now;               /* time of the latest co_node_poll() */
+    /* Bytes first: on a Cortex-M0 a byte field is one load only within the
+     * first 32 bytes of the struct (words: 128), so the hot ones go here. */
     uint8_t node_id;            /* active node-ID */
     uint8_t bitrate;            /* active bit-rate code (the product's table) */
     uint8_t can_state;          /* co_can_state_t */
@@ -116,18 +112,24 @@ struct co_node {
     uint8_t reset_request;      /* co_reset_t to perform at the next poll (0: none) */
     bool dirty;                 /* something happened since the last full poll */
     bool due_never;             /* the last full poll found no deadline at all */
+    co_nmt_t nmt;
+    const co_node_cfg_t *cfg;
+    void *port;                 /* board context for co_port_* */
+    void *app;                  /* product context for its hooks */
+    void *ram[CO_CLS_COUNT];    /* the class structs, owned by the caller */
+    uint32_t nvm_base;          /* where this node's records start in NVM */
+    uint32_t now;               /* time of the latest co_node_poll() */
     uint32_t due;               /* not dirty: no service needs to run before this time */
     uint32_t tx_dropped;        /* frames the board could not queue */
-    co_nmt_t nmt;
-    co_sdo_t sdo;
-    co_hb_t hb;
     co_sync_t sync;
+    co_hb_t hb;
     co_store_t store;
+    co_sdo_t sdo;
+    co_tpdo_t tpdo[CO_TPDO_MAX];
     co_emcy_t emcy;
     co_guard_t guard;
     co_lss_t lss;
     co_hbc_t hbc;
-    co_tpdo_t tpdo[CO_TPDO_MAX];
 };
 
 /*

@@ -47,16 +47,17 @@ typedef struct dst_vol {
 } dst_vol_t;
 
 typedef struct dst_dev {
-    co_node_t node;
-    dst_para_t para;
-    dst_vol_t vol;
-    co_lss_para_t lss;
-    co_incl_t incl;
-    const dst_variant_t *v;
+    /* Bytes first: short loads on the Cortex-M0 (see co_node_t). */
     uint8_t errors;   /* 0x4001 */
     uint8_t reported; /* 0x4001 as last sent by EMCY */
     bool sensor_fault;
     uint8_t filter_active;
+    const dst_variant_t *v;
+    dst_para_t para;
+    dst_vol_t vol;
+    co_lss_para_t lss;
+    co_incl_t incl;
+    co_node_t node;
 } dst_dev_t;
 
 /* Shared behaviour: node ops and dictionary hooks. */

@@ -7,6 +7,7 @@
 
 #include "co_node.h"
 
+#if CO_EMCY_HIST_MAX > 0
 static void record(co_emcy_t *em, uint16_t code, const uint8_t msef[5])
 {
     uint32_t info = msef != NULL ? ((uint32_t)msef[0] | ((uint32_t)msef[1] << 8)) : 0u;
@@ -17,12 +18,15 @@ static void record(co_emcy_t *em, uint16_t code, const uint8_t msef[5])
         em->nhist++;
     }
 }
+#endif
 
 bool co_emcy_send(co_node_t *node, uint16_t code, uint8_t er, const uint8_t msef[5])
 {
+#if CO_EMCY_HIST_MAX > 0
     if (code != CO_EMCY_NO_ERROR) {
         record(&node->emcy, code, msef);
     }
+#endif
     uint8_t st = node->nmt.state;
     if (st != CO_NMT_PREOP && st != CO_NMT_OPERATIONAL) {
         return false;
@@ -103,6 +107,7 @@ co_res_t co_emcy_register_read(co_node_t *node, const co_od_entry_t *e, uint32_t
     return CO_OK;
 }
 
+#if CO_EMCY_HIST_MAX > 0
 co_res_t co_emcy_hist_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value)
 {
     const co_emcy_t *em = &node->emcy;
@@ -133,6 +138,7 @@ co_res_t co_emcy_hist_write(co_node_t *node, const co_od_entry_t *e, uint32_t va
     node->emcy.nhist = 0;
     return CO_OK;
 }
+#endif
 
 co_res_t co_emcy_cobid_write(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
