@@ -88,6 +88,18 @@ static inline int16_t co_incl_slope(co_incl_t *incl, unsigned axis)
     return incl->out[axis];
 }
 
+/* The same as a read hook's answer: the slope sign-extended into *v. The
+ * slow path is a tail call, so the fast one needs no stack frame. */
+co_res_t co_incl_refresh_read(co_incl_t *incl, unsigned axis, uint32_t *v);
+static inline co_res_t co_incl_read(co_incl_t *incl, unsigned axis, uint32_t *v)
+{
+    if (axis < incl->axes && memcmp(&incl->seen, incl->p, sizeof(incl->seen)) == 0) {
+        *v = (uint32_t)(int32_t)incl->out[axis];
+        return CO_OK;
+    }
+    return co_incl_refresh_read(incl, axis, v);
+}
+
 /* Any axis beyond its limit. */
 bool co_incl_beyond(const co_incl_t *incl);
 

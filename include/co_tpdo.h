@@ -4,8 +4,7 @@
  * Communication parameters (0x1800 + n) and mapping (0x1A00 + n) are read
  * from the dictionary when a TPDO is configured (reset, or a write through
  * one of the hooks below) and cached here, with the mapped entries
- * resolved to their positions in the table so that sending is a straight
- * copy (a mappable entry must be among a table's first 256).
+ * resolved to table pointers so that sending is a straight copy.
  *
  * Transmission types:
  *   0        acyclic synchronous: at a SYNC, if the data changed since the
@@ -47,9 +46,10 @@ typedef struct co_tpdo {
     uint16_t inhibit;      /* inhibit time, in the product's unit (co_node_cfg_t) */
     uint32_t next_event;   /* time of the next event-timer send */
     uint32_t inhibit_end;  /* earliest time of the next event-driven send */
-    uint8_t map[CO_PDO_MAP_MAX];       /* mapped entries: positions in the table */
-    uint8_t map_bytes[CO_PDO_MAP_MAX];
+    const co_od_entry_t *map[CO_PDO_MAP_MAX]; /* mapped entries */
+    uint8_t map_drop[CO_PDO_MAP_MAX]; /* 32 - bits of each: the high bits not sent */
     uint8_t len;           /* mapped bytes */
+    uint8_t dlc;           /* of its frames: len, or 8 where the product pads */
     uint8_t last[8];
 } co_tpdo_t;
 

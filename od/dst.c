@@ -115,9 +115,7 @@ co_res_t dst_read_errors(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
 
 co_res_t dst_read_slope(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
 {
-    unsigned axis = e->index == 0x6010u ? 0u : 1u;
-    *v = (uint32_t)(int32_t)co_incl_slope(&dev_of(n)->incl, axis);
-    return CO_OK;
+    return co_incl_read(&dev_of(n)->incl, e->index == 0x6010u ? 0u : 1u, v);
 }
 
 /* ---- node ops ------------------------------------------------------ */

@@ -39,8 +39,7 @@ co_res_t pf_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 
 co_res_t pf_read_slope(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
 {
-    *v = (uint32_t)(int32_t)co_incl_slope(&dev_of(n)->incl, e->index == 0x6010u ? 0u : 1u);
-    return CO_OK;
+    return co_incl_read(&dev_of(n)->incl, e->index == 0x6010u ? 0u : 1u, v);
 }
 
 static uint32_t pf_poll(co_node_t *n, uint32_t now)

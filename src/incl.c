@@ -156,6 +156,12 @@ int16_t co_incl_refresh_slope(co_incl_t *incl, unsigned axis)
     return incl->out[axis];
 }
 
+co_res_t co_incl_refresh_read(co_incl_t *incl, unsigned axis, uint32_t *v)
+{
+    *v = (uint32_t)(int32_t)co_incl_slope(incl, axis);
+    return CO_OK;
+}
+
 co_res_t co_incl_set_resolution(co_incl_t *incl, uint16_t res)
 {
     co_incl_para_t *p = incl->p;

@@ -78,21 +78,21 @@ void co_tpdo_reconfig(co_node_t *node, unsigned n)
         return;
     }
     uint32_t len = 0;
-    const co_od_entry_t *table = co_cfg(node)->od->entries;
     for (uint8_t i = 0; i < count; i++) {
         uint32_t m = get_or(node, mapi, (uint8_t)(i + 1u), 0);
-        const co_od_entry_t *e;
-        if (resolve_map(node, m, &e, &t->map_bytes[i]) != CO_OK || e - table > 0xFF) {
+        uint8_t bytes;
+        if (resolve_map(node, m, &t->map[i], &bytes) != CO_OK) {
             return; /* unusable mapping: the PDO stays invalid */
         }
-        t->map[i] = (uint8_t)(e - table);
-        len += t->map_bytes[i];
+        t->map_drop[i] = (uint8_t)(32u - 8u * bytes);
+        len += bytes;
     }
     if (len > 8u) {
         return;
     }
     t->nmap = (uint8_t)count;
     t->len = (uint8_t)len;
+    t->dlc = co_cfg(node)->tpdo_dlc != 0u ? co_cfg(node)->tpdo_dlc : t->len;
     t->valid = (cob & 0x80000000u) == 0u;
     if (node->nmt.state == CO_NMT_OPERATIONAL) {
         start_one(node, t); /* a parameter changed while operational: apply it now */
@@ -189,11 +189,10 @@ void co_tpdo_stop(co_node_t *node)
     }
 }
 
-/* The low nb bytes of v in reverse order (big-endian PDO values). */
-static uint32_t reverse_bytes(uint32_t v, unsigned nb)
+/* v's four bytes in reverse order (big-endian PDO values). */
+static uint32_t reverse_bytes(uint32_t v)
 {
-    v = (v << 24) | ((v & 0xFF00u) << 8) | ((v >> 8) & 0xFF00u) | (v >> 24);
-    return v >> (32u - 8u * nb);
+    return (v << 24) | ((v & 0xFF00u) << 8) | ((v >> 8) & 0xFF00u) | (v >> 24);
 }
 
 /* The mapped part of TPDO n, without the product's fill hook. The data
@@ -201,27 +200,24 @@ static uint32_t reverse_bytes(uint32_t v, unsigned nb)
 static inline void build_mapped(co_node_t *node, unsigned n, co_frame_t *f)
 {
     const co_tpdo_t *t = &node->tpdo[n];
-    const co_od_entry_t *table = co_cfg(node)->od->entries;
+    unsigned nmap = t->nmap;
+    bool msb_first = node->pdo_msb_first;
     f->id = t->cob_id;
     f->rtr = false;
+    f->dlc = t->dlc;
     uint64_t data = 0;
-    unsigned pos = 0;
-    for (unsigned i = 0; i < t->nmap; i++) {
+    unsigned shift = 0;
+    for (unsigned i = 0; i < nmap; i++) {
         uint32_t v = 0;
-        (void)co_od_get(node, &table[t->map[i]], &v);
-        unsigned nb = t->map_bytes[i]; /* 1..4: every mapped object is at most 32 bits */
-        if (nb < 4u) {
-            v &= (1u << (8u * nb)) - 1u;
-        }
-        if (node->pdo_msb_first) {
-            v = reverse_bytes(v, nb);
-        }
-        data |= (uint64_t)v << (8u * pos);
-        pos += nb;
+        (void)co_od_get(node, t->map[i], &v);
+        /* Its own bytes only: 1..4, every mapped object is at most 32 bits. */
+        unsigned drop = t->map_drop[i];
+        v = msb_first ? reverse_bytes(v) >> drop : v & (0xFFFFFFFFu >> drop);
+        data |= (uint64_t)v << shift;
+        shift += 32u - drop;
     }
     co_put_u32(&f->data[0], (uint32_t)data);
     co_put_u32(&f->data[4], (uint32_t)(data >> 32));
-    f->dlc = co_cfg(node)->tpdo_dlc != 0u ? co_cfg(node)->tpdo_dlc : t->len;
 }
 
 void co_tpdo_build(co_node_t *node, unsigned n, co_frame_t *f)

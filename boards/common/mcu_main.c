@@ -22,6 +22,19 @@
 
 extern const product_t PRODUCT_SYM;
 
+/* The LEDs; not inlined, so that its locals are not part of main's frame,
+ * on which every other call of the loop stacks. Returns the delay until
+ * either LED changes. */
+static CO_NOINLINE uint32_t leds(co_node_t *node, uint32_t now)
+{
+    bool g;
+    bool r;
+    uint32_t next;
+    co_node_leds(node, now, &g, &r, &next);
+    board_leds(g, r);
+    return next;
+}
+
 int main(void)
 {
     /* The instance: static storage of this image's one product, sized for it.
@@ -77,11 +90,6 @@ int main(void)
             co_node_set_can_state(nodes[i], (co_can_state_t)board_can_state());
             wait = co_min_u32(wait, co_node_poll(nodes[i], now));
         }
-        bool g;
-        bool r;
-        uint32_t led_next;
-        co_node_leds(nodes[0], now, &g, &r, &led_next);
-        board_leds(g, r);
-        board_sleep(co_min_u32(wait, led_next));
+        board_sleep(co_min_u32(wait, leds(nodes[0], now)));
     }
 }
