@@ -10,21 +10,26 @@
 #include "co_sdo.h"
 #include "sdo_internal.h"
 
-static bool initiate_download(co_node_t *node, const uint8_t *d)
+/* A transfer of object e begins: the initiate request d is answered. */
+static bool begin(co_node_t *node, const uint8_t *d, uint8_t state, const co_od_entry_t *e)
 {
     co_sdo_t *sdo = &node->sdo;
-    const co_od_entry_t *e = co_sdo_download_target(node, d, (d[0] & 0x01u) != 0u);
-    if (e == NULL) {
-        return true;
-    }
-    sdo->state = SDO_DOWNLOAD;
+    sdo->state = state;
     sdo->e = e;
     sdo->size = co_od_size(e);
     sdo->pos = 0;
     sdo->toggle = 0;
     co_sdo_restart(sdo);
-    co_sdo_reply_head(node, 0x60, d, 0);
+    /* Download: 0x60; upload: 0x41 with the size indicated. */
+    co_sdo_reply_head(node, state == SDO_DOWNLOAD ? 0x60 : 0x41, d,
+                      state == SDO_DOWNLOAD ? 0u : sdo->size);
     return true;
+}
+
+static bool initiate_download(co_node_t *node, const uint8_t *d)
+{
+    const co_od_entry_t *e = co_sdo_download_target(node, d, (d[0] & 0x01u) != 0u);
+    return e == NULL || begin(node, d, SDO_DOWNLOAD, e);
 }
 
 static void download_segment(co_node_t *node, const uint8_t *d)
@@ -66,7 +71,6 @@ static void download_segment(co_node_t *node, const uint8_t *d)
 /* An object of more than 4 bytes (the server answered the others). */
 static bool initiate_upload(co_node_t *node, const uint8_t *d)
 {
-    co_sdo_t *sdo = &node->sdo;
     const co_od_entry_t *e = co_sdo_find(node, d);
     if (e == NULL) {
         return true;
@@ -75,14 +79,7 @@ static bool initiate_upload(co_node_t *node, const uint8_t *d)
         co_sdo_abort(node, d, CO_E_WO);
         return true;
     }
-    sdo->state = SDO_UPLOAD;
-    sdo->e = e;
-    sdo->size = co_od_size(e);
-    sdo->pos = 0;
-    sdo->toggle = 0;
-    co_sdo_restart(sdo);
-    co_sdo_reply_head(node, 0x41, d, sdo->size);
-    return true;
+    return begin(node, d, SDO_UPLOAD, e);
 }
 
 static void upload_segment(co_node_t *node, const uint8_t *d)
