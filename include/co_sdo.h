@@ -1,7 +1,8 @@
 /*
  * co_sdo.h - SDO server (CiA 301 7.2.4): expedited, and where the product
- * links them segmented and block upload and download (block: CRC-16-CCITT when the client wants it; one
- * block carries any object, the protocol-switch threshold is not used),
+ * links them segmented and block upload and download (block: CRC-16-CCITT
+ * when the client wants it; one block carries any object, the
+ * protocol-switch threshold is not used),
  * toggle and sequence checks, timeout, abort codes from co_res_t.
  */
 #ifndef CO_SDO_H

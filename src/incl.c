@@ -158,7 +158,7 @@ int16_t co_incl_refresh_slope(co_incl_t *incl, unsigned axis)
 
 co_res_t co_incl_refresh_read(co_incl_t *incl, unsigned axis, uint32_t *v)
 {
-    *v = (uint32_t)(int32_t)co_incl_slope(incl, axis);
+    *v = axis < incl->axes ? (uint32_t)(int32_t)co_incl_refresh_slope(incl, axis) : 0u;
     return CO_OK;
 }
 

@@ -32,15 +32,10 @@ static bool initiate_download(co_node_t *node, const uint8_t *d)
     return e == NULL || begin(node, d, SDO_DOWNLOAD, e);
 }
 
-static void download_segment(co_node_t *node, const uint8_t *d)
+/* A segment with the expected toggle bit; mux names the transfer. */
+static void download_segment(co_node_t *node, const uint8_t *d, const uint8_t mux[4])
 {
     co_sdo_t *sdo = &node->sdo;
-    uint8_t mux[4];
-    co_sdo_mux(sdo, mux);
-    if ((d[0] & 0x10u) != sdo->toggle) {
-        co_sdo_abort(node, mux, CO_E_TOGGLE);
-        return;
-    }
     uint32_t n = 7u - ((d[0] >> 1) & 0x07u);
     if (sdo->pos + n > sdo->size) {
         co_sdo_abort(node, mux, CO_E_LEN_HIGH);
@@ -82,15 +77,10 @@ static bool initiate_upload(co_node_t *node, const uint8_t *d)
     return begin(node, d, SDO_UPLOAD, e);
 }
 
-static void upload_segment(co_node_t *node, const uint8_t *d)
+/* A segment with the expected toggle bit; mux names the transfer. */
+static void upload_segment(co_node_t *node, const uint8_t mux[4])
 {
     co_sdo_t *sdo = &node->sdo;
-    uint8_t mux[4];
-    co_sdo_mux(sdo, mux);
-    if ((d[0] & 0x10u) != sdo->toggle) {
-        co_sdo_abort(node, mux, CO_E_TOGGLE);
-        return;
-    }
     uint8_t out[8] = {0, 0, 0, 0, 0, 0, 0, 0};
     uint32_t n;
     co_res_t r = co_od_read(node, sdo->e, sdo->pos, &out[1], 7, &n);
@@ -124,10 +114,16 @@ bool co_sdo_segmented(co_node_t *node, const uint8_t *d)
         bool download = (d[0] >> 5) == CCS_DOWNLOAD_SEGMENT;
         if (sdo->state != (download ? SDO_DOWNLOAD : SDO_UPLOAD)) {
             co_sdo_abort(node, d, CO_E_CMD);
+            return true;
+        }
+        uint8_t mux[4];
+        co_sdo_mux(sdo, mux);
+        if ((d[0] & 0x10u) != sdo->toggle) {
+            co_sdo_abort(node, mux, CO_E_TOGGLE);
         } else if (download) {
-            download_segment(node, d);
+            download_segment(node, d, mux);
         } else {
-            upload_segment(node, d);
+            upload_segment(node, mux);
         }
         return true;
     }
