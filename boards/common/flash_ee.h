@@ -33,7 +33,8 @@ typedef struct flash_ee {
     uint32_t pages;     /* pages available: one per slot */
 } flash_ee_t;
 
-/* Bytes of emulated EEPROM (pages x CO_STORE_SLOT). */
+/* Bytes of emulated EEPROM (pages x CO_STORE_SLOT); 0 when a page cannot
+ * hold a slot (page_size below CO_STORE_SLOT or odd) or base is odd. */
 uint32_t flash_ee_size(const flash_ee_t *fe);
 bool flash_ee_read(const flash_ee_t *fe, uint32_t addr, void *buf, uint32_t len);
 bool flash_ee_write(const flash_ee_t *fe, uint32_t addr, const void *buf, uint32_t len);

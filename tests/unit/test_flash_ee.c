@@ -81,6 +81,7 @@ static void sim_read(void *ctx, uint32_t addr, void *buf, uint32_t len)
 
 static const flash_ops_t sim_ops = {.erase = sim_erase, .program16 = sim_program16, .read = sim_read};
 static const flash_ee_t fe = {.ops = &sim_ops, .ctx = NULL, .base = 0, .page_size = PAGE, .pages = PAGES};
+static const flash_ee_t *ee = &fe; /* the geometry the port uses */
 
 /* The port: CAN frames are kept for inspection, NVM is the flash. */
 static co_frame_t last_tx;
@@ -95,19 +96,19 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
 uint32_t co_port_nvm_size(void *port)
 {
     (void)port;
-    return flash_ee_size(&fe);
+    return flash_ee_size(ee);
 }
 
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     (void)port;
-    return flash_ee_read(&fe, addr, buf, len);
+    return flash_ee_read(ee, addr, buf, len);
 }
 
 bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
 {
     (void)port;
-    return flash_ee_write(&fe, addr, buf, len);
+    return flash_ee_write(ee, addr, buf, len);
 }
 
 static _Alignas(8) unsigned char mem[sizeof(dst_dev_t)];
@@ -205,9 +206,51 @@ static void test_pages_and_alignment(void)
     CHECK_EQ(node->node_id, 6);
 }
 
+/*
+ * Regression (found by tests/fuzz/fuzz_flash_ee.c): a geometry whose pages
+ * cannot hold a slot (smaller than CO_STORE_SLOT, or odd, so that slots
+ * start at odd addresses) made the emulation read and write outside its
+ * pages and across slots; with 1-byte pages it read 192 bytes of "EEPROM"
+ * from one byte of flash. Such a geometry is refused as a whole: no
+ * EEPROM, the store reports a hardware error, the flash is not touched.
+ */
+static void test_unusable_geometry(void)
+{
+    static const flash_ee_t small = {.ops = &sim_ops, .base = 0, .page_size = 128, .pages = 8};
+    static const flash_ee_t tiny = {.ops = &sim_ops, .base = 0, .page_size = 1, .pages = 1};
+    static const flash_ee_t odd = {.ops = &sim_ops, .base = 0, .page_size = 1023, .pages = 4};
+    static const flash_ee_t odd_base = {.ops = &sim_ops, .base = 1, .page_size = PAGE, .pages = 2};
+    const flash_ee_t *bad[4] = {&small, &tiny, &odd, &odd_base};
+    memset(flash.mem, 0xFF, sizeof(flash.mem));
+    flash.erases = 0;
+    flash.programs = 0;
+    uint8_t two[2] = {1, 2};
+    uint8_t b[2];
+    for (unsigned i = 0; i < 4u; i++) {
+        CHECK_EQ(flash_ee_size(bad[i]), 0);
+        CHECK(!flash_ee_write(bad[i], 0, two, 2));
+        CHECK(!flash_ee_read(bad[i], 0, b, 2));
+    }
+    /* A node on such a flash: defaults, reported; a save answers 0x06060000. */
+    ee = &small;
+    power_on();
+    CHECK_EQ(node->store.status[CO_CLS_PARA], CO_STORE_HW);
+    (void)co_node_poll(node, 0); /* 0x4001 is evaluated by the poll */
+    CHECK_EQ(get(0x4001, 0) & DST_ERR_CHECKSUM, DST_ERR_CHECKSUM);
+    CHECK_EQ(sdo("23 10 10 01 73 61 76 65"), CO_E_HW);
+    ee = &fe;
+    CHECK_EQ(flash.erases, 0);
+    CHECK_EQ(flash.programs, 0);
+    /* The usable one still is: 1024-byte pages, and exactly a slot. */
+    static const flash_ee_t exact = {.ops = &sim_ops, .base = 0, .page_size = CO_STORE_SLOT, .pages = 4};
+    CHECK_EQ(flash_ee_size(&fe), PAGES * CO_STORE_SLOT);
+    CHECK_EQ(flash_ee_size(&exact), 4u * CO_STORE_SLOT);
+}
+
 int main(void)
 {
     RUN(test_power_cut_at_every_flash_step);
     RUN(test_pages_and_alignment);
+    RUN(test_unusable_geometry);
     return h_finish();
 }
