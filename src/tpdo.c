@@ -328,6 +328,15 @@ static uint32_t inhibit_us(const co_node_t *node, const co_tpdo_t *t)
     return (uint32_t)t->inhibit * unit;
 }
 
+/* The inhibit time of t still runs at now. Its end is never more than one
+ * inhibit time ahead; a stamp that seems further ahead went stale more than
+ * 2^31 us ago without a send since (an event-driven PDO whose data did not
+ * change for 36 minutes): it ran out long ago (found by fuzz_node.c). */
+static bool inhibited(const co_node_t *node, const co_tpdo_t *t, uint32_t now)
+{
+    return co_time_before(now, t->inhibit_end) && t->inhibit_end - now <= inhibit_us(node, t);
+}
+
 uint32_t co_tpdo_poll(co_node_t *node, uint32_t now)
 {
     uint32_t next = CO_NEVER;
@@ -342,7 +351,7 @@ uint32_t co_tpdo_poll(co_node_t *node, uint32_t now)
         uint32_t period = (uint32_t)t->event_ms * 1000u;
         bool timer_due = t->timer_armed && !co_time_before(now, t->next_event);
         if (timer_due || t->pending) {
-            if (co_time_before(now, t->inhibit_end)) {
+            if (inhibited(node, t, now)) {
                 t->pending = true; /* keep the event until the inhibit time ends */
                 next = co_min_u32(next, t->inhibit_end - now);
                 continue;

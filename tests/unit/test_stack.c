@@ -3,6 +3,7 @@
  * every feature (long strings, writable PDO parameters, inhibit time,
  * limits of signed and unsigned types), frame-exact, on a virtual clock.
  */
+#include "co_filter.h"
 #include "dst.h"
 #include "harness.h"
 
@@ -736,6 +737,42 @@ static void test_tpdo_events_and_inhibit(void)
     co_tpdo_event(d->node, 5); /* no such TPDO: ignored */
 }
 
+/*
+ * Regression (found by tests/fuzz/fuzz_node.c): the end of the inhibit time
+ * is a time stamp compared wrap-around; after more than 2^31 us (35.8 min)
+ * without a send it read as still ahead, and the next event was held back
+ * for up to 35.8 minutes (an event-driven PDO of a sensor at rest).
+ */
+static void test_tpdo_event_after_a_long_quiet_spell(void)
+{
+    boot();
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* no timer */
+    SDO(d, "2B 00 18 03 E8 03 00 00", "60 00 18 03 00 00 00 00"); /* 100 ms */
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 1);
+    const co_frame_t *f = h_next(d);
+    CHECK(f != NULL && f->id == 0x190);
+    /* 40 minutes without an event. The board's samples change nothing
+     * that matters here, so the clock jumps (as an MCU's does asleep). */
+    d->now += 40u * 60u * 1000000u;
+    d->next_sample = d->now + CO_FILTER_PERIOD_US;
+    h_advance(d, 10000);
+    EXPECT_NONE(d);
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 1);
+    f = h_next(d);
+    CHECK(f != NULL && f->id == 0x190); /* at once: the inhibit time ended long ago */
+    /* And the inhibit time works as before right after it. */
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 99000);
+    EXPECT_NONE(d);
+    h_advance(d, 2000);
+    f = h_next(d);
+    CHECK(f != NULL && f->id == 0x190);
+}
+
 static void test_tpdo_cobid_and_mapping_rules(void)
 {
     boot();
@@ -794,5 +831,6 @@ int main(void)
     RUN(test_tpdo_rtr_and_types);
     RUN(test_tpdo_events_and_inhibit);
     RUN(test_tpdo_cobid_and_mapping_rules);
+    RUN(test_tpdo_event_after_a_long_quiet_spell);
     return h_finish();
 }
