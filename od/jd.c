@@ -412,7 +412,19 @@ void jd_sample(void *mem, const int32_t values[], uint32_t faults)
     }
     maf(d, in);
     if (d->axes == 1u) {
-        d->raw[0] = mod_pos(d->raw[0], TURN);
+        /* Back into 0..360 deg, and the averaged inputs with it: the next
+         * input is put on the side of raw[0], so the window must stay in
+         * raw[0]'s frame (else a turn's worth of offset enters the mean and
+         * sticks: 1 deg read as 271 after crossing 0). Inputs then stay
+         * within half a turn of [0, 360): the sum is bounded. */
+        int32_t shift = d->raw[0] - mod_pos(d->raw[0], TURN);
+        if (shift != 0) {
+            for (unsigned i = 0; i < d->maf_fill; i++) {
+                d->maf_buf[0][i] -= shift;
+            }
+            d->maf_sum[0] -= shift * (int32_t)d->maf_fill;
+            d->raw[0] -= shift;
+        }
     }
     /* Rates (0.1 deg/s) from the 5 ms sample period, accelerations (mg). */
     int32_t x = values[0];

@@ -359,6 +359,13 @@ static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags, group
         return CO_E_STORE;
     }
     newest_t nw = newest(node, cls);
+    if (nw.hw) {
+        /* A slot could not be read: which record is newest is unknown, so a
+         * write could replace it, lose to an older one, or (group save)
+         * take the other groups' values from nowhere. Refuse; both stored
+         * records stay as they are. */
+        return CO_E_HW;
+    }
     if (g != NULL) {
         g->from = (nw.k >= 0 && (nw.flags & FLAG_DEFAULTS) == 0u) ? nw.k : -1;
     }
