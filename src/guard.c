@@ -61,13 +61,20 @@ static void next_lap(co_guard_t *g, uint32_t from)
 uint32_t co_guard_poll(co_node_t *node, uint32_t now)
 {
     co_guard_t *g = &node->guard;
-    if (!g->enabled || !g->seen || g->lost || node->hb.period_ms != 0u) {
+    if (!g->enabled || !g->seen || g->lost) {
         return CO_NEVER;
     }
     /* Life time = guard time x life time factor (CiA 301), up to
      * 65535 x 255 ms: 32 bits hold it in ms, not in us. */
     uint32_t life_ms = get(node, 0x100C) * get(node, 0x100D);
-    if (life_ms == 0u) {
+    if (life_ms == 0u || node->hb.period_ms != 0u) {
+        /* Life guarding is off (no life time, or the heartbeat is the
+         * protocol in use): it starts again with the first request answered
+         * after. Kept, the last request's time stamp would be stale by then:
+         * more than 2^31 us old, it reads as ahead, and the event came up to
+         * 36 min late (found by tests/fuzz/fuzz_node.c). */
+        g->seen = false;
+        g->kick = false;
         return CO_NEVER;
     }
     if (g->kick) {

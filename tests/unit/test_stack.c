@@ -856,6 +856,51 @@ static void check_life_time(uint16_t guard_ms, uint8_t factor)
     CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
 }
 
+/*
+ * Regression (found by tests/fuzz/fuzz_node.c): a guard request answered
+ * while the life time was 0 was kept, and the life time counted from it
+ * once guard time and life factor were set; set more than 2^31 us after
+ * the request, its stale time stamp read as ahead, and the event came 32
+ * minutes later out of nothing. The same after the heartbeat was switched
+ * off again. Life guarding now starts with the first request answered while
+ * it is on (a life time, no heartbeat).
+ */
+static void test_life_guarding_waits_for_a_request(void)
+{
+    boot();
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* TPDO1 quiet */
+    co_frame_t rtr = {.id = 0x710, .rtr = true, .dlc = 1};
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x710, "7F"); /* node guarding answers without a life time */
+    run_for(40u * 60u * 1000000ull);
+    SDO(d, "2B 0C 10 00 E8 03 00 00", "60 0C 10 00 00 00 00 00"); /* 1 s */
+    SDO(d, "2F 0D 10 00 05 00 00 00", "60 0D 10 00 00 00 00 00"); /* x 5 */
+    h_drain(d);
+    run_for(2u * 3600u * 1000000ull); /* no request since: no event */
+    EXPECT_NONE(d);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x710, "FF");
+    run_for(4999999);
+    EXPECT_NONE(d);
+    run_for(1);
+    EXPECT(d, 0x90, "30 81 11 00 00 00 00 00");
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x710, "7F");
+    EXPECT(d, 0x90, "00 00 00 00 00 00 00 00"); /* error reset */
+    /* The heartbeat on for 40 minutes (one a minute), then off: no event
+     * until a request. */
+    SDO(d, "2B 17 10 00 60 EA 00 00", "60 17 10 00 00 00 00 00");
+    run_for(40u * 60u * 1000000ull);
+    SDO(d, "2B 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");
+    h_drain(d);
+    run_for(2u * 3600u * 1000000ull);
+    EXPECT_NONE(d);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x710, "FF");
+    run_for(5000000);
+    EXPECT(d, 0x90, "30 81 11 00 00 00 00 00");
+}
+
 static void test_life_guarding_long_times(void)
 {
     check_life_time(100, 3);     /* 300 ms */
@@ -980,6 +1025,7 @@ int main(void)
     RUN(test_tpdo_cobid_and_mapping_rules);
     RUN(test_tpdo_event_after_a_long_quiet_spell);
     RUN(test_life_guarding_long_times);
+    RUN(test_life_guarding_waits_for_a_request);
     RUN(test_largest_periods);
     RUN(test_sync_cobid_bits);
     RUN(test_emcy_cobid_restricted_and_as_written);
