@@ -35,6 +35,9 @@
  *     never keeps asking to be called again at once (a busy loop).
  *  7. A node writes the EEPROM only inside its own area.
  *  8. Nothing is handed to the port while the node's controller is bus-off.
+ *  9. An expedited SDO write the node confirmed reads back as written (but
+ *     0x1010 and 0x1011, whose signatures read as 1).
+ * 10. The LEDs never ask to be looked at again at once.
  *
  * The simulated board meets the stack's contract and no more: it polls at
  * the delays the node asks for (until a per-input budget is spent) and at
@@ -432,6 +435,36 @@ static void check_sdo_answers(const dev_t *d, unsigned k, const pre_t *pre, cons
              f->data[0], f->data[1], f->data[2], f->data[3], pre->sdo_state, count, lo, hi);
 }
 
+/* An expedited SDO write to node k, before it is handled: its entry, or NULL. */
+static const co_od_entry_t *expedited_write(co_node_t *n, const co_frame_t *f)
+{
+    if (f->rtr || f->dlc != 8u || !has_id(n) || f->id != 0x600u + n->node_id ||
+        (f->data[0] & 0xE2u) != 0x22u) {
+        return NULL;
+    }
+    const co_od_entry_t *e = co_node_entry(n, co_get_u16(&f->data[1]), f->data[3]);
+    if (e == NULL || e->type == CO_T_VSTR || (e->attr & CO_A_R) == 0u || e->size > 4u ||
+        e->index == 0x1010u || e->index == 0x1011u) {
+        return NULL; /* "save" and "load" read 1, not their signatures (CiA 301) */
+    }
+    return e;
+}
+
+/* Invariant 9: a confirmed expedited write reads back as written. */
+static void check_read_back(dev_t *d, unsigned k, const co_od_entry_t *e, const co_frame_t *f)
+{
+    const co_frame_t *r = &d->w[k].sdo_last;
+    if (d->w[k].sdo_count != 1u || r->data[0] != 0x60u || memcmp(&r->data[1], &f->data[1], 3) != 0) {
+        return; /* refused (or not answered: invariant 5) */
+    }
+    uint32_t mask = e->size >= 4u ? 0xFFFFFFFFu : (1u << (8u * e->size)) - 1u;
+    uint32_t v = 0;
+    (void)co_od_get(d->nodes[k], e, &v);
+    FZ_CHECK((v & mask) == (co_get_u32(&f->data[4]) & mask),
+             "%04X sub %u written %08X reads back %08X", e->index, e->sub,
+             co_get_u32(&f->data[4]) & mask, v & mask);
+}
+
 /* One frame on the bus, as a board feeds it: poll, receive, poll. */
 static void deliver(dev_t *d, const co_frame_t *f)
 {
@@ -445,7 +478,11 @@ static void deliver(dev_t *d, const co_frame_t *f)
         pre_t pre = {n->node_id, n->nmt.state, n->sdo.state, n->can_state};
         w->in_guard_rtr = f->rtr && has_id(n) && f->id == 0x700u + n->node_id;
         w->sdo_count = 0;
+        const co_od_entry_t *written = expedited_write(n, f);
         co_node_receive(n, f);
+        if (written != NULL) {
+            check_read_back(d, k, written, f);
+        }
         if (w->in_guard_rtr && n->can_state == CO_CAN_BUSOFF && n->guard.kick &&
             n->guard.deadline == now32(d)) {
             guard_answered(d, w); /* taken, though the answer was not sent (bus-off) */
@@ -1359,6 +1396,20 @@ static void set_inputs(fz_t *in, dev_t *d)
     }
 }
 
+/* What a board does between ops: drive the LEDs (co_node_leds), which must
+ * never ask to be looked at again at once. */
+static void leds(dev_t *d)
+{
+    for (unsigned k = 0; k < d->nnodes; k++) {
+        bool green;
+        bool red;
+        uint32_t next;
+        co_node_leds(d->nodes[k], now32(d), &green, &red, &next);
+        FZ_CHECK(next != 0u && (next == CO_NEVER || next <= 65535000u),
+                 "the LEDs ask to be looked at again in %u us", next);
+    }
+}
+
 static void run_op(fz_t *in, dev_t *d)
 {
     static flist_t l;
@@ -1509,8 +1560,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
     }
     boot(d);
+    (void)product_kbps(d->prod, d->nodes[0]->bitrate); /* the bit rate a board would set */
     while (in.n > 0u && g_op < FZ_MAX_OPS) {
         run_op(&in, d);
+        leds(d);
         g_op++;
     }
     /* Let the timers run out once more: deadlines the last op set. */
