@@ -16,11 +16,12 @@ import demo  # noqa: E402  (tools/demo.py, for its FAMILIES table)
 from test_eds import product_ids  # noqa: E402
 
 
-def start_demo(product, step, iface="vcan0"):
+def start_demo(product, step, tmp, iface="vcan0"):
+    # TMPDIR: the demo's directory (sensor log, EDS) inside pytest's.
     return subprocess.Popen([sys.executable, str(ROOT / "tools" / "demo.py"), product,
                              "--step", str(step), "--iface", iface],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env=dict(os.environ, CANOPEN_SENSOR=BINARY))
+                            env=dict(os.environ, CANOPEN_SENSOR=BINARY, TMPDIR=str(tmp)))
 
 
 def demo_output(p):
@@ -31,12 +32,12 @@ def demo_output(p):
     return out
 
 
-def run_demo(product, step):
-    return demo_output(start_demo(product, step))
+def run_demo(product, step, tmp):
+    return demo_output(start_demo(product, step, tmp))
 
 
-def test_demo_session(network):  # network: fails loudly without vcan0
-    out = run_demo("dst-x730-xy30", 1.6)  # the README's session
+def test_demo_session(network, tmp_path):  # network: fails loudly without vcan0
+    out = run_demo("dst-x730-xy30", 1.6, tmp_path)  # the README's session
     assert "boot-up" in out
     assert "device type: 0x0008019A" in out
     assert "device name: 'GIB'" in out
@@ -75,8 +76,9 @@ FAMILY_CASES = {
 # Two at a time, one on each bus (each demo takes the node-IDs of the
 # boot-ups on its bus): half the time.
 @pytest.mark.parametrize("pair", [("dst-x730-z360", "gsh-a-redundant"), ("jd1xxx", "inx360d")])
-def test_demo_of_each_family(pair, network):
-    runs = [start_demo(product, 1.0, iface) for product, iface in zip(pair, ("vcan0", "vcan1"))]
+def test_demo_of_each_family(pair, network, tmp_path):
+    runs = [start_demo(product, 1.0, tmp_path, iface)
+            for product, iface in zip(pair, ("vcan0", "vcan1"))]
     outs = [demo_output(p) for p in runs]
     for product, out in zip(pair, outs):
         for pattern in FAMILY_CASES[product]:
