@@ -170,14 +170,14 @@ co_res_t co_od_read(co_node_t *node, const co_od_entry_t *e, uint32_t at, uint8_
 co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len);
 
 /*
- * Check, without acting, that the value a writable entry e holds in RAM
+ * Check, without acting, that the value the numeric entry e holds in RAM
  * could be written to it by SDO: the limits, then the write hook in check
- * mode (see co_od_write_fn). A value that fails is replaced by the
- * entry's default. Returns true when the value passed, or was the default
- * already (a table may ship a default its hook refuses, such as a mapping
- * that leaves a PDO invalid); read-only entries, entries without RAM,
- * strings and computed values pass. The parameter store runs every
- * restored value through it (co_store_validate).
+ * mode (see co_od_write_fn); a read-only entry's limits too, where it has
+ * any. A value that fails is replaced by the entry's default, and false
+ * returned; entries without RAM and strings pass. Every default of a
+ * product's table must pass (tests/unit/test_hardening.c checks them
+ * all). The parameter store runs every restored value through it
+ * (co_store_validate).
  */
 bool co_od_validate(co_node_t *node, const co_od_entry_t *e);
 

@@ -31,13 +31,16 @@ void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limi
 
 static void refresh(co_incl_t *incl);
 
-/* Angle in [-180000, 180000) millidegrees. */
-static int32_t wrap180(int32_t a)
+/* Angle in [-180000, 180000) millidegrees. By whole turns, not by a
+ * division: the angles here are a few turns at most (the filter's input
+ * bound, co_filter.h), one or two passes; and no signed division helper
+ * in an MCU image. */
+static CO_NOINLINE int32_t wrap180(int32_t a)
 {
-    a %= FULL_TURN_MDEG;
-    if (a >= FULL_TURN_MDEG / 2) {
+    while (a >= FULL_TURN_MDEG / 2) {
         a -= FULL_TURN_MDEG;
-    } else if (a < -FULL_TURN_MDEG / 2) {
+    }
+    while (a < -FULL_TURN_MDEG / 2) {
         a += FULL_TURN_MDEG;
     }
     return a;
@@ -177,9 +180,12 @@ co_res_t co_incl_set_resolution(co_incl_t *incl, uint16_t res)
     }
     if (res != p->resolution) {
         p->resolution = res;
-        memset(p->preset, 0, sizeof(p->preset));
-        memset(p->offset, 0, sizeof(p->offset));
-        memset(p->diff, 0, sizeof(p->diff));
+        /* Presets, offsets and differential offsets: one run of int16_t. */
+        _Static_assert(offsetof(co_incl_para_t, diff) + sizeof(p->diff) -
+                               offsetof(co_incl_para_t, preset) ==
+                           sizeof(p->preset) + sizeof(p->offset) + sizeof(p->diff),
+                       "preset, offset, diff must be contiguous");
+        memset(p->preset, 0, sizeof(p->preset) + sizeof(p->offset) + sizeof(p->diff));
     }
     return CO_OK;
 }

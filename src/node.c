@@ -69,8 +69,9 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
     const co_lss_para_t *lss = node->ram[CO_CLS_LSS];
     if (kind == CO_RESET_NODE || co_cfg(node)->comm_reset_applies_id) {
         bool id_ok = lss != NULL && lss->node_id >= 1u && lss->node_id <= 127u;
-        if (lss != NULL && !id_ok && node->store.status[CO_CLS_LSS] == CO_STORE_OK) {
-            co_store_mark_corrupt(node, CO_CLS_LSS); /* a stored node-ID out of 1..127 */
+        if (lss != NULL && !id_ok) {
+            /* Defaults always hold a good one: a stored node-ID out of 1..127. */
+            co_store_mark_corrupt(node, CO_CLS_LSS);
         }
         node->node_id = id_ok ? lss->node_id : co_cfg(node)->default_node_id;
         node->bitrate = lss != NULL ? lss->bitrate : co_cfg(node)->default_bitrate;

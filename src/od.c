@@ -277,24 +277,20 @@ co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf
 bool co_od_validate(co_node_t *node, const co_od_entry_t *e)
 {
     uint8_t *p = ram_of(node, e);
-    if (p == NULL || (e->attr & CO_A_W) == 0u || !is_number(e) || co_od_read_hook(e) != NULL) {
-        return true; /* no value an SDO write could have put there */
+    if (p == NULL || !is_number(e)) {
+        return true; /* nothing stored there to judge */
     }
-    uint32_t raw = load_value(e, p);
-    uint32_t v = raw;
+    uint32_t v = load_value(e, p);
     if ((e->attr & CO_A_NODEID) != 0u) {
-        v = co_cobid_resolve(raw, e->def, node->node_id);
+        v = co_cobid_resolve(v, e->def, node->node_id);
     }
     node->od_checking = true;
     co_res_t r = write_value(node, e, v);
     node->od_checking = false;
-    if (r == CO_OK) {
-        return true;
+    if (r != CO_OK) {
+        store_value(e, p, e->def);
     }
-    store_value(e, p, e->def);
-    /* A default that fails (a table may ship one, such as a mapping that
-     * leaves a PDO invalid) is kept, not reported. */
-    return load_value(e, p) == raw;
+    return r == CO_OK;
 }
 
 void co_od_defaults(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)

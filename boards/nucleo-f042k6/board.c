@@ -251,10 +251,14 @@ bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
 void board_sensor(const product_t *p, int32_t values[], uint32_t *faults)
 {
     uint32_t t = ms_ticks % 20000u;
-    int32_t tri = (int32_t)(t < 10000u ? t : 20000u - t) - 5000; /* -5000..5000 */
+    uint32_t tri = t < 10000u ? t : 20000u - t; /* 0..10000 */
     for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && p->inputs[i].name != 0; i++) {
         const product_input_t *in = &p->inputs[i];
-        values[i] = in->initial + tri * in->limit / 50; /* limit x 1000 x 10 % x tri/5000 */
+        /* initial + (tri - 5000) x limit x 1000 x 10 % / 5000, in unsigned
+         * arithmetic (no signed division helper in the image): tri x limit
+         * <= 10000 x 100000 fits 32 bits. */
+        uint32_t lim = (uint32_t)in->limit;
+        values[i] = in->initial + (int32_t)(tri * lim / 50u) - (int32_t)(100u * lim);
     }
     *faults = 0;
 }

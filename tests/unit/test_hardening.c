@@ -239,6 +239,29 @@ static void test_stored_values_pass_sdo_validation(void)
     EXPECT(d, 0x093, "00 00 00 00 00 00 00 00"); /* sound again: error reset */
 }
 
+/* Every product's defaults pass its own validation: a saved set of
+ * defaults restores as a sound set (co_od_validate relies on it). */
+static void test_every_default_passes_validation(void)
+{
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        h_boot(d, product_list[i], false);
+        for (unsigned n = 0; n < d->nnodes; n++) {
+            CHECK_EQ(co_store_save(d->nodes[n], CO_CLS_PARA), CO_OK);
+            if (d->nodes[n]->cfg->ram_size[CO_CLS_LSS] != 0u) {
+                CHECK_EQ(co_store_save(d->nodes[n], CO_CLS_LSS), CO_OK);
+            }
+        }
+        h_power_cycle(d);
+        for (unsigned n = 0; n < d->nnodes; n++) {
+            if (d->nodes[n]->store.status[CO_CLS_PARA] != CO_STORE_OK ||
+                d->nodes[n]->store.status[CO_CLS_LSS] == CO_STORE_CORRUPT) {
+                fprintf(stderr, "%s node %u: its defaults fail validation\n", product_list[i]->id, n);
+                CHECK(!"a default fails validation");
+            }
+        }
+    }
+}
+
 /* ---- NVM that is neither erased nor a record -------------------------- */
 
 static void boot_on_nvm(const product_t *p, int fill)
@@ -358,6 +381,7 @@ int main(void)
     RUN(test_jd_differential_offset_range);
     RUN(test_jd_slope_saturates_with_any_stored_offset);
     RUN(test_stored_values_pass_sdo_validation);
+    RUN(test_every_default_passes_validation);
     RUN(test_nvm_neither_blank_nor_valid);
     RUN(test_filter_takes_any_input);
     RUN(test_div_round_whole_range);
