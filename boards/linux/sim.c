@@ -72,8 +72,10 @@ static bool can_command(sim_t *s, char **save, char *err, unsigned errlen)
     if (st == (int)CO_CAN_BUSOFF && arg != NULL) {
         char *end;
         hold = strtod(arg, &end);
-        if (end == arg || *end != '\0' || !isfinite(hold) || hold < 0.0 || hold > 3600.0) {
-            snprintf(err, errlen, "'%s': not a number of seconds within 0..3600", arg);
+        /* at most 30 min: the deadline stays within half the 32-bit
+         * microsecond clock the board's timers compare on */
+        if (end == arg || *end != '\0' || !isfinite(hold) || hold < 0.0 || hold > 1800.0) {
+            snprintf(err, errlen, "'%s': not a number of seconds within 0..1800", arg);
             return false;
         }
         arg = strtok_r(NULL, " \t\r", save);

@@ -119,6 +119,9 @@ static void test_sim_can_commands(void)
     CHECK(strstr(err, "usage: can bus-off [SECONDS]") != NULL);
     CHECK(!sim_command(&s, "can off", err, sizeof(err)));
     CHECK(!sim_command(&s, "can bus-off -1", err, sizeof(err)));
+    CHECK(!sim_command(&s, "can bus-off 1800.5", err, sizeof(err)));
+    CHECK(sim_command(&s, "can bus-off 1800", err, sizeof(err)) && s.can_hold_ms == 1800000u);
+    s.can_request = false;
     CHECK(!sim_command(&s, "can bus-off 1 2", err, sizeof(err)));
     CHECK(!sim_command(&s, "can passive 3", err, sizeof(err)));
     CHECK(!s.can_request);
@@ -466,8 +469,11 @@ static void test_sim_bus_off(void)
     }
     CHECK(emcy);
     CHECK(strstr(log_text(), "back from bus-off") != NULL);
-    /* `can active` during a long bus-off: only the recovery is left. */
+    /* `can active` during a long bus-off (longer than the port's cap of
+     * half the clock): only the recovery is left. */
     lp_sim_can(&p, CO_CAN_BUSOFF, end, 3600000000u, recovery);
+    (void)lp_poll(&p, end + 0x7FFFFFF0u);
+    CHECK_EQ(lp_can_state(&p), CO_CAN_BUSOFF);
     lp_sim_can(&p, CO_CAN_ACTIVE, end + 10u, 0, recovery);
     (void)lp_poll(&p, end + 10u + recovery - 1u);
     CHECK_EQ(lp_can_state(&p), CO_CAN_BUSOFF);
