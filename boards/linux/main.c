@@ -155,7 +155,7 @@ static void apply_can_command(app_t *a, uint32_t now)
     for (unsigned i = 0; i < a->nnodes; i++) {
         uint32_t kbps = product_kbps(a->prod, a->nodes[i]->bitrate);
         if (kbps == 0u) {
-            kbps = 125u; /* a code the product does not define: CiA 301's default */
+            kbps = 125u; /* a code the product does not define: the usual default */
         }
         /* 128 x 11 recessive bits at the node's bit rate, rounded up */
         uint32_t recovery_us = (LP_BUSOFF_RECOVERY_BITS * 1000u + kbps - 1u) / kbps;
