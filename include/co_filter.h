@@ -3,7 +3,7 @@
  * stages y += (x - y) >> k in Q8 millidegrees. Integer only (no FPU on the
  * target MCUs), no multiplication. At the 5 ms sample period the settling
  * time to within 0.01 deg after a 90 deg step is about 2.2 s (k = 5),
- * 0.52 s (k = 3) and 0.24 s (k = 2); tests/unit/test_filter.c measures it.
+ * 0.52 s (k = 3) and 0.24 s (k = 2); tests/unit/test_profile.c measures it.
  */
 #ifndef CO_FILTER_H
 #define CO_FILTER_H
@@ -11,6 +11,10 @@
 #include "co_common.h"
 
 #define CO_FILTER_STAGES 3u
+/* Largest input magnitude (mdeg, about 4194 deg): beyond it an input
+ * saturates, so that the Q8 arithmetic cannot overflow (filter.c). */
+#define CO_FILTER_IN_MAX 4194303
+
 /* Sample period the shifts are tuned for. */
 #define CO_FILTER_PERIOD_US 5000u
 
@@ -26,7 +30,8 @@ uint8_t co_filter_shift(uint8_t speed);
 void co_filter_reset(co_filter_t *f);
 
 /*
- * One sample in (millidegrees, |x| < 8e6), filtered value out.
+ * One sample in (millidegrees; beyond +-CO_FILTER_IN_MAX it saturates),
+ * filtered value out.
  * The first sample after a reset passes through unchanged.
  */
 int32_t co_filter_step(co_filter_t *f, int32_t x_mdeg, uint8_t shift);

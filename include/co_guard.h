@@ -11,11 +11,18 @@
  * request for guard time x factor is a life-guard event: EMCY 8130h in
  * the error table and, from operational, pre-operational. The next request
  * clears it (error reset EMCY when nothing else is active).
+ * The life time reaches 65535 ms x 255 = 4.6 h, beyond the 71.6 min of the
+ * wrapping microsecond clock (and the 35.8 min of co_time_before): it is
+ * timed in laps of at most CO_GUARD_LAP_MS, exactly, whatever its length.
  */
 #ifndef CO_GUARD_H
 #define CO_GUARD_H
 
 #include "co_common.h"
+
+/* Longest lap of the life time: 1e9 us stays well inside co_time_before's
+ * 2^31 us horizon, with room for a late poll. */
+#define CO_GUARD_LAP_MS 1000000u
 
 typedef struct co_node co_node_t;
 
@@ -25,7 +32,8 @@ typedef struct co_guard {
     bool seen;        /* a request came since the last reset */
     bool kick;        /* a request came: restart the life time at next poll */
     bool lost;        /* life-guard event active */
-    uint32_t deadline;
+    uint32_t deadline; /* end of the current lap of the life time */
+    uint32_t left_ms;  /* life time still to run after this lap */
 } co_guard_t;
 
 /* Reset communication: toggle 0, life guarding waits for the first request. */

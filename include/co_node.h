@@ -91,7 +91,9 @@ typedef struct co_node_cfg {
     uint8_t default_node_id;
     uint8_t default_bitrate;    /* product's code for its default bit rate */
     uint8_t tpdo_dlc;           /* 0: DLC = mapped bytes; 8: pad with zeros */
-    uint16_t inhibit_unit_us;   /* unit of 0x1800+n sub 3; 0: CiA 301's 100 us */
+    uint16_t inhibit_unit_us;   /* unit of 0x1800+n sub 3; 0: CiA 301's 100 us; at most
+                                 * 1000, so that 65535 units stay inside the 2^31 us a
+                                 * wrapping deadline can span (a larger one counts as 1000) */
     uint32_t store_write_limit; /* 0: unlimited */
     bool autosave;              /* every SDO write to a stored entry is stored at once */
     bool load_keeps_lss;        /* 0x1011 "load" leaves node-ID and bit rate alone */
@@ -112,6 +114,7 @@ struct co_node {
     uint8_t reset_request;      /* co_reset_t to perform at the next poll (0: none) */
     bool dirty;                 /* something happened since the last full poll */
     bool due_never;             /* the last full poll found no deadline at all */
+    bool od_checking;           /* write hooks only validate (co_od_check) */
     co_nmt_t nmt;
     const co_node_cfg_t *cfg;
     void *port;                 /* board context for co_port_* */
@@ -166,6 +169,12 @@ static inline void co_node_wake(co_node_t *node)
     node->dirty = true;
 }
 
+/* A write hook runs for co_od_check(): validate the value, act on nothing. */
+static inline bool co_od_checking(const co_node_t *node)
+{
+    return node->od_checking;
+}
+
 /* Reset at the next poll, after the answer to the current request went out. */
 static inline void co_node_request_reset(co_node_t *node, co_reset_t kind)
 {
@@ -186,7 +195,8 @@ void co_node_receive(co_node_t *node, const co_frame_t *f);
  */
 uint32_t co_node_poll(co_node_t *node, uint32_t now);
 
-/* Send through the port, counting frames the board could not queue. */
+/* Send through the port, counting frames the board could not queue; nothing
+ * is sent while the controller is bus-off (counted the same way). */
 bool co_node_send(co_node_t *node, const co_frame_t *f);
 
 /* The board's view of the CAN controller (LEDs, diagnostics). */

@@ -55,7 +55,10 @@ typedef enum co_cls {
 /*
  * Write hook: called instead of the plain store after access, length and
  * range checks passed. It may validate further, act, and call co_od_store()
- * to keep the value. Read hook: computes the value of a numeric entry.
+ * to keep the value. A hook of a stored entry (class PARA or LSS) also
+ * serves co_od_check(): while co_od_checking(node), it checks the value and
+ * returns CO_OK or the abort code without acting. Read hook: computes the
+ * value of a numeric entry.
  */
 typedef co_res_t (*co_od_write_fn)(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 typedef co_res_t (*co_od_read_fn)(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
@@ -109,12 +112,29 @@ typedef struct co_od {
  * default, and the node-ID is added on every read. A master writing
  * "base + current node-ID" is stored as the base again, so a saved default
  * COB-ID follows a later node-ID change (CiA 301 behaviour).
+ * A master writing the base itself (0x80 for EMCY: a legal CAN-ID) means
+ * that CAN-ID, not "follow the node-ID": it is kept with CO_COBID_ABS, a
+ * bit no COB-ID write accepts (11-bit IDs: bits 11..28 are zero), so it
+ * reads back and acts as written. Records stored before the flag existed
+ * never hold it, and read as they always did.
  */
+#define CO_COBID_ABS 0x10000000u
 uint32_t co_cobid_resolve(uint32_t raw, uint32_t def, uint8_t node_id);
 
 /* CiA 301 7.3.5 restricted CAN-IDs (NMT, SDO, LSS, NMT error control, ...):
  * no configurable COB-ID (SYNC, EMCY, PDO) may use one. */
 bool co_cobid_restricted(uint32_t id);
+
+/*
+ * The value rules every COB-ID object shares (CiA 301 7.5.2): bit 29 (a
+ * 29-bit frame) and bits 11..28 zero, since this stack speaks 11-bit CAN-IDs
+ * only; bit 30 only where the object gives it a meaning this node supports
+ * (bit30_ok: a TPDO's "no RTR"; never SYNC's "generate", nor EMCY's
+ * reserved bit); and a CAN-ID that is not restricted, unless bit 31 marks
+ * the object invalid (bit31_invalid: EMCY, PDO; SYNC's bit 31 means
+ * nothing). CO_OK or CO_E_VAL (0x06090030).
+ */
+co_res_t co_cobid_check(uint32_t value, bool bit30_ok, bool bit31_invalid);
 
 /*
  * Find (index, sub). Returns the entry, or NULL with *res set to
@@ -144,6 +164,18 @@ co_res_t co_od_read(co_node_t *node, const co_od_entry_t *e, uint32_t at, uint8_
  * write hook or stores the value.
  */
 co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len);
+
+/*
+ * Check, without storing or acting, that the value a writable entry e
+ * holds in RAM could be written to it by SDO: its default always can;
+ * otherwise the limits, then the write hook in check mode. In check mode
+ * (co_od_checking(node) true) a hook validates the value alone and returns
+ * before any rule of sequence ("invalidate the PDO first"), any store and
+ * any action (a plain entry stores the value it holds again). CO_OK for
+ * read-only entries, entries without RAM, strings and computed values.
+ * The parameter store runs every restored value through it.
+ */
+co_res_t co_od_check(co_node_t *node, const co_od_entry_t *e);
 
 /* Plain store of a numeric value into the entry's RAM (no checks, no hook). */
 co_res_t co_od_store(co_node_t *node, const co_od_entry_t *e, uint32_t value);

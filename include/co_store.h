@@ -36,7 +36,10 @@ typedef enum co_store_status {
     CO_STORE_OK = 0,       /* a valid record was applied */
     CO_STORE_BLANK,        /* nothing ever stored: defaults */
     CO_STORE_DEFAULTS,     /* "load" was requested: defaults */
-    CO_STORE_CORRUPT,      /* records exist but none is valid: defaults */
+    CO_STORE_CORRUPT,      /* the slots hold something (not erased) but no valid record:
+                            * defaults; or the newest record passed its CRC but some
+                            * values failed validation (co_od_check): those are
+                            * defaults. Stays until the next full save */
     CO_STORE_HW,           /* NVM read failed: defaults */
 } co_store_status_t;
 
@@ -52,6 +55,8 @@ void co_store_init(co_node_t *node);
  * Restore the entries of class cls with index in [lo, hi] from the newest
  * valid record, or set them to their defaults; [0, 0xFFFF] restores the
  * whole struct (the LSS struct has no dictionary entries of its own).
+ * Every restored value then passes co_od_check(), as an SDO write of it
+ * would; one that fails takes its default (status CO_STORE_CORRUPT).
  * Returns and remembers why.
  */
 co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi);
@@ -71,6 +76,24 @@ co_res_t co_store_save(co_node_t *node, co_cls_t cls);
  */
 co_res_t co_store_save_group(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi,
                              bool defaults);
+
+/*
+ * A value of the restored set of cls that only the product can judge (the
+ * DST's bit-rate code, kept without a dictionary entry) failed: the product
+ * set it to its default; the set is reported as corrupt, like one whose
+ * values fail co_od_check(), until the next full save.
+ */
+void co_store_mark_corrupt(co_node_t *node, co_cls_t cls);
+
+/*
+ * Keep EMCY 6300h ("data set", CiA 301) active in the error table while the
+ * last restore of PARA or LSS found a corrupt set or could not read the
+ * NVM, and clear it once a full save made the set sound again. For the
+ * products whose manuals name no other report of their own (the DST has
+ * 0x4001): call it from the product's poll hook; it only acts while EMCY
+ * may be sent (pre-operational, operational), so no report is lost.
+ */
+void co_store_report_emcy(co_node_t *node);
 
 /* Make the next restore of cls use defaults (0x1011 "load"). */
 co_res_t co_store_request_defaults(co_node_t *node, co_cls_t cls);

@@ -26,9 +26,12 @@ co_res_t dst_write_hb(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 
 co_res_t dst_write_emcy_cobid(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
-    /* CiA 301: bits 30..29 must be 0 (no RTR, 11-bit); an 11-bit CAN-ID. */
-    if ((v & 0x7FFFF800u) != 0u || (v & 0x7FFu) == 0u) {
-        return CO_E_VAL;
+    /* CiA 301: bits 30..29 must be 0 (no RTR, 11-bit); an 11-bit CAN-ID,
+     * not a restricted one while valid. The manual sets no rule on when the
+     * CAN-ID may change: any time. */
+    co_res_t c = co_cobid_check(v, false, true);
+    if (c != CO_OK || co_od_checking(n)) {
+        return c;
     }
     return co_od_store(n, e, v);
 }
@@ -84,6 +87,9 @@ co_res_t dst_write_bitrate(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 
 co_res_t dst_write_coding(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
+    if (co_od_checking(n)) {
+        return CO_OK;
+    }
     co_res_t r = co_od_store(n, e, v);
     n->pdo_msb_first = dev_of(n)->para.pdo_coding == 0u;
     return r;
@@ -95,12 +101,18 @@ co_res_t dst_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     if (v != 10u && v != 50u && v != 100u && v != 500u && v != 1000u) {
         return CO_E_VAL;
     }
+    if (co_od_checking(n)) {
+        return CO_OK;
+    }
     return co_incl_set_resolution(&dev_of(n)->incl, (uint16_t)v);
 }
 
 co_res_t dst_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
     /* Immediate (manual L1018): the output equals the preset from now on. */
+    if (co_od_checking(n)) {
+        return CO_OK;
+    }
     unsigned axis = e->index == 0x6012u ? 0u : 1u;
     co_incl_set_preset(&dev_of(n)->incl, axis, (int16_t)v);
     return CO_OK;
@@ -130,6 +142,13 @@ static void dst_reset(co_node_t *n, co_reset_t kind)
 {
     dst_dev_t *d = dev_of(n);
     (void)kind;
+    if (d->lss.bitrate > 7u) {
+        /* A stored code beyond the table (0..7, as 0x20F2 accepts): the
+         * default, and the set reported as corrupt (0x4001 bit 6). */
+        d->lss.bitrate = co_cfg(n)->default_bitrate;
+        n->bitrate = d->lss.bitrate;
+        co_store_mark_corrupt(n, CO_CLS_LSS);
+    }
     /* Both copies read the active values after a reset (B-46). */
     d->vol.id[0] = d->vol.id[1] = n->node_id;
     d->vol.br[0] = d->vol.br[1] = d->lss.bitrate;

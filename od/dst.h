@@ -107,7 +107,7 @@ extern const product_t dst_x710_xy10, dst_x710_xy15, dst_x710_xy20, dst_x710_xy3
 #define DST_BITRATES                                                                    \
     (PRODUCT_BR_20K | PRODUCT_BR_50K | PRODUCT_BR_125K | PRODUCT_BR_250K | PRODUCT_BR_500K | \
      PRODUCT_BR_800K | PRODUCT_BR_1000K)
-#define DST_XY_INPUTS {{"x", PRODUCT_TEXT("deg"), 0, 3600}, {"y", PRODUCT_TEXT("deg"), 0, 3600}}
-#define DST_Z_INPUTS {{"z", PRODUCT_TEXT("deg"), 0, 3600}}
+#define DST_XY_INPUTS {{"x", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}, {"y", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}}
+#define DST_Z_INPUTS {{"z", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}}
 
 #endif /* DST_H */

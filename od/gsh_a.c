@@ -86,7 +86,7 @@ const co_node_cfg_t gsh_ch2_cfg = GSH_CFG(&ch2_od, 0x14);
 
 #define GSH_INPUTS                                                                       \
     {{"length", PRODUCT_TEXT("mm"), 0, 100000},                                          \
-     {"angle", PRODUCT_TEXT("deg"), 0, 3600},                                            \
+     {"angle", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT},                                            \
      {"field", PRODUCT_TEXT("%"), 100000, 1000}}
 #define GSH_FAULTS {PRODUCT_TEXT("extension-element"), PRODUCT_TEXT("tilt-element"), NULL, NULL}
 #define GSH_BITRATES                                                                     \

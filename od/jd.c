@@ -85,6 +85,24 @@ static int32_t clamp16(int32_t v)
     return v > INT16_MAX ? INT16_MAX : (v < INT16_MIN ? INT16_MIN : v);
 }
 
+static int32_t clamp32(int64_t v)
+{
+    return v > INT32_MAX ? INT32_MAX : (v < INT32_MIN ? INT32_MIN : (int32_t)v);
+}
+
+/* The largest differential offset, in resolution units: JD1 (-N/2, N/2]
+ * (6114h: -17999..18000 at 0.01 deg, L1783-1791), JD2 +-90 deg (the
+ * spec's recommendation; the manual gives none). Beyond: 0x06090030. */
+static bool diff_ok(const jd_dev_t *d, int32_t v)
+{
+    if (d->axes == 1u) {
+        int32_t half = turn_lsb(d) / 2;
+        return v > -half && v <= half;
+    }
+    int32_t lim = 90000 / (int32_t)d->para.resolution;
+    return v >= -lim && v <= lim;
+}
+
 /* The slope of one axis, 16- or 32-bit flavour (R51, R53, R54, R56). */
 static int32_t slope(const jd_dev_t *d, unsigned axis, bool wide)
 {
@@ -97,13 +115,22 @@ static int32_t slope(const jd_dev_t *d, unsigned axis, bool wide)
     if ((op & CO_INCL_OP_INVERT) != 0u) {
         v = -v;
     }
+    int32_t off = 0;
+    int32_t diff = 0;
     if ((op & CO_INCL_OP_SCALING) != 0u) {
-        v += wide ? p->off32[axis] + p->diff32[axis] : p->off16[axis] + p->diff16[axis];
+        off = wide ? p->off32[axis] : p->off16[axis];
+        diff = wide ? p->diff32[axis] : p->diff16[axis];
     }
     if (d->axes == 1u) {
-        return mod_pos(v, turn_lsb(d)); /* 0..N-1 */
+        /* 0..N-1: each term reduced first, so the sum never overflows
+         * whatever a stored offset holds (N <= 36000). */
+        int32_t n = turn_lsb(d);
+        return mod_pos(mod_pos(v, n) + mod_pos(off, n) + mod_pos(diff, n), n);
     }
-    return wide ? v : clamp16(v);
+    /* Saturated, never wrapped: the output stops at the type's end (R53:
+     * "clamp only to the data type's range"). */
+    int32_t sum = clamp32((int64_t)v + off + diff);
+    return wide ? sum : clamp16(sum);
 }
 
 /* ---- dictionary hooks ------------------------------------------------ */
@@ -129,6 +156,7 @@ co_res_t jd_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     jd_dev_t *d = dev_of(n);
     unsigned axis = (e->index == 0x2601u || e->index == 0x6022u || e->index == 0x6122u) ? 1u : 0u;
     int32_t p = e->size == 2u ? (int32_t)(int16_t)v : (int32_t)v;
+    int32_t lim = 90000 / (int32_t)d->para.resolution;
     if (d->axes == 1u) {
         if (e->size == 2u) {
             p = (int32_t)(uint16_t)v; /* 0..N-1, an unsigned bit pattern (2600h) */
@@ -136,11 +164,11 @@ co_res_t jd_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
         if (p < 0 || p >= turn_lsb(d)) {
             return CO_E_VAL;
         }
-    } else {
-        int32_t lim = 90000 / (int32_t)d->para.resolution;
-        if (p < -lim || p > lim) {
-            return CO_E_VAL; /* +-90 deg (C7, C8) */
-        }
+    } else if (p < -lim || p > lim) {
+        return CO_E_VAL; /* +-90 deg (C7, C8) */
+    }
+    if (co_od_checking(n)) {
+        return CO_OK;
     }
     int32_t m = measure(d, axis);
     int32_t m16 = (d->para.op16[axis] & CO_INCL_OP_INVERT) != 0u ? -m : m;
@@ -151,22 +179,47 @@ co_res_t jd_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     return CO_OK;
 }
 
+co_res_t jd_write_diff(co_node_t *n, const co_od_entry_t *e, uint32_t v)
+{
+    int32_t x = e->size == 2u ? (int32_t)(int16_t)v : (int32_t)v;
+    if (!diff_ok(dev_of(n), x)) {
+        return CO_E_VAL;
+    }
+    return co_od_checking(n) ? CO_OK : co_od_store(n, e, v);
+}
+
+/* v in unit old, rounded into unit now (both 10, 100 or 1000): a division
+ * by 10 or 100, or a saturated multiplication, so that any stored value
+ * (offsets are not written by SDO) gives a defined result; no 64-bit
+ * division on the MCU. */
+static int32_t rescale(int32_t v, int32_t old, int32_t now)
+{
+    if (now >= old) {
+        return co_div_round(v, now / old); /* any v: see co_div_round */
+    }
+    int32_t k = old / now;
+    return clamp32((int64_t)v * k);
+}
+
 co_res_t jd_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
     (void)e;
     if (v != 10u && v != 100u && v != 1000u) {
         return CO_E_VAL;
     }
+    if (co_od_checking(n)) {
+        return CO_OK;
+    }
     jd_para_t *p = &dev_of(n)->para;
     int32_t old = (int32_t)p->resolution;
     int32_t now = (int32_t)v;
     /* Every preset and offset follows into the new unit (R55). */
     for (unsigned a = 0; a < 2u; a++) {
-        p->preset[a] = co_div_round(p->preset[a] * old, now);
-        p->off16[a] = (int16_t)clamp16(co_div_round(p->off16[a] * old, now));
-        p->off32[a] = co_div_round(p->off32[a] * old, now);
-        p->diff16[a] = (int16_t)clamp16(co_div_round(p->diff16[a] * old, now));
-        p->diff32[a] = co_div_round(p->diff32[a] * old, now);
+        p->preset[a] = rescale(p->preset[a], old, now);
+        p->off16[a] = (int16_t)clamp16(rescale(p->off16[a], old, now));
+        p->off32[a] = rescale(p->off32[a], old, now);
+        p->diff16[a] = (int16_t)clamp16(rescale(p->diff16[a], old, now));
+        p->diff32[a] = rescale(p->diff32[a], old, now);
     }
     p->resolution = (uint16_t)v;
     return CO_OK;
@@ -175,6 +228,9 @@ co_res_t jd_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 co_res_t jd_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
     /* 0x1800:05, 0x1801:05 and 0x2200 are one value (R20). */
+    if (co_od_checking(n)) {
+        return CO_OK;
+    }
     co_res_t r = co_od_store(n, e, v);
     co_tpdo_reconfig(n, 0);
     co_tpdo_reconfig(n, 1);
@@ -183,6 +239,9 @@ co_res_t jd_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 
 co_res_t jd_write_inhibit(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
+    if (co_od_checking(n)) {
+        return CO_OK; /* any value; the "only while invalid" rule is of sequence */
+    }
     const co_od_entry_t *cob = co_node_entry(n, e->index, 1);
     uint32_t c = 0;
     (void)co_od_get(n, cob, &c);
@@ -268,8 +327,18 @@ static void jd_leds(co_node_t *n, co_led_pattern_t *g, co_led_pattern_t *r)
     }
 }
 
+static uint32_t jd_poll(co_node_t *n, uint32_t now)
+{
+    (void)now;
+    /* A broken stored set: defaults and the red LED blinking (R11), and
+     * CiA 301's EMCY 6300h, so that a master learns it too. */
+    co_store_report_emcy(n);
+    return CO_NEVER;
+}
+
 const co_node_ops_t jd_ops = {
     .reset = jd_reset,
+    .poll = jd_poll,
     .can_state = co_emcy_can_state, /* 8120h, 8140h (R34) */
     .lss_store = jd_lss_store,
     .leds = jd_leds,
@@ -343,7 +412,19 @@ void jd_sample(void *mem, const int32_t values[], uint32_t faults)
     }
     maf(d, in);
     if (d->axes == 1u) {
-        d->raw[0] = mod_pos(d->raw[0], TURN);
+        /* Back into 0..360 deg, and the averaged inputs with it: the next
+         * input is put on the side of raw[0], so the window must stay in
+         * raw[0]'s frame (else a turn's worth of offset enters the mean and
+         * sticks: 1 deg read as 271 after crossing 0). Inputs then stay
+         * within half a turn of [0, 360): the sum is bounded. */
+        int32_t shift = d->raw[0] - mod_pos(d->raw[0], TURN);
+        if (shift != 0) {
+            for (unsigned i = 0; i < d->maf_fill; i++) {
+                d->maf_buf[0][i] -= shift;
+            }
+            d->maf_sum[0] -= shift * (int32_t)d->maf_fill;
+            d->raw[0] -= shift;
+        }
     }
     /* Rates (0.1 deg/s) from the 5 ms sample period, accelerations (mg). */
     int32_t x = values[0];

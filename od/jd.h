@@ -72,6 +72,7 @@ co_res_t jd_write_save_reset(co_node_t *n, const co_od_entry_t *e, uint32_t v);
 co_res_t jd_write_node_number(co_node_t *n, const co_od_entry_t *e, uint32_t v);
 co_res_t jd_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v);
 co_res_t jd_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v);
+co_res_t jd_write_diff(co_node_t *n, const co_od_entry_t *e, uint32_t v);
 co_res_t jd_read_preset(co_node_t *n, const co_od_entry_t *e, uint32_t *v);
 co_res_t jd_read_slope(co_node_t *n, const co_od_entry_t *e, uint32_t *v);
 co_res_t jd_read_sensor(co_node_t *n, const co_od_entry_t *e, uint32_t *v);

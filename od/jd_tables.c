@@ -93,13 +93,13 @@
     {.index = (base) + 1, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(op16[ax]), .def = 0, CO_EXT(.min = 0, .max = 3), CO_NAME("Slope " nm "16 operating parameter")}, \
     {.index = (base) + 2, .sub = 0, CO_TYPE_I16, .attr = RW, CO_EXT(.write = jd_write_preset, .read = jd_read_preset), CO_NAME("Slope " nm "16 preset value")}, \
     {.index = (base) + 3, .sub = 0, CO_TYPE_I16, .attr = RO, PARA(off16[ax]), .def = 0, CO_NAME("Slope " nm "16 offset")}, \
-    {.index = (base) + 4, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(diff16[ax]), .def = 0, CO_NAME("Differential slope " nm "16 offset")}
+    {.index = (base) + 4, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(diff16[ax]), .def = 0, CO_EXT(.write = jd_write_diff), CO_NAME("Differential slope " nm "16 offset")}
 #define JD_AXIS32(base, ax, nm) \
     {.index = (base), .sub = 0, CO_TYPE_I32, .attr = RO | PDO, CO_EXT(.read = jd_read_slope), CO_NAME("Slope " nm "32")}, \
     {.index = (base) + 1, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(op32[ax]), .def = 0, CO_EXT(.min = 0, .max = 3), CO_NAME("Slope " nm "32 operating parameter")}, \
     {.index = (base) + 2, .sub = 0, CO_TYPE_I32, .attr = RW, PARA(preset[ax]), .def = 0, CO_EXT(.write = jd_write_preset), CO_NAME("Slope " nm "32 preset value")}, \
     {.index = (base) + 3, .sub = 0, CO_TYPE_I32, .attr = RO, PARA(off32[ax]), .def = 0, CO_NAME("Slope " nm "32 offset")}, \
-    {.index = (base) + 4, .sub = 0, CO_TYPE_I32, .attr = RW, PARA(diff32[ax]), .def = 0, CO_NAME("Differential slope " nm "32 offset")}
+    {.index = (base) + 4, .sub = 0, CO_TYPE_I32, .attr = RW, PARA(diff32[ax]), .def = 0, CO_EXT(.write = jd_write_diff), CO_NAME("Differential slope " nm "32 offset")}
 
 static const co_od_entry_t jd2_entries[] = {
     JD_COMM(0x0002019Au, "JD2xxx"),
@@ -161,14 +161,14 @@ static const uint8_t axes1 = 1;
 
 const product_t jd2xxx = {
     .id = PRODUCT_TEXT("jd2xxx"), .summary = PRODUCT_TEXT("ifm JD2xxx dual axis +-90 deg, LSS (CiA 410)"),
-    .inputs = {{"x", PRODUCT_TEXT("deg"), 0, 3600}, {"y", PRODUCT_TEXT("deg"), 0, 3600},
+    .inputs = {{"x", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}, {"y", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT},
                {"temp", PRODUCT_TEXT("degC"), 25000, 200}},
     .nodes = 1, .inst_size = sizeof(jd_dev_t), .create = jd_create, .sample = jd_sample,
     .variant = &axes2, .cfg = &jd2_cfg, .vendor = PRODUCT_TEXT("ifm electronic"), .bitrates = JD_BITRATES,
     .lss = true, .kbps = product_kbps_ifm};
 const product_t jd1xxx = {
     .id = PRODUCT_TEXT("jd1xxx"), .summary = PRODUCT_TEXT("ifm JD1xxx single axis 0..360 deg, LSS (CiA 410)"),
-    .inputs = {{"z", PRODUCT_TEXT("deg"), 0, 3600}, {"temp", PRODUCT_TEXT("degC"), 25000, 200}},
+    .inputs = {{"z", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}, {"temp", PRODUCT_TEXT("degC"), 25000, 200}},
     .nodes = 1, .inst_size = sizeof(jd_dev_t), .create = jd_create, .sample = jd_sample,
     .variant = &axes1, .cfg = &jd1_cfg, .vendor = PRODUCT_TEXT("ifm electronic"), .bitrates = JD_BITRATES,
     .lss = true, .kbps = product_kbps_ifm};

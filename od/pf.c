@@ -20,6 +20,9 @@ co_res_t pf_write_bitrate(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     if (v != PF_BR_125K && v != PF_BR_250K && v != PF_BR_500K && v != PF_BR_1M) {
         return CO_E_VAL;
     }
+    if (co_od_checking(n)) {
+        return CO_OK;
+    }
     return co_od_store(n, e, v);
 }
 
@@ -33,6 +36,9 @@ co_res_t pf_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 co_res_t pf_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
     /* Zero point: the output equals the preset at once when scaling is on (R56). */
+    if (co_od_checking(n)) {
+        return CO_OK;
+    }
     co_incl_set_preset(&dev_of(n)->incl, e->index == 0x6012u ? 0u : 1u, (int16_t)v);
     return CO_OK;
 }
@@ -57,10 +63,7 @@ static uint32_t pf_poll(co_node_t *n, uint32_t now)
     }
     (void)co_emcy_error(n, CO_EMCY_VOLTAGE_LOW, CO_ER_VOLTAGE,
                         (d->faults & PF_FAULT_UNDERVOLTAGE) != 0u, NULL);
-    uint8_t st = n->store.status[CO_CLS_PARA];
-    bool bad = st == CO_STORE_CORRUPT || st == CO_STORE_HW ||
-               n->store.status[CO_CLS_LSS] == CO_STORE_CORRUPT;
-    (void)co_emcy_error(n, CO_EMCY_DATA_SET, 0, bad, NULL);
+    co_store_report_emcy(n); /* 6300h: a corrupt stored set (R52) */
     return CO_NEVER;
 }
 

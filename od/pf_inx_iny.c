@@ -103,14 +103,14 @@ static const pf_variant_t v_iny = {.cfg = &pf_iny_cfg, .axes = 2};
 
 const product_t pf_inx360d = {
     .id = PRODUCT_TEXT("inx360d"), .summary = PRODUCT_TEXT("Pepperl+Fuchs INX360D single axis 0..359.9 deg (CiA 410)"),
-    .inputs = {{"x", PRODUCT_TEXT("deg"), 0, 3600}},
+    .inputs = {{"x", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}},
     .faults = {PRODUCT_TEXT("range-x"), PRODUCT_TEXT(PRODUCT_TEXT("range-y")), PRODUCT_TEXT("undervoltage"), NULL},
     .nodes = 1, .inst_size = sizeof(pf_dev_t), .create = pf_create, .sample = pf_sample,
     .variant = &v_inx, .cfg = &pf_inx_cfg, .vendor = PRODUCT_TEXT("Pepperl+Fuchs"), .bitrates = PF_EDS_BITRATES,
     .kbps = product_kbps_pf};
 const product_t pf_iny360d = {
     .id = PRODUCT_TEXT("iny360d"), .summary = PRODUCT_TEXT("Pepperl+Fuchs INY360D dual axis 0..359.9 deg (CiA 410)"),
-    .inputs = {{"x", PRODUCT_TEXT("deg"), 0, 3600}, {"y", PRODUCT_TEXT("deg"), 0, 3600}},
+    .inputs = {{"x", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}, {"y", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}},
     .faults = {PRODUCT_TEXT("range-x"), PRODUCT_TEXT(PRODUCT_TEXT("range-y")), PRODUCT_TEXT("undervoltage"), NULL},
     .nodes = 1, .inst_size = sizeof(pf_dev_t), .create = pf_create, .sample = pf_sample,
     .variant = &v_iny, .cfg = &pf_iny_cfg, .vendor = PRODUCT_TEXT("Pepperl+Fuchs"), .bitrates = PF_EDS_BITRATES,

@@ -9,6 +9,7 @@
 
 #include <stddef.h>
 
+#include "co_filter.h"
 #include "co_node.h"
 
 /* Largest number of nodes one product runs (the redundant GSH-A has two). */
@@ -28,6 +29,13 @@ typedef struct product product_t;
 #else
 #define PRODUCT_TEXT(s) (s)
 #endif
+
+/* Largest magnitude of a simulated angle input (deg): ten turns each way.
+ * The angle filter takes it without saturating (board input limit vs the
+ * filter's bound: co_filter.h). */
+#define PRODUCT_ANGLE_LIMIT 3600
+_Static_assert(PRODUCT_ANGLE_LIMIT * 1000 <= CO_FILTER_IN_MAX,
+               "angle inputs must stay within the filter's input bound");
 
 /* One simulated physical input. */
 typedef struct product_input {

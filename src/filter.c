@@ -16,7 +16,17 @@ void co_filter_reset(co_filter_t *f)
 
 int32_t co_filter_step(co_filter_t *f, int32_t x_mdeg, uint8_t shift)
 {
-    int32_t v = x_mdeg * 256; /* Q8; |x| < 8e6 keeps this inside int32 */
+    /* Safe by construction: |x| <= CO_FILTER_IN_MAX = 2^22 - 1 gives
+     * |v| < 2^30 in Q8; every stage is a weighted mean of such values, so
+     * |s| < 2^30 too, and v - s stays within +-2^31 - 1, as does v + 128.
+     * The inputs of every product are far smaller (product.h asserts it);
+     * a larger one saturates instead of overflowing. */
+    if (x_mdeg > CO_FILTER_IN_MAX) {
+        x_mdeg = CO_FILTER_IN_MAX;
+    } else if (x_mdeg < -CO_FILTER_IN_MAX) {
+        x_mdeg = -CO_FILTER_IN_MAX;
+    }
+    int32_t v = x_mdeg * 256; /* Q8 */
     if (!f->primed) {
         for (unsigned i = 0; i < CO_FILTER_STAGES; i++) {
             f->s[i] = v;

@@ -42,11 +42,20 @@ bool co_guard_receive(co_node_t *node, const co_frame_t *f)
     g->toggle ^= 0x80u;
     g->seen = true;
     g->kick = true;
+    g->deadline = node->now; /* the life time runs from this request */
     if (g->lost) {
         g->lost = false;
         (void)co_emcy_error(node, CO_EMCY_LIFE_GUARD, CO_ER_COMM, false, NULL);
     }
     return true;
+}
+
+/* Start the next lap of the life time at 'from'. */
+static void next_lap(co_guard_t *g, uint32_t from)
+{
+    uint32_t lap = co_min_u32(g->left_ms, CO_GUARD_LAP_MS);
+    g->left_ms -= lap;
+    g->deadline = from + lap * 1000u; /* <= 1e9 us: no overflow */
 }
 
 uint32_t co_guard_poll(co_node_t *node, uint32_t now)
@@ -55,23 +64,29 @@ uint32_t co_guard_poll(co_node_t *node, uint32_t now)
     if (!g->enabled || !g->seen || g->lost || node->hb.period_ms != 0u) {
         return CO_NEVER;
     }
+    /* Life time = guard time x life time factor (CiA 301), up to
+     * 65535 x 255 ms: 32 bits hold it in ms, not in us. */
     uint32_t life_ms = get(node, 0x100C) * get(node, 0x100D);
     if (life_ms == 0u) {
         return CO_NEVER;
     }
     if (g->kick) {
         g->kick = false;
-        g->deadline = now + life_ms * 1000u;
+        g->left_ms = life_ms;
+        next_lap(g, g->deadline); /* from the request's time (receive) */
     }
-    if (co_time_before(now, g->deadline)) {
-        return g->deadline - now;
+    while (!co_time_before(now, g->deadline)) {
+        if (g->left_ms == 0u) {
+            g->lost = true;
+            (void)co_emcy_error(node, CO_EMCY_LIFE_GUARD, CO_ER_COMM, true, NULL);
+            if (node->nmt.state == CO_NMT_OPERATIONAL) {
+                co_nmt_enter(node, CO_NMT_PREOP); /* CiA 301 default error behaviour */
+            }
+            return CO_NEVER;
+        }
+        next_lap(g, g->deadline); /* laps end to end: no drift */
     }
-    g->lost = true;
-    (void)co_emcy_error(node, CO_EMCY_LIFE_GUARD, CO_ER_COMM, true, NULL);
-    if (node->nmt.state == CO_NMT_OPERATIONAL) {
-        co_nmt_enter(node, CO_NMT_PREOP); /* CiA 301 default error behaviour */
-    }
-    return CO_NEVER;
+    return g->deadline - now;
 }
 
 const co_service_t co_guard_service = {.receive = co_guard_receive, .poll = co_guard_poll,

@@ -18,6 +18,9 @@ void co_hb_reconfig(co_node_t *node)
 
 co_res_t co_hb_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
+    if (co_od_checking(node)) {
+        return CO_OK;
+    }
     co_res_t r = co_od_store(node, e, value);
     if (r == CO_OK) {
         co_hb_reconfig(node);
@@ -42,6 +45,8 @@ uint32_t co_hb_poll(co_node_t *node, uint32_t now)
     if (hb->period_ms == 0u || node->nmt.state == CO_NMT_INIT) {
         return CO_NEVER;
     }
+    /* u16 ms x 1000 <= 65 535 000 us: no overflow, and far inside
+     * co_time_before's 2^31 us horizon. */
     uint32_t period = (uint32_t)hb->period_ms * 1000u;
     if (hb->restart) {
         hb->restart = false;

@@ -28,6 +28,9 @@ co_res_t co_hbc_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t val
     if ((value & 0xFF000000u) != 0u || ((value >> 16) & 0xFFu) > 127u) {
         return CO_E_VAL;
     }
+    if (co_od_checking(node)) {
+        return CO_OK;
+    }
     co_res_t r = co_od_store(node, e, value);
     if (r == CO_OK) {
         co_hbc_reconfig(node);
@@ -44,6 +47,7 @@ bool co_hbc_receive(co_node_t *node, const co_frame_t *f)
     }
     c->started = true;
     c->kick = true;
+    c->deadline = node->now; /* the time runs from this heartbeat */
     if (c->lost) {
         c->lost = false;
         (void)co_emcy_error(node, CO_EMCY_LIFE_GUARD, CO_ER_COMM, false, NULL);
@@ -59,7 +63,9 @@ uint32_t co_hbc_poll(co_node_t *node, uint32_t now)
     }
     if (c->kick) {
         c->kick = false;
-        c->deadline = now + (uint32_t)c->time_ms * 1000u;
+        /* u16 ms x 1000 <= 65 535 000 us: far inside co_time_before's
+         * 2^31 us horizon, no overflow. */
+        c->deadline += (uint32_t)c->time_ms * 1000u;
     }
     if (co_time_before(now, c->deadline)) {
         return c->deadline - now;

@@ -9,7 +9,16 @@
 
 int32_t co_div_round(int32_t a, int32_t b)
 {
-    return a >= 0 ? (a + b / 2) / b : -((-a + b / 2) / b);
+    /* Half away from zero for every a: one division, and no a + b/2 that
+     * could overflow near INT32_MAX (nor -a at INT32_MIN). */
+    int32_t q = a / b;
+    int32_t r = a - q * b; /* the sign of a, |r| < b */
+    if (r > 0 && r >= b - r) {
+        q++;
+    } else if (r < 0 && -r >= b + r) {
+        q--;
+    }
+    return q;
 }
 
 void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limit_mdeg, bool wrap)

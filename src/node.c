@@ -30,7 +30,11 @@ const co_od_entry_t *co_node_entry(const co_node_t *node, uint16_t index, uint8_
 
 bool co_node_send(co_node_t *node, const co_frame_t *f)
 {
-    if (!co_port_can_send(node->port, f)) {
+    /* A controller in bus-off transmits nothing until it has seen 128 x 11
+     * recessive bits and is error active again (ISO 11898-1; the board
+     * reports it): what falls due meanwhile is dropped, not queued for a
+     * burst on recovery. */
+    if (node->can_state == CO_CAN_BUSOFF || !co_port_can_send(node->port, f)) {
         node->tx_dropped++;
         return false;
     }
@@ -57,6 +61,9 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
     const co_lss_para_t *lss = node->ram[CO_CLS_LSS];
     if (kind == CO_RESET_NODE || co_cfg(node)->comm_reset_applies_id) {
         bool id_ok = lss != NULL && lss->node_id >= 1u && lss->node_id <= 127u;
+        if (lss != NULL && !id_ok && node->store.status[CO_CLS_LSS] == CO_STORE_OK) {
+            co_store_mark_corrupt(node, CO_CLS_LSS); /* a stored node-ID out of 1..127 */
+        }
         node->node_id = id_ok ? lss->node_id : co_cfg(node)->default_node_id;
         node->bitrate = lss != NULL ? lss->bitrate : co_cfg(node)->default_bitrate;
     }

@@ -29,6 +29,9 @@ static uint8_t *ram_of(const co_node_t *node, const co_od_entry_t *e)
 
 uint32_t co_cobid_resolve(uint32_t raw, uint32_t def, uint8_t node_id)
 {
+    if ((raw & CO_COBID_ABS) != 0u) {
+        return raw & ~CO_COBID_ABS; /* the base CAN-ID itself, as written */
+    }
     if ((raw & 0x7FFu) == (def & 0x7FFu)) {
         return raw + node_id;
     }
@@ -39,6 +42,16 @@ bool co_cobid_restricted(uint32_t id)
 {
     return id <= 0x07Fu || (id >= 0x101u && id <= 0x180u) || (id >= 0x581u && id <= 0x5FFu) ||
            (id >= 0x601u && id <= 0x67Fu) || (id >= 0x6E0u && id <= 0x6FFu) || id >= 0x701u;
+}
+
+co_res_t co_cobid_check(uint32_t value, bool bit30_ok, bool bit31_invalid)
+{
+    uint32_t reserved = bit30_ok ? 0x3FFFF800u : 0x7FFFF800u;
+    bool invalid = bit31_invalid && (value & 0x80000000u) != 0u;
+    if ((value & reserved) != 0u || (!invalid && co_cobid_restricted(value & 0x7FFu))) {
+        return CO_E_VAL;
+    }
+    return CO_OK;
 }
 
 /* co_od_find's answer: the result code where asked for, and the entry. */
@@ -191,30 +204,23 @@ co_res_t co_od_store(co_node_t *node, const co_od_entry_t *e, uint32_t value)
     if (p == NULL) {
         return CO_E_RO;
     }
-    if ((e->attr & CO_A_NODEID) != 0u && (value & 0x7FFu) == (e->def & 0x7FFu) + node->node_id) {
-        value -= node->node_id; /* the default COB-ID: keep following the node-ID */
+    if ((e->attr & CO_A_NODEID) != 0u) {
+        uint32_t base = e->def & 0x7FFu;
+        if ((value & 0x7FFu) == base + node->node_id) {
+            value -= node->node_id; /* the default COB-ID: keep following the node-ID */
+        } else if ((value & 0x7FFu) == base) {
+            value |= CO_COBID_ABS; /* the base itself: that CAN-ID, as written */
+        }
     }
     store_value(e, p, value);
     return CO_OK;
 }
 
-co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len)
+/* Limits, then the hook or the plain store, then the product's autosave:
+ * an SDO download's value, or a restored one in check mode (no autosave,
+ * and the hooks act on nothing). Not inlined: one body for both. */
+static CO_NOINLINE co_res_t write_value(co_node_t *node, const co_od_entry_t *e, uint32_t v)
 {
-    if ((e->attr & CO_A_W) == 0u) {
-        return CO_E_RO;
-    }
-    if (len > e->size) {
-        return CO_E_LEN_HIGH;
-    }
-    if (len < e->size) {
-        return CO_E_LEN_LOW;
-    }
-    if (!is_number(e)) {
-        return CO_E_RO; /* no writable strings in any product yet */
-    }
-    uint8_t tmp[4] = {0, 0, 0, 0};
-    memcpy(tmp, buf, len);
-    uint32_t v = load_value(e, tmp);
     const co_od_ext_t *x = e->ext;
     co_od_write_fn write = NULL;
     if (x != NULL) {
@@ -239,9 +245,50 @@ co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf
         write = x->write;
     }
     co_res_t r = write != NULL ? write(node, e, v) : co_od_store(node, e, v);
-    if (r == CO_OK && co_cfg(node)->autosave && (e->cls == CO_CLS_PARA || e->cls == CO_CLS_LSS)) {
+    if (r == CO_OK && co_cfg(node)->autosave && !node->od_checking &&
+        (e->cls == CO_CLS_PARA || e->cls == CO_CLS_LSS)) {
         r = co_store_save(node, (co_cls_t)e->cls); /* the product stores every change */
     }
+    return r;
+}
+
+co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len)
+{
+    if ((e->attr & CO_A_W) == 0u) {
+        return CO_E_RO;
+    }
+    if (len > e->size) {
+        return CO_E_LEN_HIGH;
+    }
+    if (len < e->size) {
+        return CO_E_LEN_LOW;
+    }
+    if (!is_number(e)) {
+        return CO_E_RO; /* no writable strings in any product yet */
+    }
+    uint8_t tmp[4] = {0, 0, 0, 0};
+    memcpy(tmp, buf, len);
+    return write_value(node, e, load_value(e, tmp));
+}
+
+co_res_t co_od_check(co_node_t *node, const co_od_entry_t *e)
+{
+    const uint8_t *p = ram_of(node, e);
+    if (p == NULL || (e->attr & CO_A_W) == 0u || !is_number(e) || co_od_read_hook(e) != NULL) {
+        return CO_OK; /* no value an SDO write could have put there */
+    }
+    uint32_t v = load_value(e, p);
+    uint32_t def = e->def;
+    store_value(e, (uint8_t *)&def, def); /* the default's RAM image, read the same way */
+    if (v == load_value(e, (const uint8_t *)&def)) {
+        return CO_OK; /* the default: valid by definition */
+    }
+    if ((e->attr & CO_A_NODEID) != 0u) {
+        v = co_cobid_resolve(v, e->def, node->node_id);
+    }
+    node->od_checking = true;
+    co_res_t r = write_value(node, e, v);
+    node->od_checking = false;
     return r;
 }
 

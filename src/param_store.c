@@ -91,10 +91,14 @@ static slot_info_t check_slot(co_node_t *node, co_cls_t cls, unsigned copy, bool
         *hw_error = true;
         return s;
     }
+    /* Erased NVM (all 0xFF: a new EEPROM, a blank file) holds nothing;
+     * anything else is a record, maybe a broken one (random bytes, zeros). */
+    for (unsigned i = 0; i < sizeof(h) && !s.present; i++) {
+        s.present = h[i] != 0xFFu;
+    }
     if (co_get_u32(&h[0]) != STORE_MAGIC) {
         return s;
     }
-    s.present = true;
     s.seq = co_get_u32(&h[8]);
     s.writes = co_get_u32(&h[12]);
     s.len = co_get_u16(&h[16]);
@@ -166,11 +170,12 @@ static void set_defaults(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi
     }
 }
 
-co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)
+/* Read the newest valid record's entries of class cls with index in
+ * [lo, hi] into RAM, or their defaults. Not inlined: its frame (the slot
+ * summary) is off the stack again before validate() calls the hooks. */
+static CO_NOINLINE co_store_status_t load(co_node_t *node, co_cls_t cls, uint16_t lo,
+                                          uint16_t hi)
 {
-    if (!stored_class(node, cls)) {
-        return CO_STORE_BLANK;
-    }
     newest_t nw = newest(node, cls);
     int k = nw.k;
     co_store_status_t st;
@@ -181,35 +186,83 @@ co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, u
     } else {
         st = CO_STORE_OK;
     }
+    uint32_t data = slot_addr(node, cls, (unsigned)k) + CO_STORE_HDR;
     if (st != CO_STORE_OK) {
         set_defaults(node, cls, lo, hi);
-        node->store.status[cls] = (uint8_t)st;
-        return st;
-    }
-    /* Verified: now copy what was asked for, straight from NVM. */
-    uint32_t data = slot_addr(node, cls, (unsigned)k) + CO_STORE_HDR;
-    if (lo == 0u && hi == 0xFFFFu) {
+    } else if (lo == 0u && hi == 0xFFFFu) {
+        /* Verified: now copy what was asked for, straight from NVM. */
         if (!co_port_nvm_read(node->port, data, node->ram[cls], nw.len)) {
             set_defaults(node, cls, lo, hi);
             st = CO_STORE_HW;
         }
-        node->store.status[cls] = (uint8_t)st;
-        return st;
-    }
-    const co_od_t *od = co_cfg(node)->od;
-    for (uint16_t i = 0; i < od->count; i++) {
-        const co_od_entry_t *e = &od->entries[i];
-        if (e->cls == cls && e->index >= lo && e->index <= hi) {
-            uint8_t *p = (uint8_t *)node->ram[cls] + e->off;
-            if (!co_port_nvm_read(node->port, data + e->off, p, e->size)) {
-                set_defaults(node, cls, lo, hi);
-                st = CO_STORE_HW;
-                break;
+    } else {
+        const co_od_t *od = co_cfg(node)->od;
+        for (uint16_t i = 0; i < od->count; i++) {
+            const co_od_entry_t *e = &od->entries[i];
+            if (e->cls == cls && e->index >= lo && e->index <= hi) {
+                uint8_t *p = (uint8_t *)node->ram[cls] + e->off;
+                if (!co_port_nvm_read(node->port, data + e->off, p, e->size)) {
+                    set_defaults(node, cls, lo, hi);
+                    st = CO_STORE_HW;
+                    break;
+                }
             }
         }
     }
-    node->store.status[cls] = (uint8_t)st;
     return st;
+}
+
+/* A restored record passed its CRC, but its values must also pass what an
+ * SDO write of each would (a set written by other firmware, or forged with
+ * a valid CRC): each one that fails is set to its default and the set is
+ * marked corrupt. The whole class is checked, also after a partial
+ * restore: the rest holds values that passed before or came by SDO. */
+static CO_NOINLINE void validate(co_node_t *node, co_cls_t cls)
+{
+    const co_od_t *od = co_cfg(node)->od;
+    const co_od_entry_t *end = od->entries + od->count;
+    for (const co_od_entry_t *e = od->entries; e < end; e++) {
+        if (e->cls == cls && co_od_check(node, e) != CO_OK) {
+            co_od_native(e, e->def, (uint8_t *)node->ram[cls] + e->off);
+            node->store.status[cls] = CO_STORE_CORRUPT;
+        }
+    }
+}
+
+co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)
+{
+    if (!stored_class(node, cls)) {
+        return CO_STORE_BLANK;
+    }
+    /* A partial restore of a set a full one found wanting stays reported:
+     * the values outside the range were not read again. */
+    bool still_corrupt = !(lo == 0u && hi == 0xFFFFu) &&
+                         node->store.status[cls] == CO_STORE_CORRUPT;
+    co_store_status_t st = load(node, cls, lo, hi);
+    node->store.status[cls] = (uint8_t)(st == CO_STORE_OK && still_corrupt ? CO_STORE_CORRUPT : st);
+    if (st == CO_STORE_OK) {
+        validate(node, cls);
+    }
+    return (co_store_status_t)node->store.status[cls];
+}
+
+void co_store_mark_corrupt(co_node_t *node, co_cls_t cls)
+{
+    node->store.status[cls] = CO_STORE_CORRUPT;
+}
+
+void co_store_report_emcy(co_node_t *node)
+{
+    uint8_t st = node->nmt.state;
+    if (st != CO_NMT_PREOP && st != CO_NMT_OPERATIONAL) {
+        return; /* raised when EMCY may be sent again */
+    }
+    bool bad = false;
+    for (unsigned cls = CO_CLS_PARA; cls <= CO_CLS_LSS; cls++) {
+        uint8_t s = node->store.status[cls];
+        bad = bad || s == CO_STORE_CORRUPT || s == CO_STORE_HW;
+    }
+    (void)co_emcy_error(node, CO_EMCY_DATA_SET, 0, bad, NULL);
 }
 
 bool co_store_limit_reached(const co_node_t *node)
@@ -306,6 +359,13 @@ static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags, group
         return CO_E_STORE;
     }
     newest_t nw = newest(node, cls);
+    if (nw.hw) {
+        /* A slot could not be read: which record is newest is unknown, so a
+         * write could replace it, lose to an older one, or (group save)
+         * take the other groups' values from nowhere. Refuse; both stored
+         * records stay as they are. */
+        return CO_E_HW;
+    }
     if (g != NULL) {
         g->from = (nw.k >= 0 && (nw.flags & FLAG_DEFAULTS) == 0u) ? nw.k : -1;
     }

@@ -52,7 +52,8 @@ static void download_segment(co_node_t *node, const uint8_t *d, const uint8_t mu
     }
     sdo->state = SDO_IDLE;
     if (sdo->pos != sdo->size) {
-        co_sdo_abort(node, mux, sdo->pos < sdo->size ? CO_E_LEN_LOW : CO_E_LEN_HIGH);
+        /* Fewer bytes than the object: more were refused segment by segment above. */
+        co_sdo_abort(node, mux, CO_E_LEN_LOW);
         return;
     }
     co_res_t r = co_od_write(node, sdo->e, sdo->buf, sdo->pos);

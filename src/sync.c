@@ -18,10 +18,13 @@ void co_sync_reconfig(co_node_t *node)
 
 co_res_t co_sync_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
-    if ((value & 0xBFFFF800u) != 0u || co_cobid_restricted(value & 0x7FFu)) {
-        /* 11-bit IDs only; bit 30 (we generate SYNC) not supported; never a
-         * restricted CAN-ID (co_node_receive relies on it for SDO frames). */
-        return CO_E_VAL;
+    /* 11-bit IDs only; bit 30 (this node generates SYNC) refused: no
+     * product produces SYNC (the specs: 0x06090030); bit 31 means nothing
+     * to a consumer; never a restricted CAN-ID (co_node_receive relies on
+     * it for SDO frames). */
+    co_res_t c = co_cobid_check(value, false, false);
+    if (c != CO_OK || co_od_checking(node)) {
+        return c;
     }
     co_res_t r = co_od_store(node, e, value);
     if (r == CO_OK) {

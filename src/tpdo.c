@@ -109,6 +109,9 @@ co_res_t co_tpdo_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
     if (e->sub == 2u && value > TYPE_SYNC_MAX && value < TYPE_RTR_SYNC) {
         return CO_E_VAL; /* reserved transmission types */
     }
+    if (co_od_checking(node)) {
+        return CO_OK;
+    }
     co_res_t r = co_od_store(node, e, value);
     if (r == CO_OK && tpdo_number(e) < CO_TPDO_MAX) {
         co_tpdo_reconfig(node, tpdo_number(e));
@@ -118,9 +121,10 @@ co_res_t co_tpdo_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
 
 co_res_t co_tpdo_cobid_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
-    bool valid = (value & 0x80000000u) == 0u;
-    if ((value & 0x3FFFF800u) != 0u || (valid && co_cobid_restricted(value & 0x7FFu))) {
-        return CO_E_VAL; /* an invalid COB-ID may name any CAN-ID (0x80000000) */
+    /* Bit 30 is "no RTR"; an invalid COB-ID may name any CAN-ID (0x80000000). */
+    co_res_t c = co_cobid_check(value, true, true);
+    if (c != CO_OK || co_od_checking(node)) {
+        return c;
     }
     uint32_t cur;
     (void)co_od_get(node, e, &cur);
@@ -136,7 +140,10 @@ co_res_t co_tpdo_map_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_
     unsigned n = (unsigned)(e->index & 0x1FFu);
     uint16_t comm = (uint16_t)(0x1800u + n);
     uint16_t mapi = e->index;
-    if ((get_or(node, comm, 1, 0x80000000u) & 0x80000000u) == 0u) {
+    bool checking = co_od_checking(node);
+    /* CiA 301's order of a mapping change; a restored record (checking)
+     * is judged by its values alone. */
+    if (!checking && (get_or(node, comm, 1, 0x80000000u) & 0x80000000u) == 0u) {
         return CO_E_UNSUPP; /* CiA 301: invalidate the PDO first */
     }
     if (e->sub == 0u) {
@@ -157,7 +164,7 @@ co_res_t co_tpdo_map_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_
             return CO_E_MAP_LEN;
         }
     } else {
-        if (get_or(node, mapi, 0, 0) != 0u) {
+        if (!checking && get_or(node, mapi, 0, 0) != 0u) {
             return CO_E_UNSUPP; /* CiA 301: set sub 0 to 0 first */
         }
         const co_od_entry_t *m;
@@ -166,6 +173,9 @@ co_res_t co_tpdo_map_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_
         if (r != CO_OK) {
             return r;
         }
+    }
+    if (checking) {
+        return CO_OK;
     }
     co_res_t r = co_od_store(node, e, value);
     if (r == CO_OK && n < CO_TPDO_MAX) {
@@ -322,9 +332,12 @@ void co_tpdo_event(co_node_t *node, unsigned n)
     }
 }
 
+/* The inhibit time in us: u16 x a unit of at most 1000 us (co_node_cfg_t)
+ * is at most 65 535 000 us, far inside co_time_before's 2^31 us horizon. */
 static uint32_t inhibit_us(const co_node_t *node, const co_tpdo_t *t)
 {
     uint32_t unit = co_cfg(node)->inhibit_unit_us != 0u ? co_cfg(node)->inhibit_unit_us : 100u;
+    unit = co_min_u32(unit, 1000u);
     return (uint32_t)t->inhibit * unit;
 }
 
@@ -339,7 +352,7 @@ uint32_t co_tpdo_poll(co_node_t *node, uint32_t now)
         if (!t->valid || !event_driven(t)) {
             continue;
         }
-        uint32_t period = (uint32_t)t->event_ms * 1000u;
+        uint32_t period = (uint32_t)t->event_ms * 1000u; /* <= 65 535 000 us: no overflow */
         bool timer_due = t->timer_armed && !co_time_before(now, t->next_event);
         if (timer_due || t->pending) {
             if (co_time_before(now, t->inhibit_end)) {

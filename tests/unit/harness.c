@@ -15,6 +15,7 @@ void fake_port_init(fake_port_t *p)
     memset(p, 0, sizeof(*p));
     memset(p->nvm, 0xFF, sizeof(p->nvm));
     p->cut_after = -1;
+    p->reads_left = -1;
 }
 
 bool co_port_can_send(void *port, const co_frame_t *frame)
@@ -46,8 +47,15 @@ uint32_t co_port_nvm_size(void *port)
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     fake_port_t *p = port;
+    if (p->reads_left == 0) {
+        p->read_faults++;
+        return false;
+    }
     if (p->nvm_read_fails || addr + len > FAKE_NVM_SIZE) {
         return false;
+    }
+    if (p->reads_left > 0) {
+        p->reads_left--;
     }
     memcpy(buf, &p->nvm[addr], len);
     return true;

@@ -86,6 +86,8 @@ typedef struct fake_port {
     long cut_after;    /* bytes that may still be written; -1 = no power cut */
     unsigned nvm_writes;
     bool nvm_read_fails;
+    long reads_left;   /* NVM reads that still succeed; -1 = all (a read fault after that) */
+    unsigned read_faults; /* reads refused because reads_left ran out */
 } fake_port_t;
 
 void fake_port_init(fake_port_t *p);

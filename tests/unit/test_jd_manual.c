@@ -396,11 +396,19 @@ static void test_can_error_emcy(void)
     h_drain(d);
     co_node_set_can_state(d->node, CO_CAN_PASSIVE);
     EXPECT(d, 0x08A, "20 81 11 00 00 00 00 00"); /* R34: 8120h */
+    SDO(d, "2B 17 10 00 64 00 00 00", "60 17 10 00 00 00 00 00"); /* heartbeat 100 ms */
+    h_drain(d);
     co_node_set_can_state(d->node, CO_CAN_BUSOFF);
-    EXPECT(d, 0x08A, "00 00 00 00 00 00 00 00"); /* passive over (nothing sent while off) */
+    /* A controller in bus-off sends nothing: no "error reset" for the end
+     * of error passive, no heartbeat, no EMCY, however long it lasts. */
+    EXPECT_NONE(d);
+    h_advance(d, 500000);
+    EXPECT_NONE(d);
     co_node_set_can_state(d->node, CO_CAN_ACTIVE);
-    EXPECT(d, 0x08A, "40 81 11 00 00 00 00 00"); /* recovered from bus-off */
+    EXPECT(d, 0x08A, "40 81 11 00 00 00 00 00"); /* recovered from bus-off (CiA 301) */
     EXPECT(d, 0x08A, "00 00 00 00 00 00 00 00");
+    h_advance(d, 100000);
+    EXPECT(d, 0x70A, "7F"); /* the heartbeat goes on */
     co_led_pattern_t g;
     co_led_pattern_t r;
     co_node_set_can_state(d->node, CO_CAN_BUSOFF);

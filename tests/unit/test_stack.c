@@ -771,6 +771,153 @@ static void test_tpdo_cobid_and_mapping_rules(void)
     }
 }
 
+/* The next sent frame has this CAN-ID (its data vary with the clock). */
+#define NEXT_IS(id_)                                                                    \
+    do {                                                                                \
+        const co_frame_t *f_ = h_next(d);                                               \
+        CHECK(f_ != NULL && f_->id == (id_));                                           \
+    } while (0)
+
+/* Let time pass without sensor samples (long spans: hours of virtual time
+ * in a few polls). The node is polled when it asks to be. */
+static void run_for(uint64_t us)
+{
+    while (us > 0u) {
+        uint32_t delay = co_node_poll(d->node, d->now);
+        uint64_t step = delay == 0u ? 1u : delay;
+        step = step < us ? step : us;
+        step = step < 0x40000000u ? step : 0x40000000u;
+        d->now += (uint32_t)step;
+        us -= step;
+    }
+    co_node_poll(d->node, d->now);
+}
+
+/* Life time = guard time x life time factor, exactly, for every accepted
+ * pair: up to 65535 ms x 255 = 4.6 h, past the 2^31 us of a wrap-safe
+ * deadline and the 2^32 us of the clock itself. */
+static void check_life_time(uint16_t guard_ms, uint8_t factor)
+{
+    boot();
+    char req[64];
+    snprintf(req, sizeof(req), "2B 0C 10 00 %02X %02X 00 00", guard_ms & 0xFFu, guard_ms >> 8);
+    SDO(d, req, "60 0C 10 00 00 00 00 00");
+    snprintf(req, sizeof(req), "2F 0D 10 00 %02X 00 00 00", factor);
+    SDO(d, req, "60 0D 10 00 00 00 00 00");
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* TPDO1 quiet */
+    h_rx(d, 0x000, "01 10");
+    co_frame_t rtr = {.id = 0x710, .rtr = true, .dlc = 1};
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x710, "05"); /* toggle 0 first */
+    h_drain(d);
+    uint64_t life_us = (uint64_t)guard_ms * factor * 1000u;
+    run_for(life_us - 1u);
+    EXPECT_NONE(d);
+    CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
+    run_for(1);
+    EXPECT(d, 0x90, "30 81 11 00 00 00 00 00"); /* life guard event, on time */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
+}
+
+static void test_life_guarding_long_times(void)
+{
+    check_life_time(100, 3);     /* 300 ms */
+    check_life_time(8422, 255);  /* 2 147 610 ms: just past 2^31 us */
+    check_life_time(16844, 255); /* past 2^32 us: the clock wraps once */
+    check_life_time(65535, 255); /* the largest: 4.6 h */
+    /* A guard request before the life time is over starts it again. */
+    check_life_time(10000, 255);
+    co_frame_t rtr = {.id = 0x710, .rtr = true, .dlc = 1};
+    h_rx_frame(d, &rtr);
+    h_drain(d);
+    run_for(2000000000ull);
+    h_rx_frame(d, &rtr);
+    h_drain(d);
+    run_for(2549999999ull);
+    EXPECT_NONE(d);
+    run_for(1);
+    EXPECT(d, 0x90, "30 81 11 00 00 00 00 00");
+}
+
+/* The other "period x unit" computations at their largest: 65535 ms event
+ * timer and heartbeat, 65535 x 100 us inhibit time. */
+static void test_largest_periods(void)
+{
+    boot();
+    SDO(d, "2B 00 18 05 FF FF 00 00", "60 00 18 05 00 00 00 00");
+    SDO(d, "2B 00 18 03 FF FF 00 00", "60 00 18 03 00 00 00 00");
+    SDO(d, "2B 17 10 00 FF FF 00 00", "60 17 10 00 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x000, "01 10");
+    NEXT_IS(0x190); /* the first event PDO at once */
+    run_for(65535000u - 1u);
+    EXPECT_NONE(d);
+    run_for(1);
+    EXPECT(d, 0x710, "05");
+    NEXT_IS(0x190);
+    /* An event inside the inhibit time waits for its end: 6.5535 s. */
+    co_tpdo_event(d->node, 0);
+    run_for(6553500u - 1u);
+    EXPECT_NONE(d);
+    run_for(1);
+    NEXT_IS(0x190);
+}
+
+/* SYNC COB-ID (CiA 301 7.5.2.5): bit 30 "generate" is refused (no product
+ * produces SYNC), bit 29 too (11-bit only); bit 31 means nothing to a
+ * consumer and is kept. */
+static void test_sync_cobid_bits(void)
+{
+    boot();
+    SDO(d, "23 05 10 00 80 00 00 40", "80 05 10 00 30 00 09 06");
+    SDO(d, "23 05 10 00 80 00 00 20", "80 05 10 00 30 00 09 06");
+    SDO(d, "23 05 10 00 80 00 00 C0", "80 05 10 00 30 00 09 06");
+    SDO(d, "40 05 10 00 00 00 00 00", "43 05 10 00 80 00 00 00");
+    SDO(d, "23 05 10 00 81 00 00 80", "60 05 10 00 00 00 00 00");
+    SDO(d, "40 05 10 00 00 00 00 00", "43 05 10 00 81 00 00 80");
+    SDO(d, "2F 00 18 02 01 00 00 00", "60 00 18 02 00 00 00 00"); /* TPDO1 on every SYNC */
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    h_rx(d, 0x081, "");
+    NEXT_IS(0x190);
+}
+
+/* EMCY COB-ID (CiA 301 7.5.2.21): never a restricted CAN-ID while valid,
+ * and a written value reads back and acts as written, the base 0x80 too. */
+static void test_emcy_cobid_restricted_and_as_written(void)
+{
+    boot();
+    static const char *const restricted[] = {"64 07", "01 06", "00 00", "7F 00", "01 01",
+                                             "80 01", "E0 06", "FF 05", "81 05", "FF 07"};
+    for (size_t i = 0; i < sizeof(restricted) / sizeof(restricted[0]); i++) {
+        char req[64];
+        snprintf(req, sizeof(req), "23 14 10 00 %s 00 80", restricted[i]);
+        SDO(d, req, "60 14 10 00 00 00 00 00"); /* invalid: any CAN-ID may be named */
+        snprintf(req, sizeof(req), "23 14 10 00 %s 00 00", restricted[i]);
+        SDO(d, req, "80 14 10 00 30 00 09 06");
+    }
+    SDO(d, "23 14 10 00 80 00 00 80", "60 14 10 00 00 00 00 00");
+    SDO(d, "23 14 10 00 80 00 00 00", "60 14 10 00 00 00 00 00"); /* 0x080 exactly */
+    SDO(d, "40 14 10 00 00 00 00 00", "43 14 10 00 80 00 00 00");
+    h_drain(d);
+    CHECK(co_emcy_error(d->node, 0x5010, CO_ER_COMM, true, NULL));
+    EXPECT(d, 0x080, "10 50 11 00 00 00 00 00");
+    /* Kept as written across a save and a power cycle. */
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_power_cycle(d);
+    EXPECT(d, 0x710, "00");
+    SDO(d, "40 14 10 00 00 00 00 00", "43 14 10 00 80 00 00 00");
+    /* "0x80 + node-ID" follows the node-ID again. */
+    SDO(d, "23 14 10 00 80 00 00 80", "60 14 10 00 00 00 00 00");
+    SDO(d, "23 14 10 00 90 00 00 00", "60 14 10 00 00 00 00 00");
+    SDO(d, "40 14 10 00 00 00 00 00", "43 14 10 00 90 00 00 00");
+    CHECK_EQ(((t_dev_t *)h_inst(d))->para.emcy_cob, 0x80); /* the base, stored */
+    /* The same rule for a TPDO's default COB-ID base (0x280 for TPDO2). */
+    SDO(d, "23 01 18 01 90 02 00 80", "60 01 18 01 00 00 00 00");
+    SDO(d, "23 01 18 01 80 02 00 00", "60 01 18 01 00 00 00 00");
+    SDO(d, "40 01 18 01 00 00 00 00", "43 01 18 01 80 02 00 00");
+}
+
 int main(void)
 {
     RUN(test_od_find);
@@ -794,5 +941,9 @@ int main(void)
     RUN(test_tpdo_rtr_and_types);
     RUN(test_tpdo_events_and_inhibit);
     RUN(test_tpdo_cobid_and_mapping_rules);
+    RUN(test_life_guarding_long_times);
+    RUN(test_largest_periods);
+    RUN(test_sync_cobid_bits);
+    RUN(test_emcy_cobid_restricted_and_as_written);
     return h_finish();
 }

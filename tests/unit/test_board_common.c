@@ -1,0 +1,338 @@
+/*
+ * test_board_common.c - what boards/common gives every MCU image besides
+ * the flash EEPROM and the division helpers (their own tests): the four
+ * memory functions of libc_min.c (renamed here, so that they run beside
+ * the host's C library and are compared with it), and the bare-metal main
+ * loop of mcu_main.c on a fake board with a virtual clock: start-up, bit
+ * rate, a sample every 5 ms, received frames served, LEDs, sleeping no
+ * longer than the next deadline, and the red LED when it cannot run.
+ * Host only: under qemu the images use libc_min.c for real, and mcu_main.c
+ * is the program itself.
+ */
+#include <setjmp.h>
+
+#include "board.h"
+#include "co_filter.h"
+#include "co_port.h"
+#include "dst.h"
+#include "harness.h"
+
+/* ---- libc_min.c, renamed -------------------------------------------- */
+
+#define memcpy lm_memcpy
+#define memmove lm_memmove
+#define memset lm_memset
+#define memcmp lm_memcmp
+#include "libc_min.c"
+#undef memcpy
+#undef memmove
+#undef memset
+#undef memcmp
+
+static void test_libc_min(void)
+{
+    uint8_t a[32];
+    uint8_t b[32];
+    for (unsigned i = 0; i < sizeof(a); i++) {
+        a[i] = (uint8_t)(i * 7u + 1u);
+    }
+    memset(b, 0xEE, sizeof(b));
+    CHECK(lm_memcpy(b + 1, a, 10) == b + 1);
+    CHECK(memcmp(b + 1, a, 10) == 0);
+    CHECK_EQ(b[0], 0xEE);
+    CHECK_EQ(b[11], 0xEE); /* not one byte more */
+    CHECK(lm_memcpy(b, a, 0) == b);
+    /* Overlapping moves, both directions, against the C library's. */
+    uint8_t want[32];
+    memcpy(want, a, sizeof(a));
+    memmove(want + 3, want, 20);
+    memcpy(b, a, sizeof(a));
+    CHECK(lm_memmove(b + 3, b, 20) == b + 3);
+    CHECK(memcmp(b, want, sizeof(b)) == 0);
+    memcpy(want, a, sizeof(a));
+    memmove(want, want + 5, 20);
+    memcpy(b, a, sizeof(a));
+    CHECK(lm_memmove(b, b + 5, 20) == b);
+    CHECK(memcmp(b, want, sizeof(b)) == 0);
+    /* memset takes an int and stores its low byte. */
+    CHECK(lm_memset(b, 0x1AB, 5) == b);
+    CHECK(b[0] == 0xAB && b[4] == 0xAB && b[5] == want[5]);
+    /* memcmp: sign of the first difference, bytes as unsigned. */
+    uint8_t x[3] = {1, 0x80, 3};
+    uint8_t y[3] = {1, 0x7F, 3};
+    CHECK(lm_memcmp(x, y, 3) > 0);
+    CHECK(lm_memcmp(y, x, 3) < 0);
+    CHECK_EQ(lm_memcmp(x, x, 3), 0);
+    CHECK_EQ(lm_memcmp(x, y, 1), 0);
+    CHECK_EQ(lm_memcmp(x, y, 0), 0);
+}
+
+/* ---- mcu_main.c on a fake board ------------------------------------------- */
+
+#define main mcu_main_any
+#define PRODUCT_SYM dst_x730_xy30
+#define PRODUCT_HEADER "dst.h"
+#define PRODUCT_INST_SIZE sizeof(dst_dev_t)
+#include "mcu_main.c"
+#undef main
+
+int mcu_main_fixed(void); /* mcu_main_fixed.c: the X730 with the X710's fixed config */
+
+#define TX_MAX 1024u
+
+static struct board {
+    jmp_buf out;        /* where the endless loop is left */
+    bool init_ok;
+    bool bitrate_ok;
+    uint16_t kbps[4];   /* bit rates asked for */
+    unsigned nkbps;
+    uint32_t now;
+    uint32_t end;       /* leave the loop once the clock gets here */
+    uint32_t max_sleep;
+    unsigned sleeps;
+    unsigned samples;
+    uint32_t last_sample;
+    uint32_t max_gap;   /* longest time between two samples */
+    co_frame_t rx;      /* one frame to receive ... */
+    uint32_t rx_at;     /* ... at this time */
+    bool rx_pending;
+    co_frame_t tx[TX_MAX];
+    uint32_t tx_at[TX_MAX];
+    unsigned ntx;
+    unsigned leds;      /* board_leds() calls */
+    unsigned red_only;  /* of which (green off, red on) */
+    bool green_seen[2]; /* green off / on seen */
+    unsigned red_limit; /* leave after this many red-only calls (0: never) */
+} bd;
+
+static void board_reset(bool init_ok, bool bitrate_ok, uint32_t run_us)
+{
+    memset(&bd, 0, sizeof(bd));
+    bd.init_ok = init_ok;
+    bd.bitrate_ok = bitrate_ok;
+    bd.now = 0xFFF00000u; /* 1 s before the 32-bit clock wraps */
+    bd.end = bd.now + run_us;
+}
+
+bool board_init(void)
+{
+    return bd.init_ok;
+}
+
+bool board_can_bitrate(uint16_t kbps)
+{
+    if (bd.nkbps < 4u) {
+        bd.kbps[bd.nkbps++] = kbps;
+    }
+    return bd.bitrate_ok;
+}
+
+uint32_t board_now_us(void)
+{
+    return bd.now;
+}
+
+bool board_can_receive(co_frame_t *f)
+{
+    if (!bd.rx_pending || co_time_before(bd.now, bd.rx_at)) {
+        return false;
+    }
+    bd.rx_pending = false;
+    *f = bd.rx;
+    return true;
+}
+
+uint8_t board_can_state(void)
+{
+    return CO_CAN_ACTIVE;
+}
+
+void board_leds(bool green, bool red)
+{
+    bd.leds++;
+    bd.green_seen[green ? 1 : 0] = true;
+    if (!green && red) {
+        bd.red_only++;
+        if (bd.red_limit != 0u && bd.red_only >= bd.red_limit) {
+            longjmp(bd.out, 1);
+        }
+    }
+}
+
+void board_sensor(const product_t *p, int32_t values[], uint32_t *faults)
+{
+    (void)p;
+    if (bd.samples > 0u && bd.now - bd.last_sample > bd.max_gap) {
+        bd.max_gap = bd.now - bd.last_sample;
+    }
+    bd.last_sample = bd.now;
+    bd.samples++;
+    values[0] = 12500; /* x = 12.5 deg */
+    values[1] = -3000;
+    *faults = 0;
+}
+
+void board_sleep(uint32_t us)
+{
+    bd.sleeps++;
+    bd.max_sleep = us > bd.max_sleep ? us : bd.max_sleep;
+    uint32_t wake = bd.now + us;
+    if (bd.rx_pending && co_time_before(bd.rx_at, wake)) {
+        wake = co_time_before(bd.now, bd.rx_at) ? bd.rx_at : bd.now; /* the receive interrupt */
+    }
+    bd.now = wake;
+    if (!co_time_before(bd.now, bd.end) || bd.sleeps > 100000u) {
+        longjmp(bd.out, 1);
+    }
+}
+
+bool co_port_can_send(void *port, const co_frame_t *frame)
+{
+    (void)port;
+    if (bd.ntx >= TX_MAX) {
+        return false;
+    }
+    bd.tx_at[bd.ntx] = bd.now;
+    bd.tx[bd.ntx++] = *frame;
+    return true;
+}
+
+static uint8_t nvm[CO_STORE_NVM_SIZE];
+
+uint32_t co_port_nvm_size(void *port)
+{
+    (void)port;
+    return sizeof(nvm);
+}
+
+bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
+{
+    (void)port;
+    if (addr + len > sizeof(nvm)) {
+        return false;
+    }
+    memcpy(buf, &nvm[addr], len);
+    return true;
+}
+
+bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
+{
+    (void)port;
+    if (addr + len > sizeof(nvm)) {
+        return false;
+    }
+    memcpy(&nvm[addr], buf, len);
+    return true;
+}
+
+/* Frames sent on id at or after time t (relative to the start). */
+static unsigned sent_on(uint16_t id, uint32_t t, uint32_t start)
+{
+    unsigned n = 0;
+    for (unsigned i = 0; i < bd.ntx; i++) {
+        n += bd.tx[i].id == id && bd.tx_at[i] - start >= t;
+    }
+    return n;
+}
+
+/* One second of a DST X730 (node 0x7F, 250 kbit/s) across the clock's wrap. */
+static void test_main_loop_runs_the_product(void)
+{
+    board_reset(true, true, 1000000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    uint32_t start = bd.now;
+    bd.rx = (co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}};
+    bd.rx_at = start + 500000u;
+    bd.rx_pending = true;
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_any();
+    }
+    CHECK_EQ(bd.nkbps, 1);
+    CHECK_EQ(bd.kbps[0], 250);
+    CHECK(bd.ntx >= 2u);
+    CHECK(bd.tx[0].id == 0x77F && bd.tx[0].dlc == 1 && bd.tx[0].data[0] == 0x00); /* boot-up */
+    CHECK_EQ(bd.tx_at[0], start);
+    /* The SDO request of t = 0.5 s answered at once, with 0x1000. */
+    unsigned i = 1;
+    while (i < bd.ntx && bd.tx[i].id != 0x5FF) {
+        i++;
+    }
+    CHECK(i < bd.ntx);
+    if (i < bd.ntx) {
+        CHECK_EQ(bd.tx_at[i] - start, 500000);
+        CHECK(bd.tx[i].data[0] == 0x43 && bd.tx[i].data[1] == 0x00 && bd.tx[i].data[2] == 0x10);
+    }
+    /* A sample every 5 ms, on time, across the wrap of the clock. */
+    CHECK(bd.samples >= 200u && bd.samples <= 202u);
+    CHECK_EQ(bd.max_gap, CO_FILTER_PERIOD_US);
+    CHECK(bd.max_sleep <= CO_FILTER_PERIOD_US);
+    /* Pre-operational: the green LED blinks, red stays off. */
+    CHECK(bd.green_seen[0] && bd.green_seen[1]);
+    CHECK_EQ(bd.red_only, 0);
+    CHECK_EQ(sent_on(0x1FF, 0, start), 0); /* no PDO before NMT start */
+}
+
+/* NMT start through the loop: TPDO1 follows (X730 default event timer). */
+static void test_main_loop_nmt_start(void)
+{
+    board_reset(true, true, 1000000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    uint32_t start = bd.now;
+    bd.rx = (co_frame_t){.id = 0x000, .dlc = 2, .data = {0x01, 0x7F}};
+    bd.rx_at = start + 100000u;
+    bd.rx_pending = true;
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_any();
+    }
+    CHECK(sent_on(0x1FF, 100000u, start) >= 1u);
+    CHECK_EQ(sent_on(0x1FF, 0, start), sent_on(0x1FF, 100000u, start));
+}
+
+/* A controller that refuses the product's bit rate is given the common
+ * default (250 kbit/s); the node runs all the same. */
+static void test_main_loop_bitrate_refused(void)
+{
+    board_reset(true, false, 100000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_any();
+    }
+    CHECK_EQ(bd.nkbps, 2);
+    CHECK_EQ(bd.kbps[1], 250);
+    CHECK(bd.ntx >= 1u && bd.tx[0].id == 0x77F);
+}
+
+/* A board that fails to start, or an image built with another product's
+ * fixed config: red LED for ever, nothing sent, the sensor never read. */
+static void test_main_loop_refuses_to_run(void)
+{
+    board_reset(false, true, 1000000u);
+    bd.red_limit = 3;
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_any();
+    }
+    CHECK_EQ(bd.red_only, 3);
+    CHECK_EQ(bd.leds, 3);
+    CHECK_EQ(bd.ntx, 0);
+    CHECK_EQ(bd.samples, 0);
+    board_reset(true, true, 1000000u);
+    bd.red_limit = 3;
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_fixed();
+    }
+    CHECK_EQ(bd.red_only, 3);
+    CHECK_EQ(bd.leds, 3);
+    CHECK_EQ(bd.ntx, 0);
+    CHECK_EQ(bd.samples, 0);
+    CHECK_EQ(bd.nkbps, 0);
+}
+
+int main(void)
+{
+    RUN(test_libc_min);
+    RUN(test_main_loop_runs_the_product);
+    RUN(test_main_loop_nmt_start);
+    RUN(test_main_loop_bitrate_refused);
+    RUN(test_main_loop_refuses_to_run);
+    return h_finish();
+}

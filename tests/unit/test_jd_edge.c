@@ -1,0 +1,218 @@
+/*
+ * test_jd_edge.c - the ifm JD1xxx / JD2xxx beyond the manual's example
+ * frames (shared/specs/ifm-jd.md, R-rules): the JD1 preset through 2600h
+ * as an unsigned bit pattern and its offset normalised into (-N/2, N/2]
+ * (R52, R54), the lateral axis' presets with inversion (R51, R52), the
+ * 16-bit slope clamped to its type and the 32-bit one not (R53, R56), the
+ * fold of negative angles (R49), the temperature (R62), the moving average
+ * across 0/360 deg on the JD1 (R59, R54), the LED (R65, R11, C20) and LSS
+ * "store" through 3000h/3001h (R46, R47). Node 10 (0x70A, SDO 0x60A).
+ */
+#include "jd.h"
+#include "harness.h"
+
+static h_dev_t dev;
+static h_dev_t *const d = &dev;
+
+static void boot(const product_t *p)
+{
+    h_boot(d, p, false);
+    EXPECT(d, 0x70A, "00");
+}
+
+/* Set the true inputs and let the sensor settle (MAF off: one sample). */
+static void tilt(int32_t a, int32_t b)
+{
+    d->truth[0] = a;
+    d->truth[1] = b;
+    h_advance(d, 20000);
+}
+
+/* JD1 (N = 36000 at 0.01 deg): 2600h takes 0..N-1 as an unsigned bit
+ * pattern; the offset is kept in (-N/2, N/2]; the output wraps into 0..N-1. */
+static void test_jd1_preset_and_wrap(void)
+{
+    boot(&jd1xxx);
+    tilt(100000, 25000);                                           /* 100 deg */
+    SDO(d, "22 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00"); /* scaling on */
+    SDO(d, "2B 00 26 00 B8 88 00 00", "60 00 26 00 00 00 00 00"); /* 35000 */
+    SDO(d, "40 13 60 00 00 00 00 00", "4B 13 60 00 08 D5 00 00"); /* 25000 -> -11000 */
+    SDO(d, "40 13 61 00 00 00 00 00", "43 13 61 00 08 D5 FF FF");
+    SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 B8 88 00 00"); /* 35000 */
+    SDO(d, "40 00 26 00 00 00 00 00", "4B 00 26 00 B8 88 00 00");
+    SDO(d, "2B 00 26 00 A0 8C 00 00", "80 00 26 00 30 00 09 06"); /* 36000 = N */
+    SDO(d, "23 12 61 00 FF FF FF FF", "80 12 61 00 30 00 09 06"); /* -1 */
+    SDO(d, "23 12 61 00 A0 8C 00 00", "80 12 61 00 30 00 09 06"); /* N */
+    SDO(d, "23 12 61 00 00 00 00 00", "60 12 61 00 00 00 00 00"); /* 0 */
+    SDO(d, "40 13 60 00 00 00 00 00", "4B 13 60 00 F0 D8 00 00"); /* -10000 */
+    SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 00 00 00 00");
+    /* 6020h reads 0 on the JD1 (L1671). */
+    SDO(d, "40 20 60 00 00 00 00 00", "4B 20 60 00 00 00 00 00");
+}
+
+/* JD2 lateral axis: 2601h, 6022h and 6122h set the one preset; the offset
+ * of an inverted axis is P + r (R52: P - r x multiplier). */
+static void test_jd2_lateral_preset_inverted(void)
+{
+    boot(&jd2xxx);
+    tilt(0, 20000);                                                /* y = 20 deg */
+    SDO(d, "22 21 60 00 03 00 00 00", "60 21 60 00 00 00 00 00"); /* invert, scaling */
+    SDO(d, "2B 01 26 00 F4 01 00 00", "60 01 26 00 00 00 00 00"); /* 5.00 deg */
+    SDO(d, "40 23 60 00 00 00 00 00", "4B 23 60 00 C4 09 00 00"); /* 500 + 2000 */
+    SDO(d, "40 20 60 00 00 00 00 00", "4B 20 60 00 F4 01 00 00"); /* -2000 + 2500 */
+    SDO(d, "40 22 60 00 00 00 00 00", "4B 22 60 00 F4 01 00 00");
+    SDO(d, "23 22 61 00 E8 03 00 00", "60 22 61 00 00 00 00 00"); /* 10.00 deg */
+    SDO(d, "40 23 61 00 00 00 00 00", "43 23 61 00 18 FC FF FF"); /* 1000 - 2000 (not inverted) */
+    SDO(d, "40 23 60 00 00 00 00 00", "4B 23 60 00 B8 0B 00 00"); /* 1000 + 2000 */
+    SDO(d, "40 01 26 00 00 00 00 00", "4B 01 26 00 E8 03 00 00");
+    SDO(d, "2B 01 26 00 29 23 00 00", "80 01 26 00 30 00 09 06"); /* 90.01 deg */
+    SDO(d, "40 12 60 00 00 00 00 00", "4B 12 60 00 00 00 00 00"); /* X untouched */
+}
+
+/* R53: the 16-bit slope is clamped to INTEGER16 only; R56: the 32-bit one
+ * carries the same sum unclamped. A differential offset beyond +-90 deg is
+ * refused (spec 6014h/6114h, 0x06090030), so only a stored offset reaches
+ * the clamp: written into the product's RAM here. */
+static void test_jd2_slope_limits(void)
+{
+    boot(&jd2xxx);
+    jd_dev_t *j = h_inst(d);
+    tilt(90000, -90000);
+    SDO(d, "22 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00");
+    SDO(d, "2B 14 60 00 30 75 00 00", "80 14 60 00 30 00 09 06"); /* +300.00 deg */
+    SDO(d, "2B 14 60 00 28 23 00 00", "60 14 60 00 00 00 00 00"); /* +90.00 deg */
+    j->para.off16[0] = 30000;
+    SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 FF 7F 00 00"); /* 48000 -> 32767 */
+    SDO(d, "22 21 60 00 02 00 00 00", "60 21 60 00 00 00 00 00");
+    SDO(d, "2B 24 60 00 D0 8A 00 00", "80 24 60 00 30 00 09 06"); /* -300.00 deg */
+    SDO(d, "2B 24 60 00 D8 DC 00 00", "60 24 60 00 00 00 00 00"); /* -90.00 deg */
+    j->para.off16[1] = -30000;
+    SDO(d, "40 20 60 00 00 00 00 00", "4B 20 60 00 00 80 00 00"); /* -48000 -> -32768 */
+    SDO(d, "22 11 61 00 02 00 00 00", "60 11 61 00 00 00 00 00");
+    SDO(d, "23 14 61 00 28 23 00 00", "60 14 61 00 00 00 00 00");
+    j->para.off32[0] = 21000;
+    SDO(d, "40 10 61 00 00 00 00 00", "43 10 61 00 58 98 00 00"); /* 39000 */
+}
+
+/* R49: beyond -90 deg the output folds back too; angles wrap first. */
+static void test_jd2_negative_fold(void)
+{
+    boot(&jd2xxx);
+    tilt(-120000, -200000);
+    SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 90 E8 00 00"); /* -60.00 */
+    SDO(d, "40 20 60 00 00 00 00 00", "4B 20 60 00 D0 07 00 00"); /* -200 = 160: 20.00 */
+}
+
+/* R62: 3411h, 0.1 degC, negative as two's complement. */
+static void test_temperature(void)
+{
+    boot(&jd2xxx);
+    d->truth[2] = 23400;
+    h_advance(d, 5000);
+    SDO(d, "40 11 34 00 00 00 00 00", "4B 11 34 00 EA 00 00 00"); /* 23.4 */
+    d->truth[2] = -5000;
+    h_advance(d, 5000);
+    SDO(d, "40 11 34 00 00 00 00 00", "4B 11 34 00 CE FF 00 00"); /* -5.0 */
+}
+
+/* R59 with R54: the JD1's moving average crosses 0/360 deg the short way,
+ * in both directions: every output on the way is within the window of the
+ * inputs averaged (359..1 deg), never a value across the circle. */
+static void test_jd1_moving_average_across_zero(void)
+{
+    boot(&jd1xxx);
+    SDO(d, "22 00 31 00 04 00 00 00", "60 00 31 00 00 00 00 00"); /* 4 samples */
+    d->truth[0] = 359000;
+    h_advance(d, 40000);
+    CHECK_EQ(h_read(d, 0x6010, 0), 35900);
+    unsigned bad = 0;
+    for (int round = 0; round < 3; round++) {
+        d->truth[0] = (round % 2 == 0) ? 1000 : 359000;
+        for (int s = 0; s < 8; s++) {
+            h_advance(d, 5000);
+            long long v = h_read(d, 0x6010, 0);
+            bool near_zero = v >= 35900 || v <= 100;
+            if (!near_zero) {
+                bad++;
+                fprintf(stderr, "round %d sample %d: 6010h = %lld\n", round, s, v);
+            }
+        }
+        CHECK_EQ(h_read(d, 0x6010, 0), (round % 2 == 0) ? 100 : 35900);
+    }
+    CHECK_EQ(bad, 0);
+}
+
+/* R65/C20: green on in pre-operational, flashing in operational; red wins
+ * (single flash: warning level, double: guard event, flashes: corrupt
+ * stored parameters, R11) and then green is off. */
+static void test_leds(void)
+{
+    boot(&jd2xxx);
+    co_led_pattern_t g;
+    co_led_pattern_t r;
+    co_node_led_patterns(d->node, &g, &r);
+    CHECK(g == CO_LED_ON && r == CO_LED_OFF);
+    h_rx(d, 0x000, "01 0A");
+    co_node_led_patterns(d->node, &g, &r);
+    CHECK(g == CO_LED_BLINK && r == CO_LED_OFF);
+    co_node_set_can_state(d->node, CO_CAN_WARNING);
+    co_node_led_patterns(d->node, &g, &r);
+    CHECK(g == CO_LED_OFF && r == CO_LED_FLASH1);
+    co_node_set_can_state(d->node, CO_CAN_ACTIVE);
+    /* A stored parameter set with a bad CRC: defaults, red flashing. */
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    for (unsigned i = 0; i < 2u * CO_STORE_SLOT; i++) {
+        if (d->port.nvm[i] != 0xFFu) {
+            d->port.nvm[i + 40u] ^= 0x01u; /* a data byte of the first record */
+            break;
+        }
+    }
+    h_power_cycle(d);
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    co_node_led_patterns(d->node, &g, &r);
+    CHECK(g == CO_LED_OFF && r == CO_LED_BLINK);
+}
+
+/* LSS "store" writes 3000h/3001h (R47): an unconfigured node-ID (0xFF)
+ * and no bit timing leave them as they are; an EEPROM that refuses the
+ * write answers error 2. */
+static void test_lss_store_edges(void)
+{
+    boot(&jd2xxx);
+    h_rx(d, 0x7E5, "04 01 00 00 00 00 00 00");
+    h_rx(d, 0x7E5, "11 FF 00 00 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x7E5, "17 00 00 00 00 00 00 00");
+    EXPECT(d, 0x7E4, "17 00 00 00 00 00 00 00");
+    SDO(d, "40 00 30 00 00 00 00 00", "4F 00 30 00 09 00 00 00"); /* still node 10 */
+    SDO(d, "40 01 30 00 00 00 00 00", "4F 01 30 00 03 00 00 00"); /* still 125 k */
+    h_rx(d, 0x7E5, "11 0B 00 00 00 00 00 00");
+    d->port.cut_after = 0;
+    h_drain(d);
+    h_rx(d, 0x7E5, "17 00 00 00 00 00 00 00");
+    EXPECT(d, 0x7E4, "17 02 00 00 00 00 00 00");
+    d->port.cut_after = -1;
+    h_power_cycle(d);
+    EXPECT(d, 0x70A, "00");
+    /* 2300h "save with reset" that cannot save: abort, no reset. */
+    d->port.cut_after = 0;
+    h_drain(d);
+    h_rx(d, 0x60A, "23 00 23 00 55 AA AA 55");
+    const co_frame_t *f = h_next(d);
+    CHECK(f != NULL && f->id == 0x58A && f->data[0] == 0x80u);
+    h_advance(d, 10000);
+    EXPECT_NONE(d); /* no boot-up */
+}
+
+int main(void)
+{
+    RUN(test_jd1_preset_and_wrap);
+    RUN(test_jd2_lateral_preset_inverted);
+    RUN(test_jd2_slope_limits);
+    RUN(test_jd2_negative_fold);
+    RUN(test_temperature);
+    RUN(test_jd1_moving_average_across_zero);
+    RUN(test_leds);
+    RUN(test_lss_store_edges);
+    return h_finish();
+}

@@ -1,0 +1,449 @@
+/*
+ * test_node_services.c - the optional services and the node object on a
+ * test dictionary: LSS (CiA 305) storing its node-ID in the stack's own
+ * LSS set (no product hook), its refusals and Fastscan's ignored requests;
+ * life guarding and the heartbeat consumer (CiA 301 7.2.8.3) and how their
+ * event is cleared; a late heartbeat; the NMT state hook; the CiA 303-3 LED
+ * mapping; TPDO mappings too long for 8 bytes; a full EMCY error table; the
+ * EMCY COB-ID's bits. Frame by frame, on a virtual clock.
+ */
+#include "harness.h"
+
+#include "co_store.h"
+
+typedef struct n_para {
+    uint32_t sync_cob;
+    uint32_t emcy_cob;
+    uint32_t hbc;
+    uint16_t guard_ms;
+    uint16_t hb;
+    uint8_t life;
+    uint8_t map0_count;
+    uint8_t map1_count;
+    uint8_t type[2];
+    uint16_t event0;
+    uint32_t cob[2];
+    uint32_t map0[3];
+    uint32_t map1[3];
+} n_para_t;
+
+typedef struct n_vol {
+    uint32_t a;
+    uint16_t b;
+} n_vol_t;
+
+typedef struct n_dev {
+    co_node_t node;
+    n_para_t para;
+    n_vol_t vol;
+    co_lss_para_t lss;
+    unsigned state_calls;
+    co_nmt_state_t last_old;
+} n_dev_t;
+
+#define P(f) CO_AT(CO_CLS_PARA, n_para_t, f)
+#define V(f) CO_AT(CO_CLS_VOL, n_vol_t, f)
+#define TPW CO_EXT(.write = co_tpdo_write_hook)
+#define MAPW CO_EXT(.write = co_tpdo_map_write_hook)
+#define COBW CO_EXT(.write = co_tpdo_cobid_write_hook)
+
+static const co_od_entry_t n_entries[] = {
+    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x0000019Au},
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_register_read)},
+    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(sync_cob), .def = 0x80, CO_EXT(.write = co_sync_write_hook)},
+    {.index = 0x100C, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(guard_ms), .def = 0},
+    {.index = 0x100D, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, P(life), .def = 0},
+    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, P(emcy_cob), .def = 0x80, CO_EXT(.write = co_emcy_cobid_write)},
+    {.index = 0x1016, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
+    {.index = 0x1016, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, P(hbc), .def = 0, CO_EXT(.write = co_hbc_write_hook)},
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(hb), .def = 0, CO_EXT(.write = co_hb_write_hook)},
+    {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 4},
+    {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x12345678u},
+    {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x0000ABCDu},
+    {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x00010002u},
+    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x00000042u},
+    {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 5},
+    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, P(cob[0]), .def = 0x180, COBW},
+    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = CO_A_RW, P(type[0]), .def = 254, TPW},
+    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = CO_A_RW, P(event0), .def = 0, TPW},
+    {.index = 0x1801, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 2},
+    {.index = 0x1801, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, P(cob[1]), .def = 0x280, COBW},
+    {.index = 0x1801, .sub = 2, CO_TYPE_U8, .attr = CO_A_RW, P(type[1]), .def = 1, TPW},
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, P(map0_count), .def = 2, MAPW},
+    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, P(map0[0]), .def = 0x20000020u, MAPW},
+    {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CO_A_RW, P(map0[1]), .def = 0x20010010u, MAPW},
+    {.index = 0x1A00, .sub = 3, CO_TYPE_U32, .attr = CO_A_RW, P(map0[2]), .def = 0, MAPW},
+    /* TPDO2's default mapping is 12 bytes: that PDO can never be sent. */
+    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, P(map1_count), .def = 3, MAPW},
+    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, P(map1[0]), .def = 0x20000020u, MAPW},
+    {.index = 0x1A01, .sub = 2, CO_TYPE_U32, .attr = CO_A_RW, P(map1[1]), .def = 0x20000020u, MAPW},
+    {.index = 0x1A01, .sub = 3, CO_TYPE_U32, .attr = CO_A_RW, P(map1[2]), .def = 0x20000020u, MAPW},
+    {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW | CO_A_PDO, V(a), .def = 0x11223344u},
+    {.index = 0x2001, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW | CO_A_PDO, V(b), .def = 0x5566u},
+};
+
+static const co_od_t n_od = {.entries = n_entries, .count = sizeof(n_entries) / sizeof(n_entries[0])};
+
+static void n_state(co_node_t *n, co_nmt_state_t old)
+{
+    n_dev_t *t = n->app;
+    t->state_calls++;
+    t->last_old = old;
+}
+
+static const co_node_ops_t n_ops = {.state = n_state, .can_state = co_emcy_can_state};
+
+static const co_service_t *const n_services[] = {&co_guard_service, &co_hbc_service,
+                                                 &co_lss_service, &co_rtr_service, NULL};
+
+static const co_node_cfg_t n_cfg = {
+    .od = &n_od,
+    .ops = &n_ops,
+    .services = n_services,
+    .ram_size = {0, sizeof(n_vol_t), sizeof(n_para_t), sizeof(co_lss_para_t)},
+    .default_node_id = 0x40,
+    .default_bitrate = 3,
+    .lss = true,
+    .lss_bitrates = 0x00DF, /* CiA 305 indices 0-4, 6, 7 */
+};
+
+/* variant: true = the board keeps no LSS set (ram NULL): "store" is not supported. */
+static void n_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
+{
+    n_dev_t *t = mem;
+    memset(t, 0, sizeof(*t));
+    bool no_lss = p->variant != NULL && *(const bool *)p->variant;
+    void *const ram[CO_CLS_COUNT] = {NULL, &t->vol, &t->para, no_lss ? NULL : &t->lss};
+    co_node_init(&t->node, &n_cfg, ports[0], t, ram, 0);
+    nodes[0] = &t->node;
+}
+
+static void n_sample(void *mem, const int32_t v[], uint32_t fault)
+{
+    (void)mem;
+    (void)v;
+    (void)fault;
+}
+
+static const bool n_no_lss = true;
+static const product_t n_prod = {.id = "services", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
+                                  .inst_size = sizeof(n_dev_t), .create = n_create,
+                                  .sample = n_sample};
+static const product_t n_prod_no_lss = {.id = "services-no-lss", .inputs = {{NULL, NULL, 0, 0}},
+                                         .nodes = 1, .inst_size = sizeof(n_dev_t),
+                                         .create = n_create, .sample = n_sample,
+                                         .variant = &n_no_lss};
+
+static h_dev_t dev;
+static h_dev_t *const d = &dev;
+
+static n_dev_t *inst(void)
+{
+    return h_inst(d);
+}
+
+static void boot(void)
+{
+    h_boot(d, &n_prod, false);
+    EXPECT(d, 0x740, "00");
+}
+
+/* An LSS request; resp NULL: no answer at all. */
+#define LSS(req, resp) lss((req), (resp), __LINE__)
+static void lss(const char *req, const char *resp, int line)
+{
+    h_drain(d);
+    h_rx(d, 0x7E5, req);
+    if (resp != NULL) {
+        h_expect(d, 0x7E4, resp, __FILE__, line);
+    } else {
+        h_expect_none(d, __FILE__, line);
+    }
+}
+
+/* "store configuration" without a product hook: the node-ID goes into the
+ * stack's LSS set, and a reset communication or power-on uses it. */
+static void test_lss_store_in_lss_set(void)
+{
+    boot();
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("11 00 00 00 00 00 00 00", "11 01 00 00 00 00 00 00"); /* 0: no node-ID */
+    LSS("11 25 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
+    LSS("13 01 03 00 00 00 00 00", "13 01 00 00 00 00 00 00"); /* table selector 1: none */
+    LSS("13 00 10 00 00 00 00 00", "13 01 00 00 00 00 00 00"); /* index 16 */
+    LSS("13 00 03 00 00 00 00 00", "13 00 00 00 00 00 00 00"); /* 125 kbit/s */
+    LSS("15 00 00 00 00 00 00 00", NULL);                      /* activate: no answer */
+    /* Not LSS frames: fewer than 8 bytes, or a remote request. */
+    h_drain(d);
+    h_rx(d, 0x7E5, "5E 00 00 00");
+    co_frame_t rtr = {.id = 0x7E5, .rtr = true, .dlc = 8, .data = {0x5E}};
+    h_rx_frame(d, &rtr);
+    EXPECT_NONE(d);
+    LSS("17 00 00 00 00 00 00 00", "17 00 00 00 00 00 00 00");
+    LSS("5E 00 00 00 00 00 00 00", "5E 40 00 00 00 00 00 00"); /* still the active one */
+    LSS("04 00 00 00 00 00 00 00", NULL); /* configured node: no reset */
+    h_rx(d, 0x000, "82 40");
+    EXPECT(d, 0x725, "00"); /* active from reset communication (CiA 305) */
+    h_power_cycle(d);
+    EXPECT(d, 0x725, "00"); /* and stored */
+    /* The EEPROM refuses the write: error 2, the stored ID stays. */
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("11 26 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
+    d->port.cut_after = 0;
+    LSS("17 00 00 00 00 00 00 00", "17 02 00 00 00 00 00 00");
+    CHECK_EQ(inst()->lss.node_id, 0x25);
+    h_power_cycle(d);
+    EXPECT(d, 0x725, "00");
+    /* Without an LSS set to keep it in: error 1, not supported. */
+    h_boot(d, &n_prod_no_lss, false);
+    EXPECT(d, 0x740, "00");
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("17 00 00 00 00 00 00 00", "17 01 00 00 00 00 00 00");
+}
+
+/* Fastscan: only a node without node-ID in waiting state takes part, and
+ * only in the sequence a master runs (restart first, bit 31..0, sub 0..3). */
+static void test_lss_fastscan_ignored_requests(void)
+{
+    boot();
+    LSS("51 00 00 00 00 80 00 00", NULL); /* configured: never answers */
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("11 FF 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
+    LSS("04 00 00 00 00 00 00 00", NULL); /* still 0x40 until reset communication */
+    LSS("4C 00 00 00 00 00 00 00", NULL);
+    h_drain(d);
+    h_rx(d, 0x000, "82 40");
+    EXPECT_NONE(d); /* no node-ID: no boot-up */
+    CHECK_EQ(d->node->node_id, CO_LSS_UNCONFIGURED);
+    LSS("4C 00 00 00 00 00 00 00", "50 00 00 00 00 00 00 00");
+    LSS("51 78 56 34 12 00 00 00", NULL); /* no restart yet */
+    LSS("51 00 00 00 00 80 00 00", "4F 00 00 00 00 00 00 00");
+    LSS("51 00 00 00 00 20 00 00", NULL); /* bit 32 */
+    LSS("51 00 00 00 00 1F 04 00", NULL); /* sub 4 */
+    LSS("51 00 00 00 00 1F 01 00", NULL); /* sub 1 before sub 0 */
+    LSS("51 00 00 00 00 1F 00 00", "4F 00 00 00 00 00 00 00"); /* bit 31 of 0x12345678: 0 */
+    LSS("51 00 00 00 80 1F 00 00", NULL); /* a 1 there: not us */
+    LSS("51 78 56 34 12 00 00 01", "4F 00 00 00 00 00 00 00"); /* vendor confirmed */
+    LSS("51 78 56 34 12 00 00 01", NULL); /* sub 0 is done */
+    /* In configuration state Fastscan is not for this node. */
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("51 00 00 00 00 80 00 00", NULL);
+    LSS("5E 00 00 00 00 00 00 00", "5E FF 00 00 00 00 00 00");
+    /* A node-ID of 0xFF configured is still "non-configured". */
+    LSS("11 FF 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
+    LSS("04 00 00 00 00 00 00 00", NULL);
+    LSS("4C 00 00 00 00 00 00 00", "50 00 00 00 00 00 00 00");
+}
+
+/* A life-guarding event is cleared by reset communication: error register 0. */
+static void test_life_guard_event_cleared_by_reset_communication(void)
+{
+    boot();
+    SDO(d, "2B 0C 10 00 64 00 00 00", "60 0C 10 00 00 00 00 00"); /* 100 ms */
+    SDO(d, "2F 0D 10 00 02 00 00 00", "60 0D 10 00 00 00 00 00"); /* x 2 */
+    co_frame_t rtr = {.id = 0x740, .rtr = true, .dlc = 1};
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x740, "7F");
+    h_advance(d, 199999);
+    EXPECT_NONE(d);
+    h_advance(d, 1);
+    EXPECT(d, 0xC0, "30 81 11 00 00 00 00 00");
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP); /* not operational: stays */
+    CHECK_EQ(h_read(d, 0x1001, 0), 0x11);
+    h_drain(d);
+    h_rx(d, 0x000, "82 40");
+    EXPECT(d, 0x740, "00"); /* boot-up; no EMCY while initialising */
+    EXPECT_NONE(d);
+    CHECK_EQ(h_read(d, 0x1001, 0), 0);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x740, "7F");
+}
+
+/* Heartbeat consumer (0x1016): only a 1-byte heartbeat of the node it
+ * watches counts; the event (8130h) ends with the next heartbeat or a new
+ * 0x1016 value. */
+static void test_heartbeat_consumer(void)
+{
+    boot();
+    SDO(d, "23 16 10 01 64 00 05 01", "80 16 10 01 30 00 09 06"); /* bits 24-31 */
+    SDO(d, "23 16 10 01 64 00 80 00", "80 16 10 01 30 00 09 06"); /* node 128 */
+    SDO(d, "23 16 10 01 64 00 05 00", "60 16 10 01 00 00 00 00"); /* node 5, 100 ms */
+    h_rx(d, 0x000, "01 40");
+    h_drain(d);
+    co_frame_t rtr = {.id = 0x705, .rtr = true, .dlc = 1};
+    h_rx_frame(d, &rtr);
+    h_rx(d, 0x705, "05 00");
+    h_rx(d, 0x706, "05");
+    h_advance(d, 500000);
+    EXPECT_NONE(d); /* not started: none of these was node 5's heartbeat */
+    h_rx(d, 0x705, "05");
+    h_advance(d, 99999);
+    EXPECT_NONE(d);
+    h_advance(d, 1);
+    EXPECT(d, 0xC0, "30 81 11 00 00 00 00 00");
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP); /* CiA 301 default error behaviour */
+    h_rx(d, 0x705, "05");
+    EXPECT(d, 0xC0, "00 00 00 00 00 00 00 00");
+    h_advance(d, 100000);
+    EXPECT(d, 0xC0, "30 81 11 00 00 00 00 00");
+    /* A new consumer time while the event is active clears it. */
+    SDO(d, "23 16 10 01 C8 00 05 00", "60 16 10 01 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x1001, 0), 0);
+    h_drain(d);
+    h_advance(d, 1000000);
+    EXPECT_NONE(d); /* waits for the first heartbeat again */
+}
+
+/* A poll late by more than a period sends one heartbeat, not a burst. */
+static void test_heartbeat_late_poll(void)
+{
+    boot();
+    SDO(d, "2B 17 10 00 0A 00 00 00", "60 17 10 00 00 00 00 00"); /* 10 ms */
+    uint32_t t0 = d->now;
+    h_drain(d);
+    CHECK_EQ(co_node_poll(d->node, t0), 10000);
+    CHECK_EQ(co_node_poll(d->node, t0 + 35000u), 10000);
+    EXPECT(d, 0x740, "7F");
+    EXPECT_NONE(d);
+    CHECK_EQ(co_node_poll(d->node, t0 + 45000u), 10000);
+    EXPECT(d, 0x740, "7F");
+}
+
+/* The product's state hook sees every change with the old state; NMT
+ * frames that are not 2 bytes, or are remote requests, change nothing. */
+static void test_nmt_state_hook(void)
+{
+    boot();
+    CHECK_EQ(inst()->state_calls, 1); /* boot-up: INIT -> pre-operational */
+    CHECK_EQ(inst()->last_old, CO_NMT_INIT);
+    h_rx(d, 0x000, "01 40");
+    CHECK_EQ(inst()->state_calls, 2);
+    CHECK_EQ(inst()->last_old, CO_NMT_PREOP);
+    h_rx(d, 0x000, "01 40"); /* no change: no call */
+    CHECK_EQ(inst()->state_calls, 2);
+    co_frame_t rtr = {.id = 0x000, .rtr = true, .dlc = 2, .data = {0x02, 0x40}};
+    h_rx_frame(d, &rtr);
+    CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
+    h_rx(d, 0x000, "02 40");
+    CHECK_EQ(inst()->last_old, CO_NMT_OPERATIONAL);
+    CHECK_EQ(d->node->nmt.state, CO_NMT_STOPPED);
+}
+
+/* Without a product LED hook: the CiA 303-3 mapping of co_node.h. */
+static void test_cia303_led_mapping(void)
+{
+    boot();
+    co_led_pattern_t g;
+    co_led_pattern_t r;
+    co_node_led_patterns(d->node, &g, &r);
+    CHECK(g == CO_LED_BLINK && r == CO_LED_OFF);
+    h_rx(d, 0x000, "01 40");
+    co_node_led_patterns(d->node, &g, &r);
+    CHECK(g == CO_LED_ON && r == CO_LED_OFF);
+    h_rx(d, 0x000, "02 40");
+    co_node_led_patterns(d->node, &g, &r);
+    CHECK(g == CO_LED_FLASH1);
+    h_rx(d, 0x000, "80 40");
+    h_drain(d);
+    co_node_set_can_state(d->node, CO_CAN_WARNING);
+    co_node_led_patterns(d->node, &g, &r);
+    CHECK(r == CO_LED_FLASH1);
+    EXPECT_NONE(d); /* a warning is no EMCY */
+    co_node_set_can_state(d->node, CO_CAN_PASSIVE);
+    EXPECT(d, 0xC0, "20 81 11 00 00 00 00 00");
+    co_node_set_can_state(d->node, CO_CAN_PASSIVE); /* no change: nothing */
+    EXPECT_NONE(d);
+    co_node_led_patterns(d->node, &g, &r);
+    CHECK(r == CO_LED_FLASH1);
+    /* A node without node-ID is in no NMT state: green off. */
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("11 FF 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
+    h_rx(d, 0x000, "82 40");
+    co_node_led_patterns(d->node, &g, &r);
+    CHECK(g == CO_LED_OFF);
+    /* The names the Linux program logs. */
+    static const char *const names[] = {"off", "on", "flickering", "blinking", "single flash",
+                                        "double flash"};
+    static const co_led_pattern_t pats[] = {CO_LED_OFF, CO_LED_ON, CO_LED_FLICKER, CO_LED_BLINK,
+                                            CO_LED_FLASH1, CO_LED_FLASH2};
+    for (unsigned i = 0; i < 6u; i++) {
+        CHECK(strcmp(co_led_pattern_name(pats[i]), names[i]) == 0);
+    }
+    CHECK(strcmp(co_led_pattern_name((co_led_pattern_t)99), "?") == 0);
+}
+
+/* A mapping of more than 8 bytes: refused when written (0x06040042), and a
+ * default one that long leaves the PDO invalid: never sent, never answered. */
+static void test_tpdo_mapping_longer_than_8_bytes(void)
+{
+    boot();
+    SDO(d, "2F 00 18 02 01 00 00 00", "60 00 18 02 00 00 00 00"); /* TPDO1 on every SYNC */
+    h_rx(d, 0x000, "01 40");
+    h_drain(d);
+    h_rx(d, 0x080, "");
+    EXPECT(d, 0x1C0, "44 33 22 11 66 55");
+    EXPECT_NONE(d); /* TPDO2 (type 1 too): 12 bytes mapped, invalid */
+    co_frame_t rtr = {.id = 0x2C0, .rtr = true, .dlc = 0};
+    h_rx_frame(d, &rtr);
+    EXPECT_NONE(d);
+    /* An RTR is no SYNC. */
+    co_frame_t sync_rtr = {.id = 0x080, .rtr = true, .dlc = 0};
+    h_rx_frame(d, &sync_rtr);
+    EXPECT_NONE(d);
+    SDO(d, "23 01 18 01 C0 02 00 80", "60 01 18 01 00 00 00 00"); /* invalidate TPDO2 */
+    SDO(d, "2F 01 1A 00 03 00 00 00", "80 01 1A 00 42 00 04 06");
+    SDO(d, "2F 01 1A 00 02 00 00 00", "60 01 1A 00 00 00 00 00"); /* 8 bytes: fine */
+    SDO(d, "23 01 18 01 C0 02 00 00", "60 01 18 01 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x080, "");
+    EXPECT(d, 0x1C0, "44 33 22 11 66 55");
+    EXPECT(d, 0x2C0, "44 33 22 11 44 33 22 11");
+    /* No TPDO 6: ignored. */
+    CHECK(!co_tpdo_changed(d->node, 5));
+    co_tpdo_event(d->node, 5);
+    h_advance(d, 1000);
+    EXPECT_NONE(d);
+}
+
+/* The active-error table holds CO_EMCY_ACTIVE_MAX errors; one more is
+ * refused (no EMCY) until one clears. EMCY COB-ID: 11-bit, never 0. */
+static void test_emcy_table_full_and_cobid(void)
+{
+    boot();
+    h_drain(d);
+    for (uint16_t i = 0; i < CO_EMCY_ACTIVE_MAX; i++) {
+        CHECK(co_emcy_error(d->node, (uint16_t)(0xFF00u + i), CO_ER_MANUFACTURER, true, NULL));
+    }
+    unsigned sent = 0;
+    while (h_next(d) != NULL) {
+        sent++;
+    }
+    CHECK_EQ(sent, CO_EMCY_ACTIVE_MAX);
+    CHECK(!co_emcy_error(d->node, 0xFF80, CO_ER_MANUFACTURER, true, NULL));
+    EXPECT_NONE(d);
+    CHECK(co_emcy_error(d->node, 0xFF00, 0, false, NULL));
+    CHECK(co_emcy_error(d->node, 0xFF80, CO_ER_MANUFACTURER, true, NULL));
+    EXPECT(d, 0xC0, "80 FF 81 00 00 00 00 00");
+    SDO(d, "23 14 10 00 C0 00 00 20", "80 14 10 00 30 00 09 06"); /* bit 29: 29-bit ID */
+    /* Invalid (bit 31) may name any CAN-ID, as for a PDO; valid never a
+     * restricted one, CAN-ID 0 included (CiA 301 7.3.5). */
+    SDO(d, "23 14 10 00 00 00 00 80", "60 14 10 00 00 00 00 00");
+    SDO(d, "23 14 10 00 00 00 00 00", "80 14 10 00 30 00 09 06");
+    SDO(d, "23 14 10 00 C0 00 00 00", "60 14 10 00 00 00 00 00"); /* its own value again */
+    CHECK_EQ(h_read(d, 0x1014, 0), 0xC0);
+}
+
+int main(void)
+{
+    RUN(test_lss_store_in_lss_set);
+    RUN(test_lss_fastscan_ignored_requests);
+    RUN(test_life_guard_event_cleared_by_reset_communication);
+    RUN(test_heartbeat_consumer);
+    RUN(test_heartbeat_late_poll);
+    RUN(test_nmt_state_hook);
+    RUN(test_cia303_led_mapping);
+    RUN(test_tpdo_mapping_longer_than_8_bytes);
+    RUN(test_emcy_table_full_and_cobid);
+    return h_finish();
+}

@@ -1,0 +1,210 @@
+/*
+ * test_products_edge.c - the product registry and the DST and P+F
+ * behaviour the manuals' example frames leave out: product_find() and the
+ * bit-rate code tables; on the DST X730 (specs/danfoss-dst-x730.md) the
+ * values it accepts and refuses (heartbeat 0, transmission types C-18,
+ * resolutions, EMCY COB-ID), the node-ID pair written only when it
+ * changes (B-44), big-endian PDOs after a reset (0x5001 = 0), an error
+ * raised while stopped reported once allowed again, the error behaviour
+ * 0x4000 = 0 in pre-operational, an EEPROM that cannot be read (0x4001
+ * bit 6); on the P+F (specs/pf-inx-iny.md) the fixed resolution (L760),
+ * the error LED and 6300h for stored sets that cannot be used.
+ */
+#include "dst.h"
+#include "harness.h"
+#include "pf.h"
+
+static h_dev_t dev;
+static h_dev_t *const d = &dev;
+
+static void test_registry(void)
+{
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        CHECK(product_find(product_list[i]->id) == product_list[i]);
+    }
+    CHECK(product_find("dst-x730") == NULL); /* a prefix is no ID */
+    CHECK(product_find("") == NULL);
+    CHECK(product_find("DST-X730-XY30") == NULL);
+    /* Bit-rate codes (kbit/s): CiA (DST, GSH-A), ifm (JD 3001h), P+F. */
+    CHECK_EQ(product_kbps(&dst_x730_xy30, 0), 1000);
+    CHECK_EQ(product_kbps(&dst_x730_xy30, 3), 250);
+    CHECK_EQ(product_kbps(&dst_x730_xy30, 7), 20);
+    CHECK_EQ(product_kbps(&dst_x730_xy30, 8), 0);  /* no such code */
+    CHECK_EQ(product_kbps(&dst_x730_xy30, 16), 0); /* outside the table */
+    CHECK_EQ(product_kbps(&dst_x730_xy30, 255), 0);
+    CHECK_EQ(product_kbps(product_find("jd2xxx"), 0), 20);
+    CHECK_EQ(product_kbps(product_find("jd2xxx"), 7), 1000);
+    CHECK_EQ(product_kbps(&pf_inx360d, 2), 250);
+    CHECK_EQ(product_kbps(&pf_inx360d, 3), 0);
+    product_t none = {.id = "no-table"};
+    CHECK_EQ(product_kbps(&none, 3), 0);
+}
+
+static void boot_dst(void)
+{
+    h_boot(d, &dst_x730_xy30, false);
+    EXPECT(d, 0x77F, "00");
+}
+
+static void test_dst_values(void)
+{
+    boot_dst();
+    SDO(d, "2B 17 10 00 14 00 00 00", "60 17 10 00 00 00 00 00"); /* 20 ms */
+    SDO(d, "2B 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00"); /* 0: off */
+    SDO(d, "2B 17 10 00 13 00 00 00", "80 17 10 00 30 00 09 06"); /* 1-19 refused */
+    /* C-18: 1..240 and 254 only. */
+    SDO(d, "2F 00 18 02 FF 00 00 00", "80 00 18 02 30 00 09 06");
+    SDO(d, "2F 00 18 02 FC 00 00 00", "80 00 18 02 30 00 09 06");
+    SDO(d, "2F 00 18 02 F1 00 00 00", "80 00 18 02 30 00 09 06");
+    SDO(d, "2F 00 18 02 F0 00 00 00", "60 00 18 02 00 00 00 00");
+    /* 0x6000: 0.01, 0.05, 0.1, 0.5, 1 deg. */
+    static const char *const ok[] = {"2B 00 60 00 32 00 00 00", "2B 00 60 00 F4 01 00 00",
+                                     "2B 00 60 00 E8 03 00 00", "2B 00 60 00 0A 00 00 00"};
+    for (unsigned i = 0; i < 4u; i++) {
+        SDO(d, ok[i], "60 00 60 00 00 00 00 00");
+    }
+    SDO(d, "2B 00 60 00 14 00 00 00", "80 00 60 00 30 00 09 06"); /* 0.02 */
+    /* EMCY COB-ID: CAN-ID 0 is no EMCY while valid (CiA 301 7.3.5); an
+     * invalid one may name any CAN-ID. */
+    SDO(d, "23 14 10 00 00 00 00 00", "80 14 10 00 30 00 09 06");
+    SDO(d, "23 14 10 00 00 00 00 80", "60 14 10 00 00 00 00 00");
+}
+
+/* B-44: the pair is written to EEPROM when both copies agree on a new
+ * value; agreeing on the active one costs no write cycle. */
+static void test_dst_node_id_pair_unchanged(void)
+{
+    boot_dst();
+    unsigned w = d->port.nvm_writes;
+    SDO(d, "2F F0 20 00 7F 00 00 00", "60 F0 20 00 00 00 00 00");
+    SDO(d, "2F F1 20 00 7F 00 00 00", "60 F1 20 00 00 00 00 00");
+    CHECK_EQ(d->port.nvm_writes, w);
+    SDO(d, "2F F0 20 00 20 00 00 00", "60 F0 20 00 00 00 00 00");
+    CHECK_EQ(d->port.nvm_writes, w);
+    SDO(d, "2F F1 20 00 20 00 00 00", "60 F1 20 00 00 00 00 00");
+    CHECK(d->port.nvm_writes > w);
+    h_power_cycle(d);
+    EXPECT(d, 0x720, "00");
+}
+
+/* 0x5001 = 0 (big endian), saved: the PDOs after the next power-on too. */
+static void test_dst_big_endian_after_reset(void)
+{
+    boot_dst();
+    d->truth[0] = 12500;
+    d->truth[1] = -3000;
+    h_advance(d, 3000000); /* the filter settles */
+    SDO(d, "2F 01 50 00 00 00 00 00", "60 01 50 00 00 00 00 00");
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_power_cycle(d);
+    h_advance(d, 3000000);
+    h_rx(d, 0x000, "01 7F");
+    h_advance(d, 1000);
+    EXPECT_ID(d, 0x1FF, "00 FA FF C4 00 00 00 00"); /* 250, -60 in 0.05 deg (default) */
+}
+
+/* No EMCY in stopped: an error raised there is reported when EMCY is
+ * allowed again. With 0x4000 = 0 a new error in pre-operational keeps the
+ * state (only operational drops to pre-operational, C-42). */
+static void test_dst_error_while_stopped(void)
+{
+    boot_dst();
+    SDO(d, "2F 00 40 00 00 00 00 00", "60 00 40 00 00 00 00 00");
+    h_rx(d, 0x000, "02 7F");
+    h_drain(d);
+    d->fault = 1;
+    h_advance(d, 20000);
+    EXPECT_NONE(d);
+    h_rx(d, 0x000, "80 7F");
+    h_advance(d, 1000);
+    EXPECT(d, 0x0FF, "00 10 00 00 01 00 00 00");
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
+    d->fault = 0;
+    h_advance(d, 20000);
+    EXPECT(d, 0x0FF, "00 00 00 00 00 00 00 00");
+}
+
+/* An EEPROM that cannot be read at power-on: defaults, and 0x4001 bit 6
+ * with an EMCY, as a corrupt stored set is reported. */
+static void test_dst_eeprom_unreadable(void)
+{
+    boot_dst();
+    d->port.nvm_read_fails = true;
+    h_power_cycle(d);
+    EXPECT(d, 0x77F, "00");
+    h_advance(d, 1000);
+    EXPECT(d, 0x0FF, "00 10 00 00 40 00 00 00");
+    d->port.nvm_read_fails = false;
+    CHECK_EQ(h_read(d, 0x4001, 0), 0x40);
+}
+
+static void boot_pf(const product_t *p)
+{
+    h_boot(d, p, false);
+    EXPECT(d, 0x701, "00");
+}
+
+/* L760: the resolution is fixed at 0.1 deg. */
+static void test_pf_resolution_fixed(void)
+{
+    boot_pf(&pf_inx360d);
+    SDO(d, "2B 00 60 00 64 00 00 00", "60 00 60 00 00 00 00 00");
+    SDO(d, "2B 00 60 00 0A 00 00 00", "80 00 60 00 30 00 09 06");
+    SDO(d, "40 00 60 00 00 00 00 00", "4B 00 60 00 64 00 00 00");
+}
+
+/* The err LED (L212-227): bus-off on (run off), Y out of range 1x flash. */
+static void test_pf_leds(void)
+{
+    boot_pf(&pf_iny360d);
+    co_led_pattern_t run;
+    co_led_pattern_t err;
+    co_node_set_can_state(d->node, CO_CAN_BUSOFF);
+    co_node_led_patterns(d->node, &run, &err);
+    CHECK(run == CO_LED_OFF && err == CO_LED_ON);
+    co_node_set_can_state(d->node, CO_CAN_ACTIVE);
+    d->fault = PF_FAULT_RANGE_Y;
+    h_advance(d, 10000);
+    co_node_led_patterns(d->node, &run, &err);
+    CHECK(run == CO_LED_BLINK && err == CO_LED_FLASH1);
+}
+
+/* 6300h (R52) for a stored set that cannot be used: unreadable EEPROM,
+ * or a node-ID / bit-rate record that fails its check; err LED 2x flash. */
+static void test_pf_stored_set_unusable(void)
+{
+    boot_pf(&pf_inx360d);
+    d->port.nvm_read_fails = true;
+    h_power_cycle(d);
+    EXPECT(d, 0x701, "00");
+    h_advance(d, 10000);
+    EXPECT(d, 0x081, "00 63 01 00 00 00 00 00");
+    co_led_pattern_t run;
+    co_led_pattern_t err;
+    co_node_led_patterns(d->node, &run, &err);
+    CHECK(err == CO_LED_FLASH2);
+    d->port.nvm_read_fails = false;
+    /* A record header in the node-ID set's first slot with nothing valid behind it. */
+    boot_pf(&pf_inx360d);
+    static const uint8_t magic[4] = {0x43, 0x6F, 0x50, 0x53}; /* "CoPS" */
+    memcpy(&d->port.nvm[2u * CO_STORE_SLOT], magic, 4);
+    h_power_cycle(d);
+    EXPECT(d, 0x701, "00");
+    CHECK_EQ(d->node->store.status[CO_CLS_LSS], CO_STORE_CORRUPT);
+    h_advance(d, 10000);
+    EXPECT(d, 0x081, "00 63 01 00 00 00 00 00");
+}
+
+int main(void)
+{
+    RUN(test_registry);
+    RUN(test_dst_values);
+    RUN(test_dst_node_id_pair_unchanged);
+    RUN(test_dst_big_endian_after_reset);
+    RUN(test_dst_error_while_stopped);
+    RUN(test_dst_eeprom_unreadable);
+    RUN(test_pf_resolution_fixed);
+    RUN(test_pf_leds);
+    RUN(test_pf_stored_set_unusable);
+    return h_finish();
+}
