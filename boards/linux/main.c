@@ -273,6 +273,14 @@ int main(int argc, char **argv)
     int led_green = 0;
     int led_red = 1;
     bool eds = false;
+    /* --on-eof quit by default: standard input is the sensor's tie to whoever
+     * started it. A CI job whose parent exits or dies closes the pipe, and
+     * the sensor leaves the bus instead of running on as an orphan; Ctrl-D
+     * stops it too. No PR_SET_PDEATHSIG: it fires when the parent *thread*
+     * ends (a Python thread that started the sensor, the process living on)
+     * and would kill a sensor a script starts in the background on purpose.
+     * --on-eof run is for input that ends at once (/dev/null, a daemon, a
+     * file of commands, tools/vcan-run). */
     bool quit_on_eof = true;
     static const struct option opts[] = {
         {"product", required_argument, NULL, 'p'}, {"iface", required_argument, NULL, 'i'},
