@@ -498,6 +498,7 @@ int main(int argc, char **argv)
             leds_set(&a.leds[i], i, g, rd, gp, rp);
             wait = co_min_u32(wait, led_next);
             backlog |= lp_flush(&a.ports[i]) > 0u;
+            sync_can_state(&a, i); /* a write may have found the link gone */
         }
         log_states(&a);
         log_held_input(&a, t);

@@ -117,18 +117,30 @@ static lp_link_t link_probe(lp_port_t *p, int *index, const char **cause)
     return (ifr.ifr_flags & IFF_UP) != 0 ? LP_LINK_UP : LP_LINK_DOWN;
 }
 
-/* Probe the link now and log a change. */
-static void link_check(lp_port_t *p, uint32_t now)
+/*
+ * Probe the link now and log a change. lost: the kernel just said the link
+ * went down or away (a socket error); should it be up again already, the
+ * node still sees a bus-off for a moment (lp_poll ends it), so that no
+ * loss of the bus goes unreported.
+ */
+static void link_check(lp_port_t *p, uint32_t now, bool lost)
 {
     int index = p->ifindex;
     const char *cause;
     lp_link_t l = link_probe(p, &index, &cause);
     p->link_check_at = now + LP_LINK_POLL_US;
     if (l == (lp_link_t)p->link) {
-        if (l == LP_LINK_UP && index != p->ifindex) {
-            lp_log("node %u: %s was re-created (index %d -> %d): socket bound again", p->node,
-                   p->iface, p->ifindex, index);
+        if (l == LP_LINK_UP && (lost || index != p->ifindex)) {
+            char again[64] = "";
+            if (index != p->ifindex) {
+                snprintf(again, sizeof(again), " (re-created, index %d: socket bound again)",
+                         index);
+            }
+            lp_log("node %u: %s went down and is up again%s: a moment of CAN bus-off", p->node,
+                   p->iface, again);
             p->ifindex = index;
+            p->link_blip = true;
+            drop_txq(p);
         }
         return;
     }
@@ -208,7 +220,7 @@ void lp_close(lp_port_t *p)
 
 co_can_state_t lp_can_state(const lp_port_t *p)
 {
-    if (p->link != LP_LINK_UP) {
+    if (p->link != LP_LINK_UP || p->link_blip) {
         return CO_CAN_BUSOFF;
     }
     return (co_can_state_t)(p->ctrl_state > p->sim_state ? p->ctrl_state : p->sim_state);
@@ -251,9 +263,10 @@ uint32_t lp_poll(lp_port_t *p, uint32_t now)
 {
     p->now = now;
     uint32_t next = CO_NEVER;
+    p->link_blip = false;
     if (p->link != LP_LINK_UP) {
         if (!co_time_before(now, p->link_check_at)) {
-            link_check(p, now);
+            link_check(p, now, false);
         }
         if (p->link != LP_LINK_UP) {
             next = co_time_until(now, p->link_check_at);
@@ -297,7 +310,7 @@ static int write_frame(lp_port_t *p, const co_frame_t *f)
         return 0; /* the kernel's queue is full: keep it for later */
     }
     if (n < 0 && link_errno(errno)) {
-        link_check(p, p->now); /* the frame is lost with the link */
+        link_check(p, p->now, true); /* the frame is lost with the link */
         return -1;
     }
     if (lp_rate_allow(&p->err_rate, p->now, 3u)) {
@@ -394,7 +407,7 @@ static unsigned read_batch(lp_port_t *p, uint32_t now)
             return 0;
         }
         if (link_errno(errno)) {
-            link_check(p, now);
+            link_check(p, now, true);
         } else if (lp_rate_allow(&p->err_rate, now, 3u)) {
             lp_log("node %u: CAN read on %s failed: %s", p->node, p->iface, strerror(errno));
         }

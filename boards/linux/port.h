@@ -72,6 +72,8 @@ typedef struct lp_port {
     int link;               /* lp_link_t */
     int ifindex;            /* of the interface last bound (0: never) */
     uint32_t link_check_at; /* next look while not up */
+    bool link_blip;         /* the link went down and came back before it was
+                             * looked at: bus-off until the next lp_poll */
     /* CAN controller */
     int ctrl_state;         /* co_can_state_t from the kernel's error frames */
     int sim_state;          /* co_can_state_t of the simulated controller */

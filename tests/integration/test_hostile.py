@@ -186,6 +186,14 @@ def test_interface_down_deleted_recreated(tmp_path, procs):
     node = 10
     p, b = boot(procs, tmp_path, "jd2xxx", node)
     assert sdo_write(b, node, 0x1017, 0, 50, 2) == 0
+    b.shutdown()
+    # Down and up again at once: still a (short) bus-off, reported.
+    subprocess.run("ip link set vcan0 down && ip link set vcan0 up", shell=True, check=True)
+    b = bus(ids=[0x70A, 0x8A, 0x58A])
+    m = wait_for(b, 0x8A, 2)
+    assert m is not None and m.data[0:2] == b"\x40\x81", "a short link loss went unreported"
+    assert "node 0: vcan0 went down and is up again" in p.text() or \
+        "node 0: vcan0 is up again" in p.text()
     ip("set", "vcan0", "down")
     assert p.wait_log("node 0: vcan0 is down")
     assert p.wait_log("red on")
