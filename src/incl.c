@@ -9,16 +9,12 @@
 
 int32_t co_div_round(int32_t a, int32_t b)
 {
-    /* Half away from zero for every a: one division, and no a + b/2 that
-     * could overflow near INT32_MAX (nor -a at INT32_MIN). */
-    int32_t q = a / b;
-    int32_t r = a - q * b; /* the sign of a, |r| < b */
-    if (r > 0 && r >= b - r) {
-        q++;
-    } else if (r < 0 && -r >= b + r) {
-        q--;
-    }
-    return q;
+    /* Half away from zero, in unsigned arithmetic so that no a overflows
+     * (|a| <= 2^31, |a| + b/2 < 2^32). The result for INT32_MIN / 1 is
+     * converted back modulo 2^32 (gcc and clang define it). */
+    uint32_t m = a >= 0 ? (uint32_t)a : 0u - (uint32_t)a;
+    uint32_t q = (m + (uint32_t)b / 2u) / (uint32_t)b;
+    return a >= 0 ? (int32_t)q : (int32_t)(0u - q);
 }
 
 void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limit_mdeg, bool wrap)

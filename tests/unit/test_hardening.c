@@ -288,14 +288,25 @@ static void test_nvm_neither_blank_nor_valid(void)
 
 static void test_filter_takes_any_input(void)
 {
+    /* Beyond the range an input counts as the range's end, exactly. */
+    co_filter_t g;
+    co_filter_t h;
+    co_filter_reset(&g);
+    co_filter_reset(&h);
+    CHECK_EQ(co_filter_step(&g, -CO_FILTER_IN_MAX - 1, 2), -CO_FILTER_IN_MAX - 1);
+    CHECK_EQ(co_filter_step(&h, -CO_FILTER_IN_MAX - 2, 2), -CO_FILTER_IN_MAX - 1);
+    for (int i = 0; i < 50; i++) {
+        int32_t a = co_filter_step(&g, CO_FILTER_IN_MAX, 2);
+        CHECK_EQ(co_filter_step(&h, CO_FILTER_IN_MAX + 1 + i * 1000, 2), a);
+    }
     for (uint8_t shift = 0; shift <= 5u; shift++) {
         co_filter_t f;
         co_filter_reset(&f);
         int32_t y = co_filter_step(&f, INT32_MIN, shift);
-        CHECK_EQ(y, -CO_FILTER_IN_MAX);
+        CHECK_EQ(y, -CO_FILTER_IN_MAX - 1);
         for (int i = 0; i < 200; i++) {
             y = co_filter_step(&f, (i & 1) != 0 ? INT32_MIN : INT32_MAX, shift);
-            CHECK(y >= -CO_FILTER_IN_MAX && y <= CO_FILTER_IN_MAX);
+            CHECK(y >= -CO_FILTER_IN_MAX - 1 && y <= CO_FILTER_IN_MAX);
         }
         for (int i = 0; i < 2000; i++) {
             y = co_filter_step(&f, INT32_MAX, shift);
