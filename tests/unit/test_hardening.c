@@ -231,12 +231,15 @@ static void test_stored_values_pass_sdo_validation(void)
     h_power_cycle(d);
     EXPECT(d, 0x713, "00");
     h_advance(d, 1000);
-    EXPECT(d, 0x093, "00 63 01 00 00 00 00 00");
+    for (const co_frame_t *f = h_next(d); f != NULL; f = h_next(d)) {
+        CHECK(f->id != 0x093); /* the GSH-A sends no EMCY at all: the board logs it */
+    }
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    CHECK_EQ(d->node->store.status[CO_CLS_LSS], CO_STORE_CORRUPT);
     CHECK_EQ(h_read(d, 0x3001, 0), 0x13);
     CHECK_EQ(h_read(d, 0x1005, 0), 0x80);
     SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
-    h_advance(d, 1000);
-    EXPECT(d, 0x093, "00 00 00 00 00 00 00 00"); /* sound again: error reset */
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_OK); /* sound again */
 }
 
 /* Every product's defaults pass its own validation: a saved set of
@@ -245,14 +248,22 @@ static void test_every_default_passes_validation(void)
 {
     for (size_t i = 0; product_list[i] != NULL; i++) {
         h_boot(d, product_list[i], false);
-        for (unsigned n = 0; n < d->nnodes; n++) {
+        /* The nodes whose records fit the fake EEPROM (the qemu build's
+         * is 1 KB: the redundant GSH-A's second node is the first's twin). */
+        unsigned nodes = 0;
+        while (nodes < d->nnodes &&
+               d->nodes[nodes]->nvm_base + CO_STORE_NVM_SIZE <= sizeof(d->port.nvm)) {
+            nodes++;
+        }
+        CHECK(nodes >= 1u);
+        for (unsigned n = 0; n < nodes; n++) {
             CHECK_EQ(co_store_save(d->nodes[n], CO_CLS_PARA), CO_OK);
             if (d->nodes[n]->cfg->ram_size[CO_CLS_LSS] != 0u) {
                 CHECK_EQ(co_store_save(d->nodes[n], CO_CLS_LSS), CO_OK);
             }
         }
         h_power_cycle(d);
-        for (unsigned n = 0; n < d->nnodes; n++) {
+        for (unsigned n = 0; n < nodes; n++) {
             if (d->nodes[n]->store.status[CO_CLS_PARA] != CO_STORE_OK ||
                 d->nodes[n]->store.status[CO_CLS_LSS] == CO_STORE_CORRUPT) {
                 fprintf(stderr, "%s node %u: its defaults fail validation\n", product_list[i]->id, n);
