@@ -340,8 +340,11 @@ int main(int argc, char **argv)
         return usage_error("unknown product '%s' (see --list-products)", product);
     }
     if (eds) {
-        eds_write(stdout, prod);
-        return 0;
+        if (eds_write(stdout, prod) != 0) {
+            fprintf(stderr, "canopen-sensor: %s: EDS overrides that apply to no entry\n", prod->id);
+            return 1;
+        }
+        return fflush(stdout) == 0 ? 0 : 1;
     }
     if (iface == NULL) {
         return usage_error("--iface is missing");
