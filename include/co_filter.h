@@ -11,8 +11,9 @@
 #include "co_common.h"
 
 #define CO_FILTER_STAGES 3u
-/* Largest input magnitude (mdeg, about 4194 deg): beyond it an input
- * saturates, so that the Q8 arithmetic cannot overflow (filter.c). */
+/* Largest input (mdeg, about 4194 deg; the smallest is -CO_FILTER_IN_MAX - 1):
+ * beyond it an input saturates, so that the Q8 arithmetic cannot overflow
+ * (filter.c). */
 #define CO_FILTER_IN_MAX 4194303
 
 /* Sample period the shifts are tuned for. */
@@ -30,7 +31,7 @@ uint8_t co_filter_shift(uint8_t speed);
 void co_filter_reset(co_filter_t *f);
 
 /*
- * One sample in (millidegrees; beyond +-CO_FILTER_IN_MAX it saturates),
+ * One sample in (millidegrees; beyond CO_FILTER_IN_MAX either way it saturates),
  * filtered value out.
  * The first sample after a reset passes through unchanged.
  */

@@ -114,7 +114,7 @@ struct co_node {
     uint8_t reset_request;      /* co_reset_t to perform at the next poll (0: none) */
     bool dirty;                 /* something happened since the last full poll */
     bool due_never;             /* the last full poll found no deadline at all */
-    bool od_checking;           /* write hooks only validate (co_od_check) */
+    bool od_checking;           /* write hooks only validate (co_od_validate) */
     co_nmt_t nmt;
     const co_node_cfg_t *cfg;
     void *port;                 /* board context for co_port_* */
@@ -169,7 +169,7 @@ static inline void co_node_wake(co_node_t *node)
     node->dirty = true;
 }
 
-/* A write hook runs for co_od_check(): validate the value, act on nothing. */
+/* A write hook runs for co_od_validate(): validate the value, act on nothing. */
 static inline bool co_od_checking(const co_node_t *node)
 {
     return node->od_checking;

@@ -56,9 +56,13 @@ typedef enum co_cls {
  * Write hook: called instead of the plain store after access, length and
  * range checks passed. It may validate further, act, and call co_od_store()
  * to keep the value. A hook of a stored entry (class PARA or LSS) also
- * serves co_od_check(): while co_od_checking(node), it checks the value and
- * returns CO_OK or the abort code without acting. Read hook: computes the
- * value of a numeric entry.
+ * serves co_od_validate(), which hands it the value the entry holds
+ * already: while co_od_checking(node), co_od_store() stores nothing, and
+ * the hook must return (CO_OK or the abort code) before any rule of
+ * sequence ("invalidate the PDO first") and any action that is not a mere
+ * repetition (re-reading a configuration from RAM is one; a preset that
+ * computes an offset from the measurement is not). Read hook: computes
+ * the value of a numeric entry.
  */
 typedef co_res_t (*co_od_write_fn)(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 typedef co_res_t (*co_od_read_fn)(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
@@ -166,16 +170,16 @@ co_res_t co_od_read(co_node_t *node, const co_od_entry_t *e, uint32_t at, uint8_
 co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len);
 
 /*
- * Check, without storing or acting, that the value a writable entry e
- * holds in RAM could be written to it by SDO: its default always can;
- * otherwise the limits, then the write hook in check mode. In check mode
- * (co_od_checking(node) true) a hook validates the value alone and returns
- * before any rule of sequence ("invalidate the PDO first"), any store and
- * any action (a plain entry stores the value it holds again). CO_OK for
- * read-only entries, entries without RAM, strings and computed values.
- * The parameter store runs every restored value through it.
+ * Check, without acting, that the value the numeric entry e holds in RAM
+ * could be written to it by SDO: the limits, then the write hook in check
+ * mode (see co_od_write_fn); a read-only entry's limits too, where it has
+ * any. A value that fails is replaced by the entry's default, and false
+ * returned; entries without RAM and strings pass. Every default of a
+ * product's table must pass (tests/unit/test_hardening.c checks them
+ * all). The parameter store runs every restored value through it
+ * (co_store_validate).
  */
-co_res_t co_od_check(co_node_t *node, const co_od_entry_t *e);
+bool co_od_validate(co_node_t *node, const co_od_entry_t *e);
 
 /* Plain store of a numeric value into the entry's RAM (no checks, no hook). */
 co_res_t co_od_store(co_node_t *node, const co_od_entry_t *e, uint32_t value);

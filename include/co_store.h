@@ -38,7 +38,7 @@ typedef enum co_store_status {
     CO_STORE_DEFAULTS,     /* "load" was requested: defaults */
     CO_STORE_CORRUPT,      /* the slots hold something (not erased) but no valid record:
                             * defaults; or the newest record passed its CRC but some
-                            * values failed validation (co_od_check): those are
+                            * values failed validation (co_od_validate): those are
                             * defaults. Stays until the next full save */
     CO_STORE_HW,           /* NVM read failed: defaults */
 } co_store_status_t;
@@ -55,11 +55,19 @@ void co_store_init(co_node_t *node);
  * Restore the entries of class cls with index in [lo, hi] from the newest
  * valid record, or set them to their defaults; [0, 0xFFFF] restores the
  * whole struct (the LSS struct has no dictionary entries of its own).
- * Every restored value then passes co_od_check(), as an SDO write of it
- * would; one that fails takes its default (status CO_STORE_CORRUPT).
- * Returns and remembers why.
+ * Returns and remembers why. A record passed its CRC (CO_STORE_OK): its
+ * values must then pass co_store_validate() before anything uses them
+ * (co_node_reset does it; two calls, so that the restore's frame is off
+ * the stack while the write hooks run).
  */
 co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi);
+
+/*
+ * Run every value of class cls through co_od_validate(), as an SDO write of it
+ * would be checked; one that fails takes its default, and the set is
+ * reported as corrupt (status CO_STORE_CORRUPT) until the next full save.
+ */
+void co_store_validate(co_node_t *node, co_cls_t cls);
 
 /*
  * Save the RAM struct of class cls. Returns CO_OK, CO_E_STORE when the
@@ -81,7 +89,7 @@ co_res_t co_store_save_group(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_
  * A value of the restored set of cls that only the product can judge (the
  * DST's bit-rate code, kept without a dictionary entry) failed: the product
  * set it to its default; the set is reported as corrupt, like one whose
- * values fail co_od_check(), until the next full save.
+ * values fail co_od_validate(), until the next full save.
  */
 void co_store_mark_corrupt(co_node_t *node, co_cls_t cls);
 

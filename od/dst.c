@@ -30,10 +30,7 @@ co_res_t dst_write_emcy_cobid(co_node_t *n, const co_od_entry_t *e, uint32_t v)
      * not a restricted one while valid. The manual sets no rule on when the
      * CAN-ID may change: any time. */
     co_res_t c = co_cobid_check(v, false, true);
-    if (c != CO_OK || co_od_checking(n)) {
-        return c;
-    }
-    return co_od_store(n, e, v);
+    return c != CO_OK ? c : co_od_store(n, e, v);
 }
 
 co_res_t dst_write_tx_type(co_node_t *n, const co_od_entry_t *e, uint32_t v)
@@ -87,9 +84,6 @@ co_res_t dst_write_bitrate(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 
 co_res_t dst_write_coding(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
-    if (co_od_checking(n)) {
-        return CO_OK;
-    }
     co_res_t r = co_od_store(n, e, v);
     n->pdo_msb_first = dev_of(n)->para.pdo_coding == 0u;
     return r;

@@ -63,18 +63,12 @@ static void gsh_tpdo_fill(co_node_t *n, unsigned pdo, co_frame_t *f)
     c->counter++; /* built only to be sent: type 254 is fixed */
 }
 
-static uint32_t gsh_poll(co_node_t *n, uint32_t now)
-{
-    (void)now;
-    /* The manual says nothing of a broken stored set (C-38): defaults, and
-     * CiA 301's EMCY 6300h while they stand in for it. */
-    co_store_report_emcy(n);
-    return CO_NEVER;
-}
-
+/* A corrupt stored set (C-38): factory defaults, as the spec recommends.
+ * The GSH-A sends no EMCY at all (R-14, C-37: no EMCY object, 0x1001 is
+ * always 0) and its manual describes no LED, so the node itself reports
+ * nothing; the board logs it (the Linux program does). */
 const co_node_ops_t gsh_ops = {
     .reset = gsh_reset,
-    .poll = gsh_poll,
     .tpdo_fill = gsh_tpdo_fill,
 };
 

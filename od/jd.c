@@ -185,7 +185,7 @@ co_res_t jd_write_diff(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     if (!diff_ok(dev_of(n), x)) {
         return CO_E_VAL;
     }
-    return co_od_checking(n) ? CO_OK : co_od_store(n, e, v);
+    return co_od_store(n, e, v);
 }
 
 /* v in unit old, rounded into unit now (both 10, 100 or 1000): a division
@@ -228,9 +228,6 @@ co_res_t jd_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 co_res_t jd_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
     /* 0x1800:05, 0x1801:05 and 0x2200 are one value (R20). */
-    if (co_od_checking(n)) {
-        return CO_OK;
-    }
     co_res_t r = co_od_store(n, e, v);
     co_tpdo_reconfig(n, 0);
     co_tpdo_reconfig(n, 1);

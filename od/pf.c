@@ -20,9 +20,6 @@ co_res_t pf_write_bitrate(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     if (v != PF_BR_125K && v != PF_BR_250K && v != PF_BR_500K && v != PF_BR_1M) {
         return CO_E_VAL;
     }
-    if (co_od_checking(n)) {
-        return CO_OK;
-    }
     return co_od_store(n, e, v);
 }
 

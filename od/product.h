@@ -71,6 +71,11 @@ struct product {
     uint8_t bitrates;            /* supported bit rates, PRODUCT_BR_* bits */
     const uint16_t *kbps;        /* kbit/s of each bit-rate code (0: unused), 16 codes */
     bool lss;                    /* LSS slave (CiA 305) */
+#ifndef CO_OD_NO_NAMES
+    /* EDS values the manual wants other than the device's (product_eds.h),
+     * ended by index 0; NULL: none. Not in MCU images (they print no EDS). */
+    const struct product_eds_override *eds_overrides;
+#endif
 };
 
 /* Bit rates an EDS can declare (CiA 306 [DeviceInfo] BaudRate_x). */

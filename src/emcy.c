@@ -145,7 +145,7 @@ co_res_t co_emcy_cobid_write(co_node_t *node, const co_od_entry_t *e, uint32_t v
     /* Bits 30 and 29 zero, an 11-bit CAN-ID that is not restricted while
      * the EMCY is valid (CiA 301 7.3.5, 7.5.2.21). */
     co_res_t c = co_cobid_check(value, false, true);
-    if (c != CO_OK || co_od_checking(node)) {
+    if (c != CO_OK) {
         return c;
     }
     uint32_t cur;

@@ -16,15 +16,15 @@ void co_filter_reset(co_filter_t *f)
 
 int32_t co_filter_step(co_filter_t *f, int32_t x_mdeg, uint8_t shift)
 {
-    /* Safe by construction: |x| <= CO_FILTER_IN_MAX = 2^22 - 1 gives
-     * |v| < 2^30 in Q8; every stage is a weighted mean of such values, so
-     * |s| < 2^30 too, and v - s stays within +-2^31 - 1, as does v + 128.
-     * The inputs of every product are far smaller (product.h asserts it);
-     * a larger one saturates instead of overflowing. */
-    if (x_mdeg > CO_FILTER_IN_MAX) {
-        x_mdeg = CO_FILTER_IN_MAX;
-    } else if (x_mdeg < -CO_FILTER_IN_MAX) {
-        x_mdeg = -CO_FILTER_IN_MAX;
+    /* Safe by construction: x in [-2^22, 2^22 - 1] (CO_FILTER_IN_MAX) gives
+     * v in [-2^30, 2^30 - 256] in Q8; every stage is a weighted mean of
+     * such values and stays in that range too, so v - s stays within
+     * +-(2^31 - 256), and v + 128 cannot overflow either. The inputs of
+     * every product are far smaller (product.h asserts it); a larger one
+     * saturates instead of overflowing: x >> 22 is 0 or -1 exactly inside
+     * the range (arithmetic shifts, as below). */
+    if ((x_mdeg >> 22) != (x_mdeg >> 31)) {
+        x_mdeg = (x_mdeg >> 31) ^ CO_FILTER_IN_MAX; /* 2^22 - 1, or -2^22 */
     }
     int32_t v = x_mdeg * 256; /* Q8 */
     if (!f->primed) {

@@ -18,9 +18,6 @@ void co_hb_reconfig(co_node_t *node)
 
 co_res_t co_hb_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
-    if (co_od_checking(node)) {
-        return CO_OK;
-    }
     co_res_t r = co_od_store(node, e, value);
     if (r == CO_OK) {
         co_hb_reconfig(node);

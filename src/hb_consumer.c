@@ -28,9 +28,6 @@ co_res_t co_hbc_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t val
     if ((value & 0xFF000000u) != 0u || ((value >> 16) & 0xFFu) > 127u) {
         return CO_E_VAL;
     }
-    if (co_od_checking(node)) {
-        return CO_OK;
-    }
     co_res_t r = co_od_store(node, e, value);
     if (r == CO_OK) {
         co_hbc_reconfig(node);

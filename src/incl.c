@@ -9,16 +9,12 @@
 
 int32_t co_div_round(int32_t a, int32_t b)
 {
-    /* Half away from zero for every a: one division, and no a + b/2 that
-     * could overflow near INT32_MAX (nor -a at INT32_MIN). */
-    int32_t q = a / b;
-    int32_t r = a - q * b; /* the sign of a, |r| < b */
-    if (r > 0 && r >= b - r) {
-        q++;
-    } else if (r < 0 && -r >= b + r) {
-        q--;
-    }
-    return q;
+    /* Half away from zero, in unsigned arithmetic so that no a overflows
+     * (|a| <= 2^31, |a| + b/2 < 2^32). The result for INT32_MIN / 1 is
+     * converted back modulo 2^32 (gcc and clang define it). */
+    uint32_t m = a >= 0 ? (uint32_t)a : 0u - (uint32_t)a;
+    uint32_t q = (m + (uint32_t)b / 2u) / (uint32_t)b;
+    return a >= 0 ? (int32_t)q : (int32_t)(0u - q);
 }
 
 void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limit_mdeg, bool wrap)
@@ -35,13 +31,16 @@ void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limi
 
 static void refresh(co_incl_t *incl);
 
-/* Angle in [-180000, 180000) millidegrees. */
-static int32_t wrap180(int32_t a)
+/* Angle in [-180000, 180000) millidegrees. By whole turns, not by a
+ * division: the angles here are a few turns at most (the filter's input
+ * bound, co_filter.h), one or two passes; and no signed division helper
+ * in an MCU image. */
+static CO_NOINLINE int32_t wrap180(int32_t a)
 {
-    a %= FULL_TURN_MDEG;
-    if (a >= FULL_TURN_MDEG / 2) {
+    while (a >= FULL_TURN_MDEG / 2) {
         a -= FULL_TURN_MDEG;
-    } else if (a < -FULL_TURN_MDEG / 2) {
+    }
+    while (a < -FULL_TURN_MDEG / 2) {
         a += FULL_TURN_MDEG;
     }
     return a;
@@ -181,9 +180,12 @@ co_res_t co_incl_set_resolution(co_incl_t *incl, uint16_t res)
     }
     if (res != p->resolution) {
         p->resolution = res;
-        memset(p->preset, 0, sizeof(p->preset));
-        memset(p->offset, 0, sizeof(p->offset));
-        memset(p->diff, 0, sizeof(p->diff));
+        /* Presets, offsets and differential offsets: one run of int16_t. */
+        _Static_assert(offsetof(co_incl_para_t, diff) + sizeof(p->diff) -
+                               offsetof(co_incl_para_t, preset) ==
+                           sizeof(p->preset) + sizeof(p->offset) + sizeof(p->diff),
+                       "preset, offset, diff must be contiguous");
+        memset(p->preset, 0, sizeof(p->preset) + sizeof(p->offset) + sizeof(p->diff));
     }
     return CO_OK;
 }

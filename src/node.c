@@ -41,6 +41,14 @@ bool co_node_send(co_node_t *node, const co_frame_t *f)
     return true;
 }
 
+/* A restore, and the check of a record's values (co_store.h). */
+static void restore(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)
+{
+    if (co_store_restore(node, cls, lo, hi) == CO_STORE_OK) {
+        co_store_validate(node, cls);
+    }
+}
+
 void co_node_reset(co_node_t *node, co_reset_t kind)
 {
     co_node_wake(node);
@@ -49,20 +57,21 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
     node->nmt.state = CO_NMT_INIT;
     if (kind == CO_RESET_NODE) {
         co_od_defaults(node, CO_CLS_VOL, 0x0000, 0xFFFF);
-        (void)co_store_restore(node, CO_CLS_PARA, 0x0000, 0xFFFF);
-        (void)co_store_restore(node, CO_CLS_LSS, 0x0000, 0xFFFF);
+        restore(node, CO_CLS_PARA, 0x0000, 0xFFFF);
+        restore(node, CO_CLS_LSS, 0x0000, 0xFFFF);
     } else {
         co_od_defaults(node, CO_CLS_VOL, 0x1000, 0x1FFF);
-        (void)co_store_restore(node, CO_CLS_PARA, 0x1000, 0x1FFF);
+        restore(node, CO_CLS_PARA, 0x1000, 0x1FFF);
         if (co_cfg(node)->comm_reset_applies_id) {
-            (void)co_store_restore(node, CO_CLS_LSS, 0x0000, 0xFFFF);
+            restore(node, CO_CLS_LSS, 0x0000, 0xFFFF);
         }
     }
     const co_lss_para_t *lss = node->ram[CO_CLS_LSS];
     if (kind == CO_RESET_NODE || co_cfg(node)->comm_reset_applies_id) {
         bool id_ok = lss != NULL && lss->node_id >= 1u && lss->node_id <= 127u;
-        if (lss != NULL && !id_ok && node->store.status[CO_CLS_LSS] == CO_STORE_OK) {
-            co_store_mark_corrupt(node, CO_CLS_LSS); /* a stored node-ID out of 1..127 */
+        if (lss != NULL && !id_ok) {
+            /* Defaults always hold a good one: a stored node-ID out of 1..127. */
+            co_store_mark_corrupt(node, CO_CLS_LSS);
         }
         node->node_id = id_ok ? lss->node_id : co_cfg(node)->default_node_id;
         node->bitrate = lss != NULL ? lss->bitrate : co_cfg(node)->default_bitrate;

@@ -204,6 +204,9 @@ co_res_t co_od_store(co_node_t *node, const co_od_entry_t *e, uint32_t value)
     if (p == NULL) {
         return CO_E_RO;
     }
+    if (node->od_checking) {
+        return CO_OK; /* co_od_validate: the value is the one held already */
+    }
     if ((e->attr & CO_A_NODEID) != 0u) {
         uint32_t base = e->def & 0x7FFu;
         if ((value & 0x7FFu) == base + node->node_id) {
@@ -271,25 +274,23 @@ co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf
     return write_value(node, e, load_value(e, tmp));
 }
 
-co_res_t co_od_check(co_node_t *node, const co_od_entry_t *e)
+bool co_od_validate(co_node_t *node, const co_od_entry_t *e)
 {
-    const uint8_t *p = ram_of(node, e);
-    if (p == NULL || (e->attr & CO_A_W) == 0u || !is_number(e) || co_od_read_hook(e) != NULL) {
-        return CO_OK; /* no value an SDO write could have put there */
+    uint8_t *p = ram_of(node, e);
+    if (p == NULL || !is_number(e)) {
+        return true; /* nothing stored there to judge */
     }
     uint32_t v = load_value(e, p);
-    uint32_t def = e->def;
-    store_value(e, (uint8_t *)&def, def); /* the default's RAM image, read the same way */
-    if (v == load_value(e, (const uint8_t *)&def)) {
-        return CO_OK; /* the default: valid by definition */
-    }
     if ((e->attr & CO_A_NODEID) != 0u) {
         v = co_cobid_resolve(v, e->def, node->node_id);
     }
     node->od_checking = true;
     co_res_t r = write_value(node, e, v);
     node->od_checking = false;
-    return r;
+    if (r != CO_OK) {
+        store_value(e, p, e->def);
+    }
+    return r == CO_OK;
 }
 
 void co_od_defaults(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)

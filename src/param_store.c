@@ -35,7 +35,7 @@ typedef struct newest {
     uint32_t len;
 } newest_t;
 
-uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len)
+CO_NOINLINE uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len)
 {
     const uint8_t *p = data;
     crc = ~crc;
@@ -91,12 +91,13 @@ static slot_info_t check_slot(co_node_t *node, co_cls_t cls, unsigned copy, bool
         *hw_error = true;
         return s;
     }
-    /* Erased NVM (all 0xFF: a new EEPROM, a blank file) holds nothing;
-     * anything else is a record, maybe a broken one (random bytes, zeros). */
-    for (unsigned i = 0; i < sizeof(h) && !s.present; i++) {
-        s.present = h[i] != 0xFFu;
-    }
-    if (co_get_u32(&h[0]) != STORE_MAGIC) {
+    /* Erased NVM (0xFF: a new EEPROM, a blank file) holds nothing; anything
+     * else in the magic's place is a record, maybe a broken one (random
+     * bytes, zeros). A save writes the magic first, so a save cut short
+     * leaves an erased magic only where it wrote nothing at all. */
+    uint32_t magic = co_get_u32(&h[0]);
+    s.present = magic != 0xFFFFFFFFu;
+    if (magic != STORE_MAGIC) {
         return s;
     }
     s.seq = co_get_u32(&h[8]);
@@ -173,7 +174,7 @@ static void set_defaults(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi
 /* Read the newest valid record's entries of class cls with index in
  * [lo, hi] into RAM, or their defaults. Not inlined: its frame (the slot
  * summary) is off the stack again before validate() calls the hooks. */
-static CO_NOINLINE co_store_status_t load(co_node_t *node, co_cls_t cls, uint16_t lo,
+static co_store_status_t load(co_node_t *node, co_cls_t cls, uint16_t lo,
                                           uint16_t hi)
 {
     newest_t nw = newest(node, cls);
@@ -187,27 +188,24 @@ static CO_NOINLINE co_store_status_t load(co_node_t *node, co_cls_t cls, uint16_
         st = CO_STORE_OK;
     }
     uint32_t data = slot_addr(node, cls, (unsigned)k) + CO_STORE_HDR;
-    if (st != CO_STORE_OK) {
-        set_defaults(node, cls, lo, hi);
-    } else if (lo == 0u && hi == 0xFFFFu) {
+    if (st == CO_STORE_OK && lo == 0u && hi == 0xFFFFu) {
         /* Verified: now copy what was asked for, straight from NVM. */
         if (!co_port_nvm_read(node->port, data, node->ram[cls], nw.len)) {
-            set_defaults(node, cls, lo, hi);
             st = CO_STORE_HW;
         }
-    } else {
+    } else if (st == CO_STORE_OK) {
         const co_od_t *od = co_cfg(node)->od;
-        for (uint16_t i = 0; i < od->count; i++) {
+        for (uint16_t i = 0; i < od->count && st == CO_STORE_OK; i++) {
             const co_od_entry_t *e = &od->entries[i];
-            if (e->cls == cls && e->index >= lo && e->index <= hi) {
-                uint8_t *p = (uint8_t *)node->ram[cls] + e->off;
-                if (!co_port_nvm_read(node->port, data + e->off, p, e->size)) {
-                    set_defaults(node, cls, lo, hi);
-                    st = CO_STORE_HW;
-                    break;
-                }
+            if (e->cls == cls && e->index >= lo && e->index <= hi &&
+                !co_port_nvm_read(node->port, data + e->off, (uint8_t *)node->ram[cls] + e->off,
+                                  e->size)) {
+                st = CO_STORE_HW;
             }
         }
+    }
+    if (st != CO_STORE_OK) {
+        set_defaults(node, cls, lo, hi);
     }
     return st;
 }
@@ -217,13 +215,12 @@ static CO_NOINLINE co_store_status_t load(co_node_t *node, co_cls_t cls, uint16_
  * a valid CRC): each one that fails is set to its default and the set is
  * marked corrupt. The whole class is checked, also after a partial
  * restore: the rest holds values that passed before or came by SDO. */
-static CO_NOINLINE void validate(co_node_t *node, co_cls_t cls)
+void co_store_validate(co_node_t *node, co_cls_t cls)
 {
     const co_od_t *od = co_cfg(node)->od;
     const co_od_entry_t *end = od->entries + od->count;
     for (const co_od_entry_t *e = od->entries; e < end; e++) {
-        if (e->cls == cls && co_od_check(node, e) != CO_OK) {
-            co_od_native(e, e->def, (uint8_t *)node->ram[cls] + e->off);
+        if (e->cls == cls && !co_od_validate(node, e)) {
             node->store.status[cls] = CO_STORE_CORRUPT;
         }
     }
@@ -240,10 +237,7 @@ co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, u
                          node->store.status[cls] == CO_STORE_CORRUPT;
     co_store_status_t st = load(node, cls, lo, hi);
     node->store.status[cls] = (uint8_t)(st == CO_STORE_OK && still_corrupt ? CO_STORE_CORRUPT : st);
-    if (st == CO_STORE_OK) {
-        validate(node, cls);
-    }
-    return (co_store_status_t)node->store.status[cls];
+    return st;
 }
 
 void co_store_mark_corrupt(co_node_t *node, co_cls_t cls)

@@ -23,7 +23,7 @@ co_res_t co_sync_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
      * to a consumer; never a restricted CAN-ID (co_node_receive relies on
      * it for SDO frames). */
     co_res_t c = co_cobid_check(value, false, false);
-    if (c != CO_OK || co_od_checking(node)) {
+    if (c != CO_OK) {
         return c;
     }
     co_res_t r = co_od_store(node, e, value);

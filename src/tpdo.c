@@ -15,7 +15,7 @@ enum {
     TYPE_EVENT_MFR = 254,
 };
 
-static uint32_t get_or(co_node_t *node, uint16_t index, uint8_t sub, uint32_t dflt)
+static CO_NOINLINE uint32_t get_or(co_node_t *node, uint16_t index, uint8_t sub, uint32_t dflt)
 {
     const co_od_entry_t *e = co_node_entry(node, index, sub);
     uint32_t v = dflt;
@@ -109,9 +109,6 @@ co_res_t co_tpdo_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
     if (e->sub == 2u && value > TYPE_SYNC_MAX && value < TYPE_RTR_SYNC) {
         return CO_E_VAL; /* reserved transmission types */
     }
-    if (co_od_checking(node)) {
-        return CO_OK;
-    }
     co_res_t r = co_od_store(node, e, value);
     if (r == CO_OK && tpdo_number(e) < CO_TPDO_MAX) {
         co_tpdo_reconfig(node, tpdo_number(e));
@@ -123,7 +120,7 @@ co_res_t co_tpdo_cobid_write_hook(co_node_t *node, const co_od_entry_t *e, uint3
 {
     /* Bit 30 is "no RTR"; an invalid COB-ID may name any CAN-ID (0x80000000). */
     co_res_t c = co_cobid_check(value, true, true);
-    if (c != CO_OK || co_od_checking(node)) {
+    if (c != CO_OK) {
         return c;
     }
     uint32_t cur;

@@ -5,6 +5,8 @@
 
 #include <stdbool.h>
 
+#include "product_eds.h"
+
 static bool is_signed(const co_od_entry_t *e)
 {
     return e->type == CO_T_I8 || e->type == CO_T_I16 || e->type == CO_T_I32;
@@ -25,7 +27,8 @@ static const char *access_type(const co_od_entry_t *e)
     }
 }
 
-static void value(FILE *f, const char *key, const co_od_entry_t *e, uint32_t v)
+/* v as the EDS writes e's values: signed decimal or unsigned hex. */
+static void format_value(char *buf, size_t len, const co_od_entry_t *e, uint32_t v)
 {
     if (is_signed(e)) {
         int32_t s = (int32_t)v;
@@ -34,24 +37,57 @@ static void value(FILE *f, const char *key, const co_od_entry_t *e, uint32_t v)
         } else if (e->size == 2u) {
             s = (int16_t)v;
         }
-        fprintf(f, "%s=%ld\n", key, (long)s);
+        snprintf(buf, len, "%ld", (long)s);
     } else {
-        fprintf(f, "%s=0x%lX\n", key, (unsigned long)v);
+        snprintf(buf, len, "0x%lX", (unsigned long)v);
     }
 }
 
-static void entry_body(FILE *f, const co_od_entry_t *e, const char *name)
+static void value(FILE *f, const char *key, const co_od_entry_t *e, uint32_t v)
+{
+    char buf[16];
+    format_value(buf, sizeof(buf), e, v);
+    fprintf(f, "%s=%s\n", key, buf);
+}
+
+/* The override of p for entry e, or NULL. Only numeric entries with a
+ * default of their own can have one: not strings, not values computed at
+ * run time, not $NODEID-relative ones. */
+static const product_eds_override_t *override_of(const product_t *p, const co_od_entry_t *e)
+{
+    if (p->eds_overrides == NULL || e->type == CO_T_VSTR || (e->attr & CO_A_NODEID) != 0u ||
+        co_od_read_hook(e) != NULL) {
+        return NULL;
+    }
+    for (const product_eds_override_t *o = p->eds_overrides; o->index != 0u; o++) {
+        if (o->index == e->index && o->sub == e->sub) {
+            return o;
+        }
+    }
+    return NULL;
+}
+
+static void entry_body(FILE *f, const product_t *p, const co_od_entry_t *e, const char *name)
 {
     fprintf(f, "ParameterName=%s\n", name);
     fprintf(f, "ObjectType=0x7\n");
     fprintf(f, "DataType=0x%04X\n", (unsigned)e->type);
     fprintf(f, "AccessType=%s\n", access_type(e));
+    const product_eds_override_t *o = override_of(p, e);
     if (e->type == CO_T_VSTR) {
         fprintf(f, "DefaultValue=%.*s\n", (int)e->size, (const char *)e->cdata);
     } else if ((e->attr & CO_A_NODEID) != 0u) {
         fprintf(f, "DefaultValue=$NODEID+0x%lX\n", (unsigned long)e->def);
     } else if (co_od_read_hook(e) != NULL) {
         fprintf(f, "DefaultValue=0\n"); /* computed at run time */
+    } else if (o != NULL) {
+        /* The manual asks the EDS for another value than the device's:
+         * an EDS comment line says so (CiA 306: lines starting with ';'). */
+        char dev[16];
+        format_value(dev, sizeof(dev), e, e->def);
+        fprintf(f, "; the device's default is %s; this EDS gives the value its manual asks for: %s\n",
+                dev, o->reason);
+        value(f, "DefaultValue", e, o->value);
     } else {
         value(f, "DefaultValue", e, e->def);
     }
@@ -90,7 +126,7 @@ static void object_list(FILE *f, const co_od_t *od, group_t g, const char *secti
     fprintf(f, "\n");
 }
 
-void eds_write(FILE *f, const product_t *p)
+int eds_write(FILE *f, const product_t *p)
 {
     const co_od_t *od = p->cfg->od;
     unsigned tpdos = 0;
@@ -141,7 +177,7 @@ void eds_write(FILE *f, const product_t *p)
         const char *name = e->name != NULL ? e->name : "Object";
         if (end - i == 1 && e->sub == 0u) {
             fprintf(f, "[%04X]\n", index);
-            entry_body(f, e, name);
+            entry_body(f, p, e, name);
         } else {
             fprintf(f, "[%04X]\nParameterName=%s\nObjectType=0x9\nSubNumber=%u\n\n", index, name,
                     (unsigned)(end - i));
@@ -154,9 +190,16 @@ void eds_write(FILE *f, const product_t *p)
                     snprintf(sub_name, sizeof(sub_name), "%s", s->name != NULL ? s->name : "Sub");
                 }
                 fprintf(f, "[%04Xsub%X]\n", index, s->sub);
-                entry_body(f, s, sub_name);
+                entry_body(f, p, s, sub_name);
             }
         }
         i = end;
     }
+    /* Overrides that found no entry to apply to: a mistake in the product's table. */
+    int unused = 0;
+    for (const product_eds_override_t *o = p->eds_overrides; o != NULL && o->index != 0u; o++) {
+        const co_od_entry_t *e = co_od_find(od, o->index, o->sub, NULL);
+        unused += e == NULL || override_of(p, e) != o;
+    }
+    return unused;
 }

@@ -4,6 +4,7 @@
 #include "leds.h"
 
 #include <errno.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "port.h"
@@ -12,7 +13,8 @@
 #include <gpiod.h>
 #endif
 
-int leds_open(leds_t *l, const char *chip, int green_line, int red_line)
+int leds_open(leds_t *l, const char *chip, int green_line, int red_line, char *err,
+              unsigned errlen)
 {
     memset(l, 0, sizeof(*l));
     l->g = l->r = -1;
@@ -23,14 +25,15 @@ int leds_open(leds_t *l, const char *chip, int green_line, int red_line)
 #if defined(HAVE_GPIOD) && HAVE_GPIOD
     struct gpiod_chip *c = gpiod_chip_open_lookup(chip);
     if (c == NULL) {
-        lp_log("error: GPIO chip %s: %s", chip, strerror(errno));
+        snprintf(err, errlen, "--led-chip %s: %s", chip, strerror(errno));
         return -1;
     }
     struct gpiod_line *g = gpiod_chip_get_line(c, (unsigned)green_line);
     struct gpiod_line *r = gpiod_chip_get_line(c, (unsigned)red_line);
     if (g == NULL || r == NULL || gpiod_line_request_output(g, "canopen-sensor", 0) < 0 ||
         gpiod_line_request_output(r, "canopen-sensor", 0) < 0) {
-        lp_log("error: GPIO lines %d/%d on %s: %s", green_line, red_line, chip, strerror(errno));
+        snprintf(err, errlen, "GPIO lines %d/%d on %s: %s", green_line, red_line, chip,
+                 strerror(errno));
         gpiod_chip_close(c);
         return -1;
     }
@@ -42,7 +45,7 @@ int leds_open(leds_t *l, const char *chip, int green_line, int red_line)
 #else
     (void)green_line;
     (void)red_line;
-    lp_log("error: --led-chip given but this build has no libgpiod");
+    snprintf(err, errlen, "--led-chip given but this build has no libgpiod");
     return -1;
 #endif
 }
@@ -66,8 +69,9 @@ void leds_set(leds_t *l, unsigned node, bool green, bool red, co_led_pattern_t g
     l->r = red;
 }
 
-void leds_close(leds_t *l)
+void leds_close(leds_t *l, unsigned node)
 {
+    leds_set(l, node, false, false, CO_LED_OFF, CO_LED_OFF);
 #if defined(HAVE_GPIOD) && HAVE_GPIOD
     if (l->chip != NULL) {
         gpiod_chip_close(l->chip);

@@ -2,11 +2,21 @@
  * main.c - canopen-sensor: runs one product of od/ as a process on a
  * SocketCAN interface. One event loop (epoll) over the CAN sockets,
  * standard input (the simulated physics) and a signalfd; the timeout is
- * the earliest deadline the nodes, the sensor sampling and the LEDs ask for.
+ * the earliest deadline the nodes, the ports (link watch, simulated
+ * bus-off), the sensor sampling and the LEDs ask for.
+ *
+ * Exit status: 0 after a clean stop (quit, end of input with --on-eof
+ * quit, SIGINT, SIGTERM, SIGHUP); 1 when something the command line names
+ * fails at start (no such CAN interface, not CAN, no CAN in the kernel, an
+ * EEPROM file that cannot be read, GPIO) or the event loop fails; 2 for a
+ * wrong command line (including an --nvm that is not a regular file or is
+ * in a missing directory). Once running, nothing on the bus or the
+ * interface ends the process: a lost interface is a cable pull.
  */
 #include <errno.h>
 #include <getopt.h>
 #include <signal.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -32,23 +42,64 @@ static void usage(FILE *f)
             "Runs a simulated CANopen sensor on a SocketCAN interface.\n"
             "\n"
             "  --product ID       product to run (see --list-products)\n"
-            "  --iface IFACE      CAN interface, e.g. vcan0\n"
-            "  --nvm FILE         EEPROM file: parameters survive restarts (a restart\n"
-            "                     is a power cycle); created blank (defaults) if absent\n"
+            "  --iface IFACE      CAN interface, e.g. vcan0; A,B gives a two-node product\n"
+            "                     one interface per node\n"
+            "  --nvm FILE         EEPROM file (a regular file, or a new one in an existing\n"
+            "                     directory): parameters survive restarts (a restart is a\n"
+            "                     power cycle); the first save creates it\n"
             "  --log FILE         write the log there instead of stderr\n"
+            "  --on-eof quit|run  at the end of standard input (Ctrl-D, the parent's pipe\n"
+            "                     closed): stop (quit, the default) or run on until a signal\n"
             "  --led-chip CHIP    drive the LEDs on this GPIO chip (libgpiod), with\n"
-            "  --led-green LINE   the green (run) LED line and\n"
-            "  --led-red LINE     the red (error) LED line; without them LED changes are logged\n"
+            "  --led-green LINE   the green (run) LED line (default 0) and\n"
+            "  --led-red LINE     the red (error) LED line (default 1); without --led-chip\n"
+            "                     LED changes are logged\n"
             "  --eds              print the product's EDS (CiA 306) and exit\n"
             "  --list-products    print every product ID with a description\n"
             "  --help             this text\n"
             "\n"
-            "Standard input, one command a line:\n"
-            "  set x=<deg> y=<deg>      true inclination (dual axis)\n"
-            "  set z=<deg>              true inclination (single axis)\n"
-            "  fault NAME on|off        force a fault (DST: sensor; P+F: range-x,\n"
-            "                           range-y, undervoltage)\n"
-            "  quit                     stop\n");
+            "Standard input, one command a line (a bad line is rejected whole):\n"
+            "  set NAME=VALUE ...         true value of the product's inputs (below)\n"
+            "  fault NAME on|off          force one of the product's faults (below)\n"
+            "  can bus-off [SECONDS]      the CAN controller goes bus-off: nothing sent; the\n"
+            "                             bus stays unusable SECONDS (default 0), then it\n"
+            "                             is back after 128 x 11 bits at its bit rate\n"
+            "  can passive|warning|active the controller's error state\n"
+            "  quit                       stop\n"
+            "\n"
+            "Exit status: 0 clean stop (quit, end of input, SIGINT, SIGTERM, SIGHUP);\n"
+            "1 failure at start (interface, EEPROM read, GPIO) or of the event loop;\n"
+            "2 wrong command line.\n"
+            "\n"
+            "Products, their inputs and faults:\n");
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        char d[256];
+        sim_describe(product_list[i], d, sizeof(d));
+        fprintf(f, "  %-16s %s\n", product_list[i]->id, d);
+    }
+}
+
+/* A wrong command line: one line with the cause, exit status 2. */
+static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int usage_error(const char *fmt, ...)
+{
+    char msg[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof(msg), fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "canopen-sensor: %s (see --help)\n", msg);
+    return 2;
+}
+
+/* A failure at start: one line on stderr, and in the log when it is a file. */
+static int start_failure(bool log_file, int rc, const char *msg)
+{
+    fprintf(stderr, "canopen-sensor: %s\n", msg);
+    if (log_file) {
+        lp_log("error: %s", msg);
+    }
+    return rc;
 }
 
 static uint32_t now_us(void)
@@ -69,6 +120,9 @@ static int parse_int(const char *s, int *out)
     return 0;
 }
 
+/* Rejected input lines: at most this many logged a second, the rest counted. */
+#define IN_REJECT_LINES 5u
+
 typedef struct app {
     const product_t *prod;
     unsigned nnodes;
@@ -77,49 +131,94 @@ typedef struct app {
     leds_t leds[PRODUCT_MAX_NODES];
     uint8_t last_state[PRODUCT_MAX_NODES];
     sim_t sim;
-    char line[256];
-    size_t linelen;
-    bool line_overflow;
+    bool quit_on_eof;
+    lp_rate_t in_rate;
+    unsigned long in_held; /* rejected lines not logged yet */
 } app_t;
 
-static void handle_line(app_t *a, const char *line)
+/* The node sees the CAN state its port shows (link, error frames, simulator). */
+static void sync_can_state(app_t *a, unsigned i)
 {
-    char err[200];
-    if (!sim_command(&a->sim, line, err, sizeof(err))) {
-        fprintf(stderr, "canopen-sensor: %s\n", err);
-        lp_log("stdin rejected: %s", err);
-        return;
-    }
-    if (line[0] != '\0') {
-        lp_log("stdin: %s", line);
+    co_can_state_t s = lp_can_state(&a->ports[i]);
+    if (s != (co_can_state_t)a->nodes[i]->can_state) {
+        co_node_set_can_state(a->nodes[i], s);
     }
 }
 
-/* Read what stdin has; returns false at end of input. */
+/* A `can` command from standard input: every node's simulated controller. */
+static void apply_can_command(app_t *a, uint32_t now)
+{
+    if (!a->sim.can_request) {
+        return;
+    }
+    a->sim.can_request = false;
+    for (unsigned i = 0; i < a->nnodes; i++) {
+        uint32_t kbps = product_kbps(a->prod, a->nodes[i]->bitrate);
+        if (kbps == 0u) {
+            kbps = 125u; /* a code the product does not define: the usual default */
+        }
+        /* 128 x 11 recessive bits at the node's bit rate, rounded up */
+        uint32_t recovery_us = (LP_BUSOFF_RECOVERY_BITS * 1000u + kbps - 1u) / kbps;
+        lp_sim_can(&a->ports[i], a->sim.can_state, now, a->sim.can_hold_ms * 1000u, recovery_us);
+        sync_can_state(a, i);
+    }
+}
+
+static void log_held_input(app_t *a, uint32_t now)
+{
+    if (a->in_held != 0u && lp_rate_wait(&a->in_rate, now) == 0u) {
+        lp_log("stdin: %lu more lines rejected (not shown)", a->in_held);
+        fprintf(stderr, "canopen-sensor: %lu more lines rejected (not shown)\n", a->in_held);
+        a->in_held = 0;
+    }
+}
+
+/* sim_report_fn: the log (and stderr for rejections, rate-limited). */
+static void report_line(void *ctx, const char *line, const char *error)
+{
+    app_t *a = ctx;
+    if (error == NULL) {
+        lp_log("stdin: %s", line);
+        apply_can_command(a, now_us()); /* each `can` line when it comes */
+        return;
+    }
+    uint32_t now = now_us();
+    log_held_input(a, now);
+    if (lp_rate_allow(&a->in_rate, now, IN_REJECT_LINES)) {
+        fprintf(stderr, "canopen-sensor: %s\n", error);
+        lp_log("stdin rejected: %s", error);
+    } else {
+        a->in_held++;
+    }
+}
+
+static void end_of_input(app_t *a)
+{
+    sim_feed_end(&a->sim, report_line, a);
+    if (a->quit_on_eof) {
+        lp_log("end of standard input: stopping (--on-eof quit)");
+        a->sim.quit = true;
+    } else {
+        lp_log("end of standard input: running until a signal (--on-eof run)");
+    }
+}
+
+/* Read what stdin has; returns false at end of input (or a read error). */
 static bool read_stdin(app_t *a)
 {
     char buf[512];
     ssize_t n = read(STDIN_FILENO, buf, sizeof(buf));
+    if (n < 0 && (errno == EAGAIN || errno == EINTR)) {
+        return true;
+    }
+    if (n < 0) {
+        lp_log("standard input: %s: treated as its end", strerror(errno));
+    }
     if (n <= 0) {
-        return n < 0 && (errno == EAGAIN || errno == EINTR);
+        end_of_input(a);
+        return false;
     }
-    for (ssize_t i = 0; i < n; i++) {
-        char c = buf[i];
-        if (c == '\n') {
-            if (a->line_overflow) {
-                fprintf(stderr, "canopen-sensor: line too long, ignored\n");
-            } else {
-                a->line[a->linelen] = '\0';
-                handle_line(a, a->line);
-            }
-            a->linelen = 0;
-            a->line_overflow = false;
-        } else if (a->linelen + 1u < sizeof(a->line)) {
-            a->line[a->linelen++] = c;
-        } else {
-            a->line_overflow = true;
-        }
-    }
+    sim_feed(&a->sim, buf, (size_t)n, report_line, a);
     return true;
 }
 
@@ -137,6 +236,32 @@ static void log_states(app_t *a)
     }
 }
 
+/* After the start: say which stored sets could not be used (the stack
+ * flags them over CAN too, per product: 0x4001, EMCY, LEDs). */
+static void log_store_status(app_t *a, const lp_nvm_t *nvm)
+{
+    static const struct {
+        co_cls_t cls;
+        const char *what;
+    } sets[] = {{CO_CLS_PARA, "parameters"}, {CO_CLS_LSS, "node-ID and bit rate"}};
+    const char *file = nvm->path != NULL ? nvm->real : "(RAM)";
+    for (unsigned i = 0; i < a->nnodes; i++) {
+        for (unsigned k = 0; k < sizeof(sets) / sizeof(sets[0]); k++) {
+            if (co_cfg(a->nodes[i])->ram_size[sets[k].cls] == 0u) {
+                continue;
+            }
+            co_store_status_t st = (co_store_status_t)a->nodes[i]->store.status[sets[k].cls];
+            if (st == CO_STORE_CORRUPT || st == CO_STORE_HW) {
+                lp_log("node %u: EEPROM file %s: stored %s %s: factory defaults in use until "
+                       "the next save (the file is left as it is until then)",
+                       i, file, sets[k].what,
+                       st == CO_STORE_CORRUPT ? "corrupt (neither blank nor a valid record)"
+                                              : "unreadable (read error)");
+            }
+        }
+    }
+}
+
 int main(int argc, char **argv)
 {
     const char *product = NULL;
@@ -144,19 +269,30 @@ int main(int argc, char **argv)
     const char *nvm_path = NULL;
     const char *log_path = NULL;
     const char *led_chip = NULL;
+    const char *led_line_opt = NULL;
     int led_green = 0;
     int led_red = 1;
     bool eds = false;
+    /* --on-eof quit by default: standard input is the sensor's tie to whoever
+     * started it. A CI job whose parent exits or dies closes the pipe, and
+     * the sensor leaves the bus instead of running on as an orphan; Ctrl-D
+     * stops it too. No PR_SET_PDEATHSIG: it fires when the parent *thread*
+     * ends (a Python thread that started the sensor, the process living on)
+     * and would kill a sensor a script starts in the background on purpose.
+     * --on-eof run is for input that ends at once (/dev/null, a daemon, a
+     * file of commands, tools/vcan-run). */
+    bool quit_on_eof = true;
     static const struct option opts[] = {
         {"product", required_argument, NULL, 'p'}, {"iface", required_argument, NULL, 'i'},
         {"nvm", required_argument, NULL, 'n'},     {"log", required_argument, NULL, 'l'},
         {"led-chip", required_argument, NULL, 'c'}, {"led-green", required_argument, NULL, 'g'},
         {"led-red", required_argument, NULL, 'r'}, {"list-products", no_argument, NULL, 'L'},
-        {"eds", no_argument, NULL, 'E'},
+        {"eds", no_argument, NULL, 'E'},           {"on-eof", required_argument, NULL, 'o'},
         {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0},
     };
+    opterr = 0; /* our own one-line messages */
     int c;
-    while ((c = getopt_long(argc, argv, "", opts, NULL)) != -1) {
+    while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
         switch (c) {
         case 'p': product = optarg; break;
         case 'i': iface = optarg; break;
@@ -166,9 +302,15 @@ int main(int argc, char **argv)
         case 'g':
         case 'r':
             if (parse_int(optarg, c == 'g' ? &led_green : &led_red) != 0) {
-                fprintf(stderr, "canopen-sensor: bad GPIO line '%s'\n", optarg);
-                return 2;
+                return usage_error("bad GPIO line '%s'", optarg);
             }
+            led_line_opt = c == 'g' ? "--led-green" : "--led-red";
+            break;
+        case 'o':
+            if (strcmp(optarg, "quit") != 0 && strcmp(optarg, "run") != 0) {
+                return usage_error("--on-eof takes quit or run, not '%s'", optarg);
+            }
+            quit_on_eof = strcmp(optarg, "quit") == 0;
             break;
         case 'E':
             eds = true;
@@ -181,69 +323,103 @@ int main(int argc, char **argv)
         case 'h':
             usage(stdout);
             return 0;
+        case ':':
+            return usage_error("option %s needs a value", argv[optind - 1]);
         default:
-            usage(stderr);
-            return 2;
+            return usage_error("unknown option '%s'", argv[optind - 1]);
         }
     }
-    if (eds && product != NULL && optind == argc) {
-        const product_t *p = product_find(product);
-        if (p == NULL) {
-            fprintf(stderr, "canopen-sensor: unknown product '%s' (see --list-products)\n", product);
-            return 2;
+    if (optind != argc) {
+        return usage_error("unexpected argument '%s'", argv[optind]);
+    }
+    if (product == NULL) {
+        return usage_error("--product is missing");
+    }
+    const product_t *prod = product_find(product);
+    if (prod == NULL) {
+        return usage_error("unknown product '%s' (see --list-products)", product);
+    }
+    if (eds) {
+        if (eds_write(stdout, prod) != 0) {
+            fprintf(stderr, "canopen-sensor: %s: EDS overrides that apply to no entry\n", prod->id);
+            return 1;
         }
-        eds_write(stdout, p);
-        return 0;
+        return fflush(stdout) == 0 ? 0 : 1;
     }
-    if (optind != argc || product == NULL || iface == NULL) {
-        usage(stderr);
-        return 2;
+    if (iface == NULL) {
+        return usage_error("--iface is missing");
     }
+    if (led_line_opt != NULL && led_chip == NULL) {
+        return usage_error("%s needs --led-chip", led_line_opt);
+    }
+    if (led_chip != NULL && led_green == led_red) {
+        return usage_error("--led-green and --led-red are the same line (%d)", led_green);
+    }
+
+    /* Interfaces: one for all nodes, or one per node ("A,B"). */
+    char ifbuf[PRODUCT_MAX_NODES * IFNAMSIZ + 8];
+    if (snprintf(ifbuf, sizeof(ifbuf), "%s", iface) >= (int)sizeof(ifbuf)) {
+        return usage_error("--iface %s: too long", iface);
+    }
+    const char *ifn[PRODUCT_MAX_NODES];
+    unsigned nif = 0;
+    for (char *s = ifbuf, *comma;; s = comma + 1) {
+        comma = strchr(s, ',');
+        if (comma != NULL) {
+            *comma = '\0';
+        }
+        if (s[0] == '\0' || strlen(s) >= IFNAMSIZ) {
+            return usage_error("--iface %s: '%s' is not an interface name", iface, s);
+        }
+        if (nif == prod->nodes) {
+            return prod->nodes == 1u
+                       ? usage_error("%s has one node: give one interface, not '%s'", prod->id,
+                                     iface)
+                       : usage_error("%s has %u nodes: give one interface, or one per node "
+                                     "(A,B), not '%s'", prod->id, prod->nodes, iface);
+        }
+        ifn[nif++] = s;
+        if (comma == NULL) {
+            break;
+        }
+    }
+    for (unsigned i = nif; i < prod->nodes; i++) {
+        ifn[i] = ifn[0];
+    }
+
     app_t a;
     memset(&a, 0, sizeof(a));
-    a.prod = product_find(product);
-    if (a.prod == NULL) {
-        fprintf(stderr, "canopen-sensor: unknown product '%s' (see --list-products)\n", product);
-        return 2;
-    }
+    a.prod = prod;
+    a.quit_on_eof = quit_on_eof;
     if (log_path != NULL) {
         FILE *lf = fopen(log_path, "a");
         if (lf == NULL) {
-            fprintf(stderr, "canopen-sensor: --log %s: %s\n", log_path, strerror(errno));
-            return 2;
+            return usage_error("--log %s: %s", log_path, strerror(errno));
         }
         lp_log_open(lf);
     }
+    bool logf = log_path != NULL;
     a.nnodes = a.prod->nodes;
     sim_init(&a.sim, a.prod);
 
-    /* Interfaces: one for all nodes, or one per node ("A,B"). */
-    char ifbuf[128];
-    snprintf(ifbuf, sizeof(ifbuf), "%s", iface);
-    const char *ifn[PRODUCT_MAX_NODES] = {ifbuf, ifbuf};
-    char *comma = strchr(ifbuf, ',');
-    if (comma != NULL) {
-        *comma = '\0';
-        ifn[1] = comma + 1;
-        if (a.nnodes < 2u) {
-            fprintf(stderr, "canopen-sensor: %s has one node; give one interface\n", a.prod->id);
-            return 2;
-        }
-    }
-
+    char err[600];
     uint8_t nvm_mem[PRODUCT_MAX_NODES * CO_STORE_NVM_SIZE];
     lp_nvm_t nvm;
-    if (lp_nvm_open(&nvm, nvm_path, nvm_mem, (uint32_t)(a.nnodes * CO_STORE_NVM_SIZE)) != 0) {
-        return 1;
+    int r = lp_nvm_open(&nvm, nvm_path, nvm_mem, (uint32_t)(a.nnodes * CO_STORE_NVM_SIZE), err,
+                        sizeof(err));
+    if (r != 0) {
+        return start_failure(logf, r == -2 ? 2 : 1, err);
     }
+    uint32_t t = now_us();
     void *ports[PRODUCT_MAX_NODES];
     for (unsigned i = 0; i < a.nnodes; i++) {
-        if (lp_open(&a.ports[i], ifn[i], i, &nvm) != 0) {
-            return 1;
+        if (lp_open(&a.ports[i], ifn[i], i, &nvm, t, err, sizeof(err)) != 0) {
+            return start_failure(logf, 1, err);
         }
         ports[i] = &a.ports[i];
-        if (leds_open(&a.leds[i], i == 0 ? led_chip : NULL, led_green, led_red) != 0) {
-            return 1;
+        if (leds_open(&a.leds[i], i == 0 ? led_chip : NULL, led_green, led_red, err,
+                      sizeof(err)) != 0) {
+            return start_failure(logf, 1, err);
         }
     }
 
@@ -251,22 +427,23 @@ int main(int argc, char **argv)
     sigemptyset(&sigs);
     sigaddset(&sigs, SIGINT);
     sigaddset(&sigs, SIGTERM);
+    sigaddset(&sigs, SIGHUP);
     sigprocmask(SIG_BLOCK, &sigs, NULL);
     signal(SIGPIPE, SIG_IGN);
     int sfd = signalfd(-1, &sigs, SFD_CLOEXEC | SFD_NONBLOCK);
     int ep = epoll_create1(EPOLL_CLOEXEC);
     if (sfd < 0 || ep < 0) {
-        lp_log("error: epoll/signalfd: %s", strerror(errno));
-        return 1;
+        snprintf(err, sizeof(err), "epoll/signalfd: %s", strerror(errno));
+        return start_failure(logf, 1, err);
     }
     struct epoll_event ev = {.events = EPOLLIN};
     ev.data.u32 = 100;
     epoll_ctl(ep, EPOLL_CTL_ADD, sfd, &ev);
     ev.data.u32 = 101;
-    bool stdin_open = epoll_ctl(ep, EPOLL_CTL_ADD, STDIN_FILENO, &ev) == 0;
-    if (!stdin_open) {
-        lp_log("standard input cannot be polled (%s): no simulated input", strerror(errno));
-    }
+    /* A pipe or terminal is polled; a regular file or /dev/null cannot be
+     * (EPERM): it never blocks, so it is read to its end after the start. */
+    bool stdin_polled = epoll_ctl(ep, EPOLL_CTL_ADD, STDIN_FILENO, &ev) == 0;
+    int stdin_errno = stdin_polled ? 0 : errno;
     for (unsigned i = 0; i < a.nnodes; i++) {
         ev.data.u32 = i;
         epoll_ctl(ep, EPOLL_CTL_ADD, a.ports[i].fd, &ev);
@@ -275,17 +452,26 @@ int main(int argc, char **argv)
     /* The instance: on this stack frame, alive until main returns. */
     _Alignas(max_align_t) unsigned char mem[PRODUCT_INST_MAX];
     if (a.prod->inst_size > sizeof(mem)) {
-        lp_log("error: product instance too large");
-        return 1;
+        return start_failure(logf, 1, "product instance too large");
     }
     a.prod->create(a.prod, mem, ports, a.nodes);
     a.prod->sample(mem, a.sim.values, a.sim.faults);
-    uint32_t t = now_us();
+    t = now_us();
     for (unsigned i = 0; i < a.nnodes; i++) {
         co_node_start(a.nodes[i], t);
         lp_log("node %u: %s, node-ID 0x%02X on %s, bit-rate code %u = %u kbit/s (vcan ignores it)",
                i, a.prod->id, a.nodes[i]->node_id, ifn[i], a.nodes[i]->bitrate,
                product_kbps(a.prod, a.nodes[i]->bitrate));
+    }
+    log_store_status(&a, &nvm);
+    if (!stdin_polled) {
+        if (stdin_errno == EPERM) {
+            while (!a.sim.quit && read_stdin(&a)) {
+            }
+        } else {
+            lp_log("standard input cannot be polled (%s)", strerror(stdin_errno));
+            end_of_input(&a);
+        }
     }
     uint32_t next_sample = t + CO_FILTER_PERIOD_US;
     int rc = 0;
@@ -302,19 +488,26 @@ int main(int argc, char **argv)
         uint32_t wait = co_time_until(t, next_sample);
         bool backlog = false;
         for (unsigned i = 0; i < a.nnodes; i++) {
+            wait = co_min_u32(wait, lp_poll(&a.ports[i], t));
+            sync_can_state(&a, i);
             wait = co_min_u32(wait, co_node_poll(a.nodes[i], t));
             bool g;
-            bool r;
+            bool rd;
             uint32_t led_next;
             co_led_pattern_t gp;
             co_led_pattern_t rp;
-            co_node_leds(a.nodes[i], t, &g, &r, &led_next);
+            co_node_leds(a.nodes[i], t, &g, &rd, &led_next);
             co_node_led_patterns(a.nodes[i], &gp, &rp);
-            leds_set(&a.leds[i], i, g, r, gp, rp);
+            leds_set(&a.leds[i], i, g, rd, gp, rp);
             wait = co_min_u32(wait, led_next);
             backlog |= lp_flush(&a.ports[i]) > 0u;
+            sync_can_state(&a, i); /* a write may have found the link gone */
         }
         log_states(&a);
+        log_held_input(&a, t);
+        if (a.in_held != 0u) {
+            wait = co_min_u32(wait, lp_rate_wait(&a.in_rate, t));
+        }
         if (backlog) {
             wait = co_min_u32(wait, 1000u); /* retry the kernel's full queue soon */
         }
@@ -332,40 +525,44 @@ int main(int argc, char **argv)
             if (src == 100u) {
                 struct signalfd_siginfo si;
                 if (read(sfd, &si, sizeof(si)) == (ssize_t)sizeof(si)) {
-                    lp_log("signal %u: stopping", si.ssi_signo);
+                    lp_log("signal %u (%s): stopping", si.ssi_signo, strsignal((int)si.ssi_signo));
                     a.sim.quit = true;
                 }
             } else if (src == 101u) {
                 if (!read_stdin(&a)) {
                     epoll_ctl(ep, EPOLL_CTL_DEL, STDIN_FILENO, NULL);
-                    lp_log("end of standard input; running until a signal");
                 }
             } else if (src < a.nnodes) {
                 co_frame_t f;
-                co_can_state_t cs;
-                int r;
                 co_node_poll(a.nodes[src], t);
-                while ((r = lp_read(&a.ports[src], &f, &cs)) > 0) {
-                    if (r == 1) {
+                /* At most 64 frames, then the timers again: a flooded bus
+                 * must not starve the heartbeat (the rest stay queued in
+                 * the socket; epoll reports them at once). */
+                for (int m = 0; m < 64; m++) {
+                    int rr = lp_read(&a.ports[src], &f, t);
+                    if (rr == 0) {
+                        break;
+                    }
+                    if (rr == 1) {
                         co_node_receive(a.nodes[src], &f);
-                    } else {
-                        co_node_set_can_state(a.nodes[src], cs);
                     }
                 }
-                if (r < 0) {
-                    rc = 1;
-                    a.sim.quit = true;
-                }
+                sync_can_state(&a, src);
             }
         }
     }
     for (unsigned i = 0; i < a.nnodes; i++) {
-        lp_flush(&a.ports[i]);
-        leds_close(&a.leds[i]);
+        lp_port_t *p = &a.ports[i];
+        lp_flush(p);
+        leds_close(&a.leds[i], i); /* both LEDs off */
+        lp_report_drops(p);
+        lp_log("node %u: %lu frames received, %lu dropped by the kernel (receive queue full)", i,
+               p->rx_frames, p->rx_dropped);
         if (a.nodes[i]->tx_dropped != 0u) {
-            lp_log("node %u: %u frames could not be sent", i, a.nodes[i]->tx_dropped);
+            lp_log("node %u: %u frames could not be sent (%lu while off the bus)", i,
+                   a.nodes[i]->tx_dropped, p->tx_off);
         }
-        close(a.ports[i].fd);
+        lp_close(p);
     }
     lp_log("stopped");
     return rc;

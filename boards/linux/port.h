@@ -1,55 +1,166 @@
 /*
- * port.h - the Linux board: one SocketCAN raw socket per node, a file as
- * the EEPROM, and the log.
+ * port.h - the Linux board: one SocketCAN raw socket per node (with the
+ * link watch and the simulated CAN controller), a file as the EEPROM, and
+ * the log.
+ *
+ * The CAN state a node sees (lp_can_state) is the worst of three sources:
+ *  - the link: an interface that is down, deleted or not CAN is a cable
+ *    pull, shown as bus-off until the interface is back (looked for every
+ *    LP_LINK_POLL_US, and re-bound when it was deleted and re-created);
+ *  - the kernel's error frames (a real controller: warning, passive, bus-off);
+ *  - the simulated controller (standard input `can bus-off|passive|...`),
+ *    which recovers from bus-off by itself after 128 x 11 recessive bits.
+ * While the state is bus-off the port transmits nothing and discards what
+ * it receives, as a controller off the bus does.
+ * Everything here runs in the program's one thread; nothing blocks.
  */
 #ifndef LINUX_PORT_H
 #define LINUX_PORT_H
 
+#include <linux/can.h>
+#include <net/if.h>
 #include <stdio.h>
 
 #include "co_node.h"
 
 #define LP_TXQ 64u
+/* Frames taken from the kernel in one system call (recvmmsg). */
+#define LP_RXB 32u
+/* While the interface is down or missing, look at it this often. */
+#define LP_LINK_POLL_US 200000u
+/* Repeated log lines of one kind (dropped frames, rejected input) are
+ * limited per window of this length (lp_rate_t). */
+#define LP_RATE_US 1000000u
+/* A bus-off controller is back after 128 occurrences of 11 recessive bits
+ * (ISO 11898-1); the board turns that into time at the node's bit rate. */
+#define LP_BUSOFF_RECOVERY_BITS (128u * 11u)
 
 /* The EEPROM: one file shared by the nodes of a product. */
 typedef struct lp_nvm {
-    const char *path;  /* NULL: RAM only, lost at exit */
-    uint8_t *mem;      /* mirror of the file, size bytes (caller's storage) */
+    const char *path;  /* NULL: RAM only, lost at exit; else path[] below */
+    char real[4096];   /* the file's resolved path (symlinks followed) */
+    uint8_t *mem;      /* mirror of the file, size bytes (caller's storage); always
+                        * what the file holds (a write that fails changes neither) */
     uint32_t size;
     unsigned writes;   /* file commits, for diagnostics */
 } lp_nvm_t;
 
+/* A rate limit for one kind of log line: a window of LP_RATE_US from the
+ * first line, at most a given number of lines in it. */
+typedef struct lp_rate {
+    uint32_t start;          /* start of the current window */
+    unsigned shown;          /* lines logged in it */
+    bool open;               /* a window was started */
+} lp_rate_t;
+
+typedef enum lp_link {
+    LP_LINK_UP = 0,  /* bound, interface up */
+    LP_LINK_DOWN,    /* the interface exists but is down */
+    LP_LINK_ABSENT,  /* no such interface (deleted), or not a CAN interface */
+} lp_link_t;
+
 typedef struct lp_port {
-    int fd;               /* CAN_RAW socket, non-blocking */
+    int fd;               /* CAN_RAW socket, non-blocking; kept across link changes */
     const char *iface;
     unsigned node;        /* index, for log lines */
     lp_nvm_t *nvm;
     co_frame_t txq[LP_TXQ]; /* frames the kernel could not take yet */
     unsigned txh, txn;
     unsigned long tx_lost;  /* frames dropped because txq was full */
-    int can_state;          /* co_can_state_t */
+    unsigned long tx_off;   /* frames not sent because the controller was off the bus */
+    /* link watch */
+    int link;               /* lp_link_t */
+    int ifindex;            /* of the interface last bound (0: never) */
+    uint32_t link_check_at; /* next look while not up */
+    bool link_blip;         /* the link went down and came back before it was
+                             * looked at: bus-off until the next lp_poll */
+    /* CAN controller */
+    int ctrl_state;         /* co_can_state_t from the kernel's error frames */
+    int sim_state;          /* co_can_state_t of the simulated controller */
+    uint32_t sim_recover_at; /* simulated bus-off: back to error active then */
+    /* received frames: a batch read in one call, served one by one */
+    struct can_frame rxb[LP_RXB];
+    uint8_t rxlen[LP_RXB];    /* bytes each message had (a classic frame: 16) */
+    unsigned rxi, rxn;        /* next to serve, how many */
+    unsigned long rx_frames;  /* frames read */
+    uint32_t rx_ovfl;         /* the kernel's drop count (SO_RXQ_OVFL) last seen */
+    unsigned long rx_dropped; /* frames the kernel dropped for this socket, in all */
+    unsigned long rx_unlogged; /* of those, not logged yet */
+    lp_rate_t rx_rate;        /* one drop line a second at most */
+    lp_rate_t err_rate;       /* unexpected socket errors: a few lines a second */
+    uint32_t now;             /* latest time given to lp_poll / lp_read */
 } lp_port_t;
 
 /* Log a line with a time stamp to the log (stderr or --log FILE). */
 void lp_log(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 void lp_log_open(FILE *f);
 
-/* Open a non-blocking raw CAN socket on iface, error frames enabled. 0 or -1. */
-int lp_open(lp_port_t *p, const char *iface, unsigned node, lp_nvm_t *nvm);
+/*
+ * Rate limit: true when a line may be logged at time now (at most `lines`
+ * in a window); the caller counts what it does not log and logs the count
+ * once allowed again. lp_rate_wait() is the delay until the current
+ * window ends (0: a line may be logged now).
+ */
+bool lp_rate_allow(lp_rate_t *r, uint32_t now, unsigned lines);
+uint32_t lp_rate_wait(const lp_rate_t *r, uint32_t now);
+
+/*
+ * Open a non-blocking raw CAN socket on iface, error frames and the drop
+ * count enabled. A down interface is accepted (bus-off until it comes up).
+ * Returns 0, or -1 with a one-line cause in err (errlen bytes) when the
+ * interface does not exist, is not a CAN interface, or the kernel has no CAN.
+ */
+int lp_open(lp_port_t *p, const char *iface, unsigned node, lp_nvm_t *nvm, uint32_t now,
+            char *err, unsigned errlen);
+
+/* Close the socket. */
+void lp_close(lp_port_t *p);
+
+/*
+ * The port's timers at time now: the link watch while the interface is
+ * down or missing, the simulated bus-off recovery, the dropped-frame log.
+ * Returns the delay (us) until it needs to run again.
+ */
+uint32_t lp_poll(lp_port_t *p, uint32_t now);
+
+/* The CAN state the node should see now (see the top of this file). */
+co_can_state_t lp_can_state(const lp_port_t *p);
+
+/*
+ * The simulated controller: s = bus-off enters bus-off; the bus then stays
+ * unusable for hold_us, after which the controller is back after
+ * recovery_us (128 x 11 bits at its bit rate). Warning and passive stay
+ * until changed; active ends them, and shortens a bus-off's hold to the
+ * recovery alone.
+ */
+void lp_sim_can(lp_port_t *p, co_can_state_t s, uint32_t now, uint32_t hold_us,
+                uint32_t recovery_us);
+
+/* Log the dropped frames not logged yet, whatever the rate (at exit). */
+void lp_report_drops(lp_port_t *p);
 
 /* Try to hand queued frames to the kernel. Returns frames still queued. */
 unsigned lp_flush(lp_port_t *p);
 
 /*
- * Read one frame. Returns 1 with *f filled, 0 when nothing is pending,
- * 2 when an error frame changed *state (logged), -1 on a socket error.
+ * Read one frame. Returns 1 with *f filled, 0 when nothing (more) is
+ * pending. Socket errors (the interface went down or away) are handled
+ * here: they change the link state, which lp_can_state() then shows.
  */
-int lp_read(lp_port_t *p, co_frame_t *f, co_can_state_t *state);
+int lp_read(lp_port_t *p, co_frame_t *f, uint32_t now);
 
 /*
- * Open the EEPROM file: read it into mem (size bytes), or create it blank
- * (0xFF: every parameter at its default) when absent. 0 or -1 (logged).
+ * Open the EEPROM file (path NULL: RAM only). path must be a regular file,
+ * or not exist in an existing directory; anything else (a directory, a
+ * FIFO, a device, a missing directory) is refused with -2 and a one-line
+ * cause in err (errlen bytes); it is looked at with stat() before any
+ * open, so a FIFO never blocks. The file is read into mem (size bytes;
+ * beyond a short file's end: erased, 0xFF); a missing file reads as
+ * erased. Nothing is written, created or changed on disk here: the file is
+ * written by the first save only. -1 with the cause in err: the file
+ * could not be read. 0: done (notes logged).
  */
-int lp_nvm_open(lp_nvm_t *n, const char *path, uint8_t *mem, uint32_t size);
+int lp_nvm_open(lp_nvm_t *n, const char *path, uint8_t *mem, uint32_t size, char *err,
+                unsigned errlen);
 
 #endif /* LINUX_PORT_H */

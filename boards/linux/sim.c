@@ -37,9 +37,63 @@ void sim_init(sim_t *s, const product_t *p)
     }
 }
 
+/* The product's fault names as "a|b|c" ("" when it has none). */
+static void fault_list(const product_t *p, char *buf, size_t len)
+{
+    buf[0] = '\0';
+    for (unsigned k = 0; k < PRODUCT_MAX_INPUTS && p->faults[k] != NULL; k++) {
+        size_t at = strlen(buf);
+        snprintf(buf + at, len - at, "%s%s", k ? "|" : "", p->faults[k]);
+    }
+}
+
+void sim_describe(const product_t *p, char *buf, size_t len)
+{
+    char in[128];
+    char fl[96];
+    names(p, in, sizeof(in));
+    fault_list(p, fl, sizeof(fl));
+    snprintf(buf, len, "set %s; %s%s", in, fl[0] != '\0' ? "fault " : "no faults", fl);
+}
+
+/* `can bus-off [SECONDS]`, `can passive|warning|active`. */
+static bool can_command(sim_t *s, char **save, char *err, unsigned errlen)
+{
+    static const char *const states[] = {"active", "warning", "passive", "bus-off"};
+    char *what = strtok_r(NULL, " \t\r", save);
+    char *arg = strtok_r(NULL, " \t\r", save);
+    int st = -1;
+    for (int k = 0; k < 4 && what != NULL; k++) {
+        if (strcmp(what, states[k]) == 0) {
+            st = k;
+        }
+    }
+    double hold = 0.0;
+    if (st == (int)CO_CAN_BUSOFF && arg != NULL) {
+        char *end;
+        hold = strtod(arg, &end);
+        /* at most 30 min: the deadline stays within half the 32-bit
+         * microsecond clock the board's timers compare on */
+        if (end == arg || *end != '\0' || !isfinite(hold) || hold < 0.0 || hold > 1800.0) {
+            snprintf(err, errlen, "'%s': not a number of seconds within 0..1800", arg);
+            return false;
+        }
+        arg = strtok_r(NULL, " \t\r", save);
+    }
+    if (st < 0 || arg != NULL) {
+        snprintf(err, errlen, "usage: can bus-off [SECONDS] | can passive | can warning | "
+                              "can active");
+        return false;
+    }
+    s->can_request = true;
+    s->can_state = (co_can_state_t)st;
+    s->can_hold_ms = (uint32_t)lround(hold * 1000.0);
+    return true;
+}
+
 bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
 {
-    char buf[256];
+    char buf[SIM_LINE_MAX + 1u];
     if (strlen(line) >= sizeof(buf)) {
         snprintf(err, errlen, "line too long");
         return false;
@@ -58,10 +112,13 @@ bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
         char *what = strtok_r(NULL, " \t\r", &save);
         char *onoff = strtok_r(NULL, " \t\r", &save);
         int i = -1;
-        char list[96] = "";
+        char list[96];
+        fault_list(s->prod, list, sizeof(list));
+        if (list[0] == '\0') {
+            snprintf(err, errlen, "%s has no simulated faults", s->prod->id);
+            return false;
+        }
         for (int k = 0; k < (int)PRODUCT_MAX_INPUTS && s->prod->faults[k] != NULL; k++) {
-            size_t at = strlen(list);
-            snprintf(list + at, sizeof(list) - at, "%s%s", k ? "|" : "", s->prod->faults[k]);
             if (what != NULL && strcmp(what, s->prod->faults[k]) == 0) {
                 i = k;
             }
@@ -109,6 +166,56 @@ bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
         memcpy(s->values, v, sizeof(v));
         return true;
     }
-    snprintf(err, errlen, "unknown command '%s' (set, fault, quit)", cmd);
+    if (strcmp(cmd, "can") == 0) {
+        return can_command(s, &save, err, errlen);
+    }
+    snprintf(err, errlen, "unknown command '%s' (set, fault, can, quit)", cmd);
     return false;
+}
+
+/* One complete line: apply it, or reject it whole. */
+static void end_line(sim_t *s, sim_report_fn report, void *ctx)
+{
+    s->line[s->len] = '\0';
+    char err[200];
+    if (s->overflow) {
+        snprintf(err, sizeof(err), "line too long (more than %u characters): ignored",
+                 SIM_LINE_MAX);
+        report(ctx, "", err);
+    } else if (s->nul) {
+        /* Not cut at the NUL: "set x=11<NUL>y=99" is neither command. */
+        report(ctx, "", "line contains a NUL byte: ignored");
+    } else if (!sim_command(s, s->line, err, sizeof(err))) {
+        report(ctx, s->line, err);
+    } else {
+        size_t i = strspn(s->line, " \t\r");
+        if (s->line[i] != '\0' && s->line[i] != '#') {
+            report(ctx, s->line, NULL);
+        }
+    }
+    s->len = 0;
+    s->overflow = false;
+    s->nul = false;
+}
+
+void sim_feed(sim_t *s, const char *data, size_t n, sim_report_fn report, void *ctx)
+{
+    for (size_t i = 0; i < n; i++) {
+        char c = data[i];
+        if (c == '\n') {
+            end_line(s, report, ctx);
+        } else if (s->len >= SIM_LINE_MAX) {
+            s->overflow = true;
+        } else {
+            s->nul |= c == '\0';
+            s->line[s->len++] = c;
+        }
+    }
+}
+
+void sim_feed_end(sim_t *s, sim_report_fn report, void *ctx)
+{
+    if (s->len > 0u || s->overflow) {
+        end_line(s, report, ctx);
+    }
 }

@@ -9,7 +9,7 @@ import sys
 import canopen
 import pytest
 
-from conftest import BINARY
+from conftest import BINARY, ROOT
 
 
 def product_ids():
@@ -45,6 +45,45 @@ def test_canopen_loads_the_eds(pid, tmp_path):
     mapped = [od[0x1A00][s].default for s in range(1, od[0x1A00][0].default + 1)]
     for m in mapped:
         assert od[m >> 16].pdo_mappable
+
+
+@pytest.mark.parametrize("pid", ["gsh-a", "gsh-a-redundant"])
+def test_gsh_eds_event_timer_as_the_manual_asks(pid, tmp_path):
+    """GSH-A manual: "In the EDS file this default value must be set to 0,
+    otherwise errors will be generated"; the device keeps 100 ms (spec C-14;
+    read live in test_gsh.py). The EDS says why, in a comment line."""
+    path = eds_of(pid, tmp_path)
+    od = canopen.import_od(str(path), 0x13)
+    assert od[0x1800][5].default == 0
+    assert od[0x1800][3].default == 4  # the others stay the device's
+    section = path.read_text().split("[1800sub5]\n")[1].split("\n\n")[0]
+    comment = [l for l in section.splitlines() if l.startswith(";")]
+    assert len(comment) == 1 and "device's default is 0x64" in comment[0], section
+    assert "otherwise errors will be generated" in comment[0]
+
+
+@pytest.mark.parametrize("pid", product_ids())
+def test_eds_comments_only_explain_overrides(pid, tmp_path):
+    """A comment line in an EDS stands right before the DefaultValue it explains."""
+    lines = eds_of(pid, tmp_path).read_text().splitlines()
+    for i, line in enumerate(lines):
+        if line.startswith(";"):
+            assert lines[i + 1].startswith("DefaultValue="), line
+
+
+def test_readme_dcfchk_commands(tmp_path):
+    """The README's EDS check, run as written (binaries from this build)."""
+    readme = (ROOT / "README.md").read_text()
+    blocks = [b.split("```")[0] for b in readme.split("```sh\n")[1:]]
+    block = next(b for b in blocks if "dcfchk" in b)
+    dcfchk = pathlib.Path(sys.executable).with_name("dcfchk")
+    for line in block.splitlines():
+        cmd = line.replace("build/bin/canopen-sensor", BINARY)
+        cmd = cmd.replace("build/venv/bin/dcfchk", str(dcfchk))
+        r = subprocess.run(cmd, shell=True, cwd=tmp_path, capture_output=True, text=True)
+        assert r.returncode == 0, f"{line}\n{r.stdout}{r.stderr}"
+        assert "Error" not in r.stderr and "Warning" not in r.stderr, r.stderr
+    assert "dcfchk -n " in block
 
 
 def test_unknown_product_eds():

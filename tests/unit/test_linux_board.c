@@ -1,16 +1,50 @@
 /*
- * test_linux_board.c - the Linux board's simulator commands and EEPROM file.
+ * test_linux_board.c - the Linux board's simulator commands, standard
+ * input lines, EEPROM file and simulated CAN controller.
  */
+#include <fcntl.h>
+#include <linux/can.h>
 #include <stdlib.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "co_port.h"
 #include "dst.h"
+#include "jd.h"
 #include "port.h"
 #include "sim.h"
 
 #include "harness.h"
+
+/* The log goes to a temporary file the tests read back. */
+static FILE *log_f;
+
+static void log_start(void)
+{
+    log_f = tmpfile();
+    lp_log_open(log_f);
+}
+
+/* Everything logged since log_start(), NUL-terminated (static buffer). */
+static const char *log_text(void)
+{
+    static char buf[16384];
+    fflush(log_f);
+    long end = ftell(log_f);
+    rewind(log_f);
+    size_t n = fread(buf, 1, sizeof(buf) - 1u, log_f);
+    buf[n] = '\0';
+    fseek(log_f, end, SEEK_SET);
+    return buf;
+}
+
+static void log_stop(void)
+{
+    lp_log_open(NULL);
+    fclose(log_f);
+    log_f = NULL;
+}
 
 static void test_sim_commands(void)
 {
@@ -35,6 +69,7 @@ static void test_sim_commands(void)
     CHECK(!sim_command(&s, "tilt 4", err, sizeof(err)));
     CHECK(!sim_command(&s, "fault sensor maybe", err, sizeof(err)));
     CHECK(!sim_command(&s, "fault motor on", err, sizeof(err)));
+    CHECK(strstr(err, "usage: fault sensor on|off") != NULL);
     CHECK_EQ(s.values[0], 12345);
     CHECK_EQ(s.values[1], 3000);
     CHECK(s.faults == 0u && !s.quit);
@@ -50,6 +85,139 @@ static void test_sim_commands(void)
     CHECK(!sim_command(&z, "set x=1", err, sizeof(err)));
 }
 
+/* The JD has no simulated faults: say so, not "usage: fault  on|off". */
+static void test_sim_no_faults(void)
+{
+    sim_t s;
+    sim_init(&s, &jd1xxx);
+    char err[200];
+    CHECK(!sim_command(&s, "fault sensor on", err, sizeof(err)));
+    CHECK(strcmp(err, "jd1xxx has no simulated faults") == 0);
+    char d[256];
+    sim_describe(&jd1xxx, d, sizeof(d));
+    CHECK(strncmp(d, "set z=<deg> ", 12) == 0 && strstr(d, "; no faults") != NULL);
+    sim_describe(&dst_x730_xy30, d, sizeof(d));
+    CHECK(strcmp(d, "set x=<deg> y=<deg>; fault sensor") == 0);
+}
+
+static void test_sim_can_commands(void)
+{
+    sim_t s;
+    sim_init(&s, &jd2xxx);
+    char err[200];
+    CHECK(sim_command(&s, "can bus-off", err, sizeof(err)));
+    CHECK(s.can_request && s.can_state == CO_CAN_BUSOFF && s.can_hold_ms == 0u);
+    s.can_request = false;
+    CHECK(sim_command(&s, "can bus-off 1.5", err, sizeof(err)));
+    CHECK(s.can_request && s.can_state == CO_CAN_BUSOFF && s.can_hold_ms == 1500u);
+    s.can_request = false;
+    CHECK(sim_command(&s, "can passive", err, sizeof(err)) && s.can_state == CO_CAN_PASSIVE);
+    CHECK(sim_command(&s, "can warning", err, sizeof(err)) && s.can_state == CO_CAN_WARNING);
+    CHECK(sim_command(&s, "can active", err, sizeof(err)) && s.can_state == CO_CAN_ACTIVE);
+    s.can_request = false;
+    CHECK(!sim_command(&s, "can", err, sizeof(err)));
+    CHECK(strstr(err, "usage: can bus-off [SECONDS]") != NULL);
+    CHECK(!sim_command(&s, "can off", err, sizeof(err)));
+    CHECK(!sim_command(&s, "can bus-off -1", err, sizeof(err)));
+    CHECK(!sim_command(&s, "can bus-off 1800.5", err, sizeof(err)));
+    CHECK(sim_command(&s, "can bus-off 1800", err, sizeof(err)) && s.can_hold_ms == 1800000u);
+    s.can_request = false;
+    CHECK(!sim_command(&s, "can bus-off 1 2", err, sizeof(err)));
+    CHECK(!sim_command(&s, "can passive 3", err, sizeof(err)));
+    CHECK(!s.can_request);
+}
+
+/* What sim_feed reported, for the checks. */
+typedef struct lines {
+    unsigned applied, rejected;
+    char last[300];
+    char last_err[300];
+} lines_t;
+
+static void record(void *ctx, const char *line, const char *error)
+{
+    lines_t *l = ctx;
+    if (error == NULL) {
+        l->applied++;
+        snprintf(l->last, sizeof(l->last), "%s", line);
+    } else {
+        l->rejected++;
+        snprintf(l->last_err, sizeof(l->last_err), "%s", error);
+    }
+}
+
+static void test_stdin_lines(void)
+{
+    sim_t s;
+    sim_init(&s, &dst_x730_xy30);
+    lines_t l = {0};
+    /* A line in pieces, CR LF, a comment and an empty line. */
+    sim_feed(&s, "set x=", 6, record, &l);
+    CHECK_EQ(l.applied, 0);
+    sim_feed(&s, "4 y=2\r\n# note\n\n", 16, record, &l);
+    CHECK_EQ(l.applied, 1);
+    CHECK_EQ(s.values[0], 4000);
+    CHECK_EQ(s.values[1], 2000);
+    /* A NUL byte: the whole line is rejected, not applied up to the NUL. */
+    static const char nul[] = "set x=11\0garbage y=99\n";
+    sim_feed(&s, nul, sizeof(nul) - 1u, record, &l);
+    CHECK_EQ(l.rejected, 1);
+    CHECK(strstr(l.last_err, "NUL") != NULL);
+    CHECK_EQ(s.values[0], 4000);
+    CHECK_EQ(s.values[1], 2000);
+    /* Too long: rejected whole, and the next line is fine again. */
+    char big[600];
+    memset(big, ' ', sizeof(big));
+    memcpy(big, "set x=7", 7);
+    big[sizeof(big) - 1u] = '\n';
+    sim_feed(&s, big, sizeof(big), record, &l);
+    CHECK_EQ(l.rejected, 2);
+    CHECK(strstr(l.last_err, "line too long") != NULL);
+    CHECK_EQ(s.values[0], 4000);
+    sim_feed(&s, "set x=5\n", 8, record, &l);
+    CHECK_EQ(s.values[0], 5000);
+    CHECK_EQ(l.applied, 2);
+    /* The last line without a newline counts once the input ends. */
+    sim_feed(&s, "set y=-8", 8, record, &l);
+    CHECK_EQ(s.values[1], 2000);
+    sim_feed_end(&s, record, &l);
+    CHECK_EQ(s.values[1], -8000);
+    CHECK_EQ(l.applied, 3);
+    CHECK(strcmp(l.last, "set y=-8") == 0);
+    sim_feed_end(&s, record, &l); /* nothing left: nothing happens */
+    CHECK_EQ(l.applied, 3);
+    CHECK_EQ(l.rejected, 2);
+    /* A line of exactly the longest length is accepted. */
+    char edge[SIM_LINE_MAX + 1u];
+    memset(edge, ' ', sizeof(edge));
+    memcpy(edge, "set x=9", 7);
+    edge[SIM_LINE_MAX] = '\n';
+    sim_feed(&s, edge, sizeof(edge), record, &l);
+    CHECK_EQ(s.values[0], 9000);
+}
+
+static void write_file(const char *path, const void *data, size_t len)
+{
+    FILE *f = fopen(path, "wb");
+    CHECK(f != NULL);
+    if (f != NULL) {
+        CHECK_EQ(fwrite(data, 1, len, f), len);
+        fclose(f);
+    }
+}
+
+static bool file_equals(const char *path, const void *data, size_t len)
+{
+    uint8_t buf[4096];
+    FILE *f = fopen(path, "rb");
+    if (f == NULL) {
+        return false;
+    }
+    size_t n = fread(buf, 1, sizeof(buf), f);
+    fclose(f);
+    return n == len && memcmp(buf, data, len) == 0;
+}
+
 static void test_eeprom_file(void)
 {
     char dir[] = "/tmp/co-nvm-XXXXXX";
@@ -59,39 +227,288 @@ static void test_eeprom_file(void)
     uint8_t mem[CO_STORE_NVM_SIZE];
     lp_nvm_t n;
     lp_port_t p = {.nvm = &n};
-    FILE *devnull = fopen("/dev/null", "w");
-    lp_log_open(devnull);
-    CHECK_EQ(lp_nvm_open(&n, path, mem, sizeof(mem)), 0);
-    struct stat st;
-    CHECK(stat(path, &st) == 0 && st.st_size == (off_t)sizeof(mem)); /* created blank */
+    char err[600];
+    log_start();
+    /* A new file: nothing is created until the first save. */
+    CHECK_EQ(lp_nvm_open(&n, path, mem, sizeof(mem), err, sizeof(err)), 0);
+    CHECK(access(path, F_OK) != 0);
+    CHECK(strstr(log_text(), "the first save creates it") != NULL);
+    CHECK_EQ(mem[0], 0xFF);
     CHECK_EQ(co_port_nvm_size(&p), sizeof(mem));
     CHECK(co_port_nvm_write(&p, 10, "abc", 3));
+    struct stat st;
+    CHECK(stat(path, &st) == 0 && st.st_size == (off_t)sizeof(mem));
     CHECK(!co_port_nvm_write(&p, sizeof(mem) - 1u, "abc", 3)); /* out of range */
     char tmp[300];
     snprintf(tmp, sizeof(tmp), "%s.tmp", path);
     CHECK(access(tmp, F_OK) != 0); /* no temporary left behind */
     uint8_t again[CO_STORE_NVM_SIZE];
     lp_nvm_t n2;
-    CHECK_EQ(lp_nvm_open(&n2, path, again, sizeof(again)), 0);
+    CHECK_EQ(lp_nvm_open(&n2, path, again, sizeof(again), err, sizeof(err)), 0);
     CHECK(memcmp(&again[10], "abc", 3) == 0);
     CHECK_EQ(again[9], 0xFF);
-    /* A short file reads as erased beyond its end. */
+    /* A short file reads as erased beyond its end, and stays short on disk. */
     CHECK(truncate(path, 11) == 0);
-    CHECK_EQ(lp_nvm_open(&n2, path, again, sizeof(again)), 0);
+    CHECK_EQ(lp_nvm_open(&n2, path, again, sizeof(again), err, sizeof(err)), 0);
     CHECK_EQ(again[10], 'a');
     CHECK_EQ(again[11], 0xFF);
+    CHECK(stat(path, &st) == 0 && st.st_size == 11);
     uint8_t b;
     lp_port_t p2 = {.nvm = &n2};
     CHECK(!co_port_nvm_read(&p2, sizeof(again), &b, 1));
+    /* Through a symbolic link: the file it points to is written, the link stays. */
+    char link[300];
+    snprintf(link, sizeof(link), "%s/link.bin", dir);
+    CHECK(symlink(path, link) == 0);
+    CHECK_EQ(lp_nvm_open(&n2, link, again, sizeof(again), err, sizeof(err)), 0);
+    CHECK(co_port_nvm_write(&p2, 0, "z", 1));
+    CHECK(lstat(link, &st) == 0 && S_ISLNK(st.st_mode));
+    CHECK(stat(path, &st) == 0 && st.st_size == (off_t)sizeof(again));
+    unlink(link);
     unlink(path);
     rmdir(dir);
-    fclose(devnull);
-    lp_log_open(NULL);
+    log_stop();
+}
+
+/* --nvm given something that is not a regular file: refused at once. */
+static void test_eeprom_not_a_file(void)
+{
+    char dir[] = "/tmp/co-nvm-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char fifo[300];
+    snprintf(fifo, sizeof(fifo), "%s/fifo", dir);
+    CHECK(mkfifo(fifo, 0600) == 0);
+    char missing[300];
+    snprintf(missing, sizeof(missing), "%s/no/such/dir/e.bin", dir);
+    uint8_t mem[CO_STORE_NVM_SIZE];
+    lp_nvm_t n;
+    char err[600];
+    log_start();
+    /* A FIFO: would block in open() for ever (this test would hang). */
+    CHECK_EQ(lp_nvm_open(&n, fifo, mem, sizeof(mem), err, sizeof(err)), -2);
+    CHECK(strstr(err, "a FIFO, not a regular file") != NULL);
+    /* A device (/dev/null, /dev/zero): a save would replace it by a
+     * regular file (as root). /dev/zero, as /dev/null may itself have been
+     * replaced on a machine where the old program ran as root. */
+    struct stat st;
+    CHECK(stat("/dev/zero", &st) == 0 && S_ISCHR(st.st_mode));
+    CHECK_EQ(lp_nvm_open(&n, "/dev/zero", mem, sizeof(mem), err, sizeof(err)), -2);
+    CHECK(strstr(err, "a character device") != NULL);
+    CHECK_EQ(lp_nvm_open(&n, dir, mem, sizeof(mem), err, sizeof(err)), -2);
+    CHECK(strstr(err, "a directory") != NULL);
+    CHECK_EQ(lp_nvm_open(&n, missing, mem, sizeof(mem), err, sizeof(err)), -2);
+    CHECK(strstr(err, "does not exist") != NULL);
+    CHECK(strstr(log_text(), "created") == NULL);
+    unlink(fifo);
+    rmdir(dir);
+    log_stop();
+}
+
+/* A corrupt file stays byte for byte as it is until a save. */
+static void test_eeprom_corrupt_untouched(void)
+{
+    char dir[] = "/tmp/co-nvm-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char path[256];
+    snprintf(path, sizeof(path), "%s/eeprom.bin", dir);
+    uint8_t junk[100];
+    for (unsigned i = 0; i < sizeof(junk); i++) {
+        junk[i] = (uint8_t)(i * 37u + 11u);
+    }
+    write_file(path, junk, sizeof(junk));
+    log_start();
+    _Alignas(max_align_t) unsigned char inst[PRODUCT_INST_MAX];
+    uint8_t mem[CO_STORE_NVM_SIZE];
+    lp_nvm_t n;
+    char err[600];
+    CHECK_EQ(lp_nvm_open(&n, path, mem, sizeof(mem), err, sizeof(err)), 0);
+    lp_port_t port;
+    memset(&port, 0, sizeof(port));
+    port.fd = -1;
+    port.nvm = &n;
+    port.link = LP_LINK_DOWN; /* nothing to send frames to: bus-off */
+    void *ports[1] = {&port};
+    co_node_t *nodes[1];
+    jd1xxx.create(&jd1xxx, inst, ports, nodes);
+    co_node_start(nodes[0], 0);
+    co_node_poll(nodes[0], 1000);
+    CHECK(file_equals(path, junk, sizeof(junk)));
+    char tmp[300];
+    snprintf(tmp, sizeof(tmp), "%s.tmp", path);
+    CHECK(access(tmp, F_OK) != 0);
+    unlink(path);
+    rmdir(dir);
+    log_stop();
+}
+
+/* A save that cannot be written: false (0x06060000 over SDO), the cause
+ * logged, the file and the mirror as they were. The temporary name is
+ * taken by a directory, which stops root as well. */
+static void test_eeprom_save_fails(void)
+{
+    char dir[] = "/tmp/co-nvm-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char path[256];
+    snprintf(path, sizeof(path), "%s/eeprom.bin", dir);
+    uint8_t old[CO_STORE_NVM_SIZE];
+    memset(old, 0x5A, sizeof(old));
+    write_file(path, old, sizeof(old));
+    char tmp[300];
+    snprintf(tmp, sizeof(tmp), "%s.tmp", path);
+    CHECK(mkdir(tmp, 0700) == 0);
+    log_start();
+    uint8_t mem[CO_STORE_NVM_SIZE];
+    lp_nvm_t n;
+    char err[600];
+    CHECK_EQ(lp_nvm_open(&n, path, mem, sizeof(mem), err, sizeof(err)), 0);
+    lp_port_t p = {.nvm = &n};
+    CHECK(!co_port_nvm_write(&p, 4, "new", 3));
+    CHECK(strstr(log_text(), "save failed") != NULL);
+    CHECK(strstr(log_text(), "Is a directory") != NULL);
+    CHECK(file_equals(path, old, sizeof(old)));
+    uint8_t b[3];
+    CHECK(co_port_nvm_read(&p, 4, b, 3) && memcmp(b, "ZZZ", 3) == 0);
+    /* The way clear again: the save works. */
+    CHECK(rmdir(tmp) == 0);
+    CHECK(co_port_nvm_write(&p, 4, "new", 3));
+    CHECK(co_port_nvm_read(&p, 4, b, 3) && memcmp(b, "new", 3) == 0);
+    memcpy(&old[4], "new", 3);
+    CHECK(file_equals(path, old, sizeof(old)));
+    unlink(path);
+    rmdir(dir);
+    log_stop();
+}
+
+static void test_rate_limit(void)
+{
+    lp_rate_t r = {0};
+    uint32_t t0 = 0xFFFFFF00u; /* across the 32-bit wrap */
+    CHECK(lp_rate_allow(&r, t0, 2u));
+    CHECK(lp_rate_allow(&r, t0 + 10u, 2u));
+    CHECK(!lp_rate_allow(&r, t0 + 20u, 2u));
+    CHECK_EQ(lp_rate_wait(&r, t0 + 20u), LP_RATE_US - 20u);
+    CHECK(!lp_rate_allow(&r, t0 + LP_RATE_US - 1u, 2u));
+    CHECK_EQ(lp_rate_wait(&r, t0 + LP_RATE_US), 0);
+    CHECK(lp_rate_allow(&r, t0 + LP_RATE_US, 2u));
+}
+
+/* Frames the port wrote, read from the other end of a socket pair. */
+static int read_frames(int fd, struct can_frame *out, int max)
+{
+    int k = 0;
+    while (k < max && read(fd, &out[k], sizeof(out[k])) == (ssize_t)sizeof(out[k])) {
+        k++;
+    }
+    return k;
+}
+
+/*
+ * The simulated controller on a JD: bus-off sends nothing (not even the
+ * heartbeat), the controller is back after 128 x 11 bits at its bit rate,
+ * then EMCY 8140h "recovered from bus-off". The port writes into a socket
+ * pair instead of a CAN socket.
+ */
+static void test_sim_bus_off(void)
+{
+    int sv[2];
+    CHECK(socketpair(AF_UNIX, SOCK_DGRAM | SOCK_NONBLOCK, 0, sv) == 0);
+    log_start();
+    _Alignas(max_align_t) unsigned char inst[PRODUCT_INST_MAX];
+    uint8_t mem[CO_STORE_NVM_SIZE];
+    lp_nvm_t n;
+    char err[600];
+    CHECK_EQ(lp_nvm_open(&n, NULL, mem, sizeof(mem), err, sizeof(err)), 0);
+    lp_port_t p;
+    memset(&p, 0, sizeof(p));
+    p.fd = sv[0];
+    p.nvm = &n;
+    p.iface = "pair";
+    void *ports[1] = {&p};
+    co_node_t *nodes[1];
+    co_node_t *node;
+    jd2xxx.create(&jd2xxx, inst, ports, nodes);
+    node = nodes[0];
+    uint32_t t = 0xFFFF0000u; /* the recovery deadline crosses the 32-bit wrap */
+    co_node_start(node, t);
+    struct can_frame f[64];
+    CHECK(read_frames(sv[1], f, 64) >= 1); /* boot-up */
+    /* 0x1017 := 10 ms heartbeat over SDO */
+    co_frame_t req = {.id = 0x600u + node->node_id, .dlc = 8, .data = {0x2B, 0x17, 0x10, 0, 10, 0}};
+    co_node_receive(node, &req);
+    co_node_poll(node, t);
+    CHECK_EQ(read_frames(sv[1], f, 64), 1);
+    CHECK_EQ(f[0].data[0], 0x60);
+    uint32_t kbps = product_kbps(&jd2xxx, node->bitrate);
+    CHECK(kbps != 0u);
+    uint32_t recovery = (LP_BUSOFF_RECOVERY_BITS * 1000u + kbps - 1u) / kbps;
+    lp_sim_can(&p, CO_CAN_BUSOFF, t, 50000u, recovery);
+    CHECK_EQ(lp_can_state(&p), CO_CAN_BUSOFF);
+    co_node_set_can_state(node, lp_can_state(&p));
+    /* 50 ms unusable bus, then the recovery: nothing is sent. */
+    uint32_t end = t + 50000u + recovery;
+    for (; co_time_before(t, end - 1000u); t += 1000u) {
+        uint32_t d = lp_poll(&p, t);
+        CHECK(d != CO_NEVER && d <= end - t);
+        co_node_set_can_state(node, lp_can_state(&p));
+        co_node_poll(node, t);
+    }
+    CHECK_EQ(read_frames(sv[1], f, 64), 0);
+    /* The stack sends nothing while bus-off; the port would not either. */
+    co_frame_t hb = {.id = 0x700u + node->node_id, .dlc = 1};
+    unsigned long off = p.tx_off;
+    CHECK(!co_port_can_send(&p, &hb));
+    CHECK_EQ(p.tx_off, off + 1u);
+    CHECK_EQ(read_frames(sv[1], f, 64), 0);
+    CHECK_EQ(lp_can_state(&p), CO_CAN_BUSOFF);
+    (void)lp_poll(&p, end - 1u);
+    CHECK_EQ(lp_can_state(&p), CO_CAN_BUSOFF);
+    CHECK_EQ(lp_poll(&p, end), CO_NEVER);
+    CHECK_EQ(lp_can_state(&p), CO_CAN_ACTIVE);
+    co_node_set_can_state(node, lp_can_state(&p));
+    co_node_poll(node, end);
+    int k = read_frames(sv[1], f, 64);
+    bool emcy = false;
+    for (int i = 0; i < k; i++) {
+        emcy |= f[i].can_id == 0x80u + node->node_id && f[i].data[0] == 0x40 &&
+                f[i].data[1] == 0x81;
+    }
+    CHECK(emcy);
+    CHECK(strstr(log_text(), "back from bus-off") != NULL);
+    /* `can active` during a long bus-off (longer than the port's cap of
+     * half the clock): only the recovery is left. */
+    lp_sim_can(&p, CO_CAN_BUSOFF, end, 3600000000u, recovery);
+    (void)lp_poll(&p, end + 0x7FFFFFF0u);
+    CHECK_EQ(lp_can_state(&p), CO_CAN_BUSOFF);
+    lp_sim_can(&p, CO_CAN_ACTIVE, end + 10u, 0, recovery);
+    (void)lp_poll(&p, end + 10u + recovery - 1u);
+    CHECK_EQ(lp_can_state(&p), CO_CAN_BUSOFF);
+    (void)lp_poll(&p, end + 10u + recovery);
+    CHECK_EQ(lp_can_state(&p), CO_CAN_ACTIVE);
+    /* Passive and warning stay until changed; a link down is bus-off. */
+    lp_sim_can(&p, CO_CAN_PASSIVE, end, 0, recovery);
+    (void)lp_poll(&p, end + 100000000u);
+    CHECK_EQ(lp_can_state(&p), CO_CAN_PASSIVE);
+    p.link = LP_LINK_DOWN;
+    CHECK_EQ(lp_can_state(&p), CO_CAN_BUSOFF);
+    p.link = LP_LINK_UP;
+    lp_sim_can(&p, CO_CAN_ACTIVE, end, 0, recovery);
+    CHECK_EQ(lp_can_state(&p), CO_CAN_ACTIVE);
+    close(sv[0]);
+    close(sv[1]);
+    log_stop();
 }
 
 int main(void)
 {
     RUN(test_sim_commands);
+    RUN(test_sim_no_faults);
+    RUN(test_sim_can_commands);
+    RUN(test_stdin_lines);
     RUN(test_eeprom_file);
+    RUN(test_eeprom_not_a_file);
+    RUN(test_eeprom_corrupt_untouched);
+    RUN(test_eeprom_save_fails);
+    RUN(test_rate_limit);
+    RUN(test_sim_bus_off);
     return h_finish();
 }

@@ -1,0 +1,516 @@
+"""canopen-sensor against a hostile user and a hostile bus, on vcan inside
+User-Mode Linux (root there: the tests take interfaces down, delete and
+re-create them, and mount small file systems): --nvm that is not a file,
+cable pulls, corrupt and unwritable EEPROM files, standard input abuse,
+the process's lifetime, a simulated bus-off and a bus flood.
+
+Frames are seen through plain python-can buses (no canopen Network: its
+socket would die with a deleted interface), each filtered in the kernel to
+the identifiers a test looks at, with the kernel's receive time stamps.
+"""
+import os
+import random
+import re
+import signal
+import stat
+import struct
+import subprocess
+import sys
+import time
+
+import can
+import pytest
+
+from conftest import BINARY
+
+pytestmark = pytest.mark.skipif(
+    os.geteuid() != 0,
+    reason="LOUD SKIP: needs root (ip link, mount): run through tools/vcan-run, which runs "
+           "these tests as root inside User-Mode Linux, as CI does")
+
+SAVE = 0x65766173  # "save"
+
+
+def ip(*args):
+    subprocess.run(["ip", "link", *args], check=True)
+
+
+BUSES = []
+
+
+@pytest.fixture(autouse=True)
+def vcan_restored():
+    """Whatever a test did to vcan0/vcan1, they exist and are up afterwards;
+    its buses are shut down."""
+    yield
+    while BUSES:
+        BUSES.pop().shutdown()
+    for i in ("vcan0", "vcan1"):
+        if subprocess.run(["ip", "link", "show", i], capture_output=True).returncode != 0:
+            ip("add", "dev", i, "type", "vcan")
+        ip("set", i, "up")
+
+
+def bus(iface="vcan0", ids=None):
+    filters = [{"can_id": i, "can_mask": 0x7FF} for i in ids] if ids else None
+    b = can.Bus(interface="socketcan", channel=iface, can_filters=filters)
+    BUSES.append(b)
+    return b
+
+
+def frames(b, seconds):
+    """Frames received within this many seconds."""
+    out = []
+    end = time.monotonic() + seconds
+    while (left := end - time.monotonic()) > 0:
+        m = b.recv(timeout=left)
+        if m is not None:
+            out.append(m)
+    return out
+
+
+def wait_for(b, can_id, timeout, pred=None):
+    end = time.monotonic() + timeout
+    while (left := end - time.monotonic()) > 0:
+        m = b.recv(timeout=left)
+        if m is not None and m.arbitration_id == can_id and (pred is None or pred(m)):
+            return m
+    return None
+
+
+def sdo_write(b, node, index, sub, value, size=4):
+    """Expedited SDO download; returns 0 or the abort code."""
+    cmd = {1: 0x2F, 2: 0x2B, 4: 0x23}[size]
+    data = struct.pack("<BHB", cmd, index, sub) + value.to_bytes(size, "little").ljust(4, b"\0")
+    b.send(can.Message(arbitration_id=0x600 + node, data=data, is_extended_id=False))
+    m = wait_for(b, 0x580 + node, 2.0)
+    assert m is not None, f"no SDO answer from node {node:#x}"
+    if m.data[0] == 0x80:
+        return struct.unpack_from("<I", m.data, 4)[0]
+    assert m.data[0] == 0x60
+    return 0
+
+
+class Proc:
+    """canopen-sensor with its standard input a pipe, the log a file."""
+
+    def __init__(self, tmp_path, product, iface="vcan0", nvm=None, extra=()):
+        self.log = tmp_path / f"{product}.log"
+        cmd = [BINARY, "--product", product, "--iface", iface, "--log", str(self.log), *extra]
+        if nvm is not None:
+            cmd += ["--nvm", str(nvm)]
+        self.p = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+
+    def send(self, data):
+        self.p.stdin.write(data)
+        self.p.stdin.flush()
+
+    def text(self):
+        return self.log.read_text() if self.log.exists() else ""
+
+    def wait_log(self, what, timeout=3.0):
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            if what in self.text():
+                return True
+            time.sleep(0.02)
+        return False
+
+    def stop(self, sig=signal.SIGTERM):
+        if self.p.poll() is None:
+            self.p.send_signal(sig)
+        try:
+            return self.p.wait(timeout=5)
+        finally:
+            self.p.stdin.close()
+            self.stderr = self.p.stderr.read().decode(errors="replace")
+            self.p.stderr.close()
+
+
+@pytest.fixture
+def procs():
+    made = []
+    yield made
+    for p in made:
+        if p.p.poll() is None:
+            p.p.kill()
+            p.p.wait()
+
+
+def start(procs, *a, **kw):
+    p = Proc(*a, **kw)
+    procs.append(p)
+    return p
+
+
+def boot(procs, tmp_path, product, node, **kw):
+    b = bus(kw.get("iface", "vcan0").split(",")[0], ids=[0x700 + node, 0x580 + node, 0x80 + node])
+    p = start(procs, tmp_path, product, **kw)
+    assert wait_for(b, 0x700 + node, 3, lambda m: bytes(m.data) == b"\0"), "no boot-up"
+    return p, b
+
+
+# ---- --nvm and --iface at start ---------------------------------------------
+
+def test_nvm_device_refused_as_root(tmp_path):
+    """As root, the old program replaced /dev/null by a regular file at the
+    first save; now it refuses to start (exit 2), and /dev/null stays."""
+    assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
+    r = subprocess.run([BINARY, "--product", "jd2xxx", "--iface", "vcan0", "--nvm", "/dev/null"],
+                       capture_output=True, text=True, timeout=5, stdin=subprocess.DEVNULL)
+    assert r.returncode == 2
+    assert r.stderr.strip().splitlines() == [
+        "canopen-sensor: --nvm /dev/null: a character device, not a regular file"]
+    assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
+
+
+def test_iface_not_can(tmp_path):
+    r = subprocess.run([BINARY, "--product", "jd2xxx", "--iface", "lo"], capture_output=True,
+                       text=True, timeout=5, stdin=subprocess.DEVNULL)
+    assert r.returncode == 1  # (the log, on stderr without --log, comes first)
+    assert r.stderr.strip().splitlines()[-1] == \
+        "canopen-sensor: --iface lo: not a CAN interface (SocketCAN: can0, vcan0, ...)"
+    r = subprocess.run([BINARY, "--product", "jd2xxx", "--iface", "vcan9"], capture_output=True,
+                       text=True, timeout=5, stdin=subprocess.DEVNULL)
+    assert r.returncode == 1
+    assert r.stderr.strip().splitlines()[-1] == \
+        "canopen-sensor: --iface vcan9: no such network interface"
+
+
+# ---- cable pulls -----------------------------------------------------------
+
+def test_interface_down_deleted_recreated(tmp_path, procs):
+    """A cable pull: the process runs on, shows bus-off (red LED), and after
+    the interface is back reports EMCY 8140h and sends its heartbeat again;
+    also when the interface was deleted and re-created."""
+    node = 10
+    p, b = boot(procs, tmp_path, "jd2xxx", node)
+    assert sdo_write(b, node, 0x1017, 0, 50, 2) == 0
+    b.shutdown()
+    # Down and up again at once: still a (short) bus-off, reported.
+    subprocess.run("ip link set vcan0 down && ip link set vcan0 up", shell=True, check=True)
+    b = bus(ids=[0x70A, 0x8A, 0x58A])
+    m = wait_for(b, 0x8A, 2)
+    assert m is not None and m.data[0:2] == b"\x40\x81", "a short link loss went unreported"
+    assert "node 0: vcan0 went down and is up again" in p.text() or \
+        "node 0: vcan0 is up again" in p.text()
+    ip("set", "vcan0", "down")
+    assert p.wait_log("node 0: vcan0 is down")
+    assert p.wait_log("red on")
+    time.sleep(0.5)
+    assert p.p.poll() is None
+    b.shutdown()
+    ip("set", "vcan0", "up")
+    b = bus(ids=[0x70A, 0x8A])
+    m = wait_for(b, 0x8A, 2)
+    assert m is not None and m.data[0:2] == b"\x40\x81", "no EMCY 8140h after the link came back"
+    assert wait_for(b, 0x70A, 1) is not None
+    assert "node 0: vcan0 is up again" in p.text()
+    b.shutdown()
+    ip("del", "vcan0")
+    assert p.wait_log("vcan0: no such network interface")
+    time.sleep(0.5)
+    assert p.p.poll() is None
+    ip("add", "dev", "vcan0", "type", "vcan")
+    time.sleep(0.5)  # re-created but down: still bus-off
+    ip("set", "vcan0", "up")
+    b = bus(ids=[0x70A, 0x8A])
+    m = wait_for(b, 0x8A, 2)
+    assert m is not None and m.data[0:2] == b"\x40\x81"
+    hb = [m for m in frames(b, 0.5) if m.arbitration_id == 0x70A]
+    assert len(hb) >= 7, "no heartbeat after the interface was re-created"
+    assert "re-created" in p.text()
+    b.shutdown()
+    assert p.stop() == 0
+    assert "stopped" in p.text()
+
+
+def test_redundant_one_bus_down_leaves_the_other(tmp_path, procs):
+    """GSH-A redundant, one bus per node: vcan1 down and up again does not
+    disturb node 0x13 on vcan0 (no heartbeat gap); node 0x14 comes back."""
+    p = start(procs, tmp_path, "gsh-a-redundant", iface="vcan0,vcan1")
+    b0 = bus("vcan0", ids=[0x713, 0x593])
+    b1 = bus("vcan1", ids=[0x714, 0x594])
+    assert wait_for(b0, 0x713, 3) and wait_for(b1, 0x714, 3)
+    assert sdo_write(b0, 0x13, 0x1017, 0, 50, 2) == 0
+    assert sdo_write(b1, 0x14, 0x1017, 0, 50, 2) == 0
+    b1.shutdown()
+    frames(b0, 0.2)
+    t0 = time.monotonic()
+    ip("set", "vcan1", "down")
+    time.sleep(0.5)
+    ip("set", "vcan1", "up")
+    hb0 = [m.timestamp for m in frames(b0, 1.5 - (time.monotonic() - t0))
+           if m.arbitration_id == 0x713]
+    gaps = [b - a for a, b in zip(hb0, hb0[1:])]
+    assert len(hb0) >= 25 and max(gaps) < 0.1, gaps
+    b1 = bus("vcan1", ids=[0x714])
+    assert wait_for(b1, 0x714, 1) is not None
+    b1.shutdown()
+    b0.shutdown()
+    assert p.p.poll() is None
+    log = p.text()
+    assert "node 1: vcan1 is down" in log and "node 1: vcan1 is up again" in log
+    assert "node 0: vcan0" not in log
+    assert p.stop() == 0
+
+
+def test_start_on_a_down_interface(tmp_path, procs):
+    ip("set", "vcan1", "down")
+    p = start(procs, tmp_path, "jd2xxx", iface="vcan1")
+    assert p.wait_log("node 0: vcan1 is down")
+    assert p.p.poll() is None
+    ip("set", "vcan1", "up")
+    assert p.wait_log("node 0: vcan1 is up again")
+    b = bus("vcan1", ids=[0x58A])
+    assert sdo_write(b, 10, 0x1017, 0, 50, 2) == 0
+    b.shutdown()
+    assert p.stop() == 0
+
+
+# ---- EEPROM files ------------------------------------------------------------
+
+def saved_file(tmp_path, procs):
+    """An EEPROM file holding a valid saved set of the JD2xxx."""
+    nvm = tmp_path / "good.bin"
+    p, b = boot(procs, tmp_path, "jd2xxx", 10, nvm=nvm)
+    assert sdo_write(b, 10, 0x1017, 0, 300, 2) == 0
+    assert sdo_write(b, 10, 0x1010, 1, SAVE) == 0
+    b.shutdown()
+    assert p.stop() == 0
+    return nvm.read_bytes()
+
+
+@pytest.mark.parametrize("kind", ["random", "zeros", "bit-flip"])
+def test_corrupt_eeprom_logged_and_untouched(tmp_path, procs, kind):
+    if kind == "random":
+        data = random.Random(9).randbytes(768)
+    elif kind == "zeros":
+        data = bytes(768)
+    else:
+        good = bytearray(saved_file(tmp_path, procs))
+        i = next(k for k in range(40, 160) if good[k] != 0xFF)
+        good[i] ^= 0x10  # a bit of the record's data: its CRC no longer matches
+        data = bytes(good)
+    nvm = tmp_path / "eeprom.bin"
+    nvm.write_bytes(data)
+    os.utime(nvm, (1000000, 1000000))
+    p, b = boot(procs, tmp_path, "jd2xxx", 10, nvm=nvm)
+    assert p.wait_log("EEPROM file")
+    b.shutdown()
+    assert p.stop() == 0
+    log = p.text()
+    assert (f"node 0: EEPROM file {nvm}: stored parameters corrupt (neither blank nor a valid "
+            "record): factory defaults in use until the next save") in log, log
+    assert nvm.read_bytes() == data
+    assert os.stat(nvm).st_mtime == 1000000
+    assert not (tmp_path / "eeprom.bin.tmp").exists()
+
+
+@pytest.fixture
+def small_fs(tmp_path):
+    d = tmp_path / "fs"
+    d.mkdir()
+    subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(d)], check=True)
+    yield d
+    subprocess.run(["umount", str(d)], check=True)
+
+
+def test_failed_save_disk_full_and_read_only(small_fs, tmp_path, procs):
+    """A save that cannot be written answers 0x06060000 (CiA 301: hardware
+    error; README), logs the cause, and leaves the file as it was."""
+    nvm = small_fs / "eeprom.bin"
+    p, b = boot(procs, tmp_path, "jd2xxx", 10, nvm=nvm)
+    assert not nvm.exists()  # nothing written before the first save
+    assert sdo_write(b, 10, 0x1017, 0, 300, 2) == 0
+    assert sdo_write(b, 10, 0x1010, 1, SAVE) == 0
+    before = nvm.read_bytes()
+    # Fill the file system.
+    fd = os.open(small_fs / "fill", os.O_WRONLY | os.O_CREAT)
+    try:
+        while os.write(fd, b"\0" * 1024) > 0:
+            pass
+    except OSError:
+        pass
+    os.close(fd)
+    assert sdo_write(b, 10, 0x1017, 0, 400, 2) == 0
+    assert sdo_write(b, 10, 0x1010, 1, SAVE) == 0x06060000
+    assert p.wait_log("No space left on device")
+    assert nvm.read_bytes() == before
+    os.unlink(small_fs / "fill")
+    subprocess.run(["mount", "-o", "remount,ro", str(small_fs)], check=True)
+    assert sdo_write(b, 10, 0x1010, 1, SAVE) == 0x06060000
+    assert p.wait_log("Read-only file system")
+    assert nvm.read_bytes() == before
+    subprocess.run(["mount", "-o", "remount,rw", str(small_fs)], check=True)
+    assert sdo_write(b, 10, 0x1010, 1, SAVE) == 0
+    assert nvm.read_bytes() != before
+    b.shutdown()
+    assert p.stop() == 0
+    assert f"error: EEPROM file {nvm}: save failed" in p.text()
+
+
+# ---- standard input and lifetime -------------------------------------------
+
+def test_stdin_nul_long_and_last_line(tmp_path, procs):
+    p, b = boot(procs, tmp_path, "jd2xxx", 10)
+    b.shutdown()
+    p.send(b"set x=11\0garbage y=99\n")
+    p.send(b"set x=" + b"1" * 400 + b"\n")
+    p.send(b"set x=3")  # no newline: applied at the end of input
+    assert p.wait_log("line too long")
+    p.p.stdin.close()
+    assert p.p.wait(timeout=3) == 0  # --on-eof quit, the default
+    p.stderr = p.p.stderr.read().decode()
+    log = p.text()
+    assert "stdin rejected: line contains a NUL byte: ignored" in log
+    assert "stdin: set x=11" not in log
+    assert "stdin rejected: line too long" in log
+    assert "stdin: set x=3\n" in log
+    assert "line contains a NUL byte" in p.stderr
+    assert log.rstrip().endswith("stopped")
+
+
+def test_eof_quits_by_default(tmp_path, procs):
+    """A CI parent that dies closes the pipe: the sensor must not stay on the bus."""
+    p, b = boot(procs, tmp_path, "dst-x730-xy30", 0x7F)
+    b.shutdown()
+    p.p.stdin.close()
+    assert p.p.wait(timeout=3) == 0
+    log = p.text()
+    assert "end of standard input: stopping (--on-eof quit)" in log
+    assert log.rstrip().endswith("stopped")
+
+
+def test_eof_run_and_sighup(tmp_path, procs):
+    p, b = boot(procs, tmp_path, "dst-x730-xy30", 0x7F, extra=["--on-eof", "run"])
+    b.shutdown()
+    p.send(b"quit-not\n")
+    p.p.stdin.close()
+    time.sleep(1)
+    assert p.p.poll() is None
+    assert "end of standard input: running until a signal (--on-eof run)" in p.text()
+    p.p.send_signal(signal.SIGHUP)
+    assert p.p.wait(timeout=3) == 0
+    log = p.text()
+    assert "signal 1 (Hangup): stopping" in log
+    assert log.rstrip().endswith("stopped")
+    led = [line for line in log.splitlines() if "node 0: LED" in line]
+    assert led[-1].endswith("LED green off, red off")  # switched off at exit
+
+
+# ---- simulated bus-off -------------------------------------------------------
+
+def test_jd_bus_off_sends_nothing_then_8140(tmp_path, procs):
+    """`can bus-off 0.5`: nothing from the node while the bus is unusable and
+    the controller recovers (128 x 11 bits at 125 kbit/s = 11.3 ms); then
+    EMCY 8140h "recovered from bus-off" and the heartbeat again."""
+    node = 10
+    p, b = boot(procs, tmp_path, "jd2xxx", node)
+    assert sdo_write(b, node, 0x1017, 0, 20, 2) == 0
+    b.shutdown()
+    b = bus()  # everything on the bus: only the node sends
+    frames(b, 0.1)
+    t0 = time.time()
+    p.send(b"can bus-off 0.5\n")
+    seen = frames(b, 0.8)
+    during = [m for m in seen if t0 + 0.05 < m.timestamp < t0 + 0.48]
+    assert during == [], during
+    emcy = [m for m in seen if m.arbitration_id == 0x80 + node and m.data[0:2] == b"\x40\x81"]
+    assert len(emcy) == 1, seen
+    assert t0 + 0.5 <= emcy[0].timestamp < t0 + 0.65
+    hb = [m for m in seen if m.arbitration_id == 0x700 + node and m.timestamp > emcy[0].timestamp]
+    assert len(hb) >= 5
+    # Without a hold the recovery alone: back within milliseconds.
+    t0 = time.time()
+    p.send(b"can bus-off\n")
+    m = wait_for(b, 0x80 + node, 1, lambda m: m.data[0:2] == b"\x40\x81")
+    assert m is not None and m.timestamp - t0 < 0.2
+    b.shutdown()
+    assert p.stop() == 0
+    log = p.text()
+    assert "simulated CAN controller bus-off: bus unusable for 500 ms, then back after " \
+           "128 x 11 bits (11.264 ms)" in log
+    assert "red on" in log
+
+
+# ---- bus flood -------------------------------------------------------------
+
+FLOOD = r"""
+import errno, socket, struct, sys, time
+node, seconds = int(sys.argv[1]), float(sys.argv[2])
+s = socket.socket(socket.PF_CAN, socket.SOCK_RAW, socket.CAN_RAW)
+s.bind(("vcan0",))
+ids = [base + k for base in (0x080, 0x180, 0x280, 0x380, 0x480, 0x580, 0x700)
+       for k in range(1, 128, 7) if k != node]
+frames = [struct.pack("=IB3x8s", i, 8, bytes([i & 0xFF] * 8)) for i in ids]
+sent = full = 0
+start = time.time()
+end = time.monotonic() + seconds
+while time.monotonic() < end:
+    for f in frames:
+        try:
+            s.send(f)
+            sent += 1
+        except OSError as e:
+            if e.errno != errno.ENOBUFS:
+                raise
+            full += 1
+print(sent, full, start, time.time())
+"""
+
+
+def softnet_dropped():
+    return sum(int(line.split()[1], 16) for line in open("/proc/net/softnet_stat"))
+
+
+def test_bus_flood(tmp_path, procs):
+    """Other nodes' frames as fast as vcan takes them, for 10 s: the sensor
+    lives, its heartbeat keeps its period (mean within 1 %, no gap over
+    twice the period), and what the kernel dropped is counted in the log."""
+    node = 0x7F
+    p, b = boot(procs, tmp_path, "dst-x730-xy30", node)
+    assert sdo_write(b, node, 0x1017, 0, 100, 2) == 0
+    b.send(can.Message(arbitration_id=0, data=[1, node], is_extended_id=False))  # operational
+    b.shutdown()
+    hb_bus = bus(ids=[0x700 + node])
+    frames(hb_bus, 0.3)
+    drops0 = softnet_dropped()
+    # The generator runs at a lower priority (nice 10): on a real bus the
+    # sender is another machine and takes none of the sensor's CPU; here
+    # they share User-Mode Linux's one CPU. It still sends whenever the
+    # sensor does not need the CPU: as fast as vcan takes frames then.
+    gen = subprocess.run(["nice", "-n", "10", sys.executable, "-c", FLOOD, str(node), "10"],
+                         capture_output=True, text=True, timeout=30)
+    assert gen.returncode == 0, gen.stderr
+    sent, full, t_start, t_end = gen.stdout.split()
+    sent, full, t_start, t_end = int(sent), int(full), float(t_start), float(t_end)
+    # The heartbeats of the flood's 10 s (kernel receive times; the bus's
+    # socket is filtered to them, so it kept every one), and one either side.
+    hb = [m.timestamp for m in frames(hb_bus, 0.5) if m.arbitration_id == 0x700 + node]
+    first = max(i for i, t in enumerate(hb) if t <= t_start)
+    last = min(i for i, t in enumerate(hb) if t >= t_end)
+    hb = hb[first:last + 1]
+    hb_bus.shutdown()
+    assert p.p.poll() is None, "the sensor died in the flood"
+    assert p.stop() == 0
+    backlog_drops = softnet_dropped() - drops0
+    gaps = [b - a for a, b in zip(hb, hb[1:])]
+    mean = (hb[-1] - hb[0]) / len(gaps)
+    log = p.text()
+    m = re.search(r"node 0: (\d+) frames received, (\d+) dropped by the kernel", log)
+    assert m, log[-2000:]
+    received, dropped = int(m.group(1)), int(m.group(2))
+    logged = sum(int(x) for x in re.findall(r"node 0: (\d+) received frames dropped", log))
+    print(f"flood: {sent} frames in 10 s ({sent / 10:.0f}/s, {full} ENOBUFS), sensor read "
+          f"{received}, kernel dropped {dropped} (logged {logged}), backlog drops "
+          f"{backlog_drops}; heartbeat mean {mean * 1000:.2f} ms, longest gap "
+          f"{max(gaps) * 1000:.1f} ms over {len(gaps)} periods")
+    assert 0.099 <= mean <= 0.101, mean
+    assert max(gaps) <= 0.2, max(gaps)
+    assert len(gaps) >= 100
+    assert logged == dropped
+    # Every flood frame was read or counted as dropped (save those the
+    # kernel's input backlog itself dropped before any socket saw them);
+    # the frames before the flood (SDO, NMT) count too.
+    assert sent - backlog_drops <= received + dropped <= sent + 10

@@ -1,0 +1,139 @@
+"""tools/vcan-run over User-Mode Linux: the exit status and output come
+through, a signal to vcan-run reaches the command inside, vcan-run then ends
+promptly by that signal, and no process of its User-Mode Linux is left
+behind, however it ends (timeout's SIGTERM, a command that ignores the
+signal, SIGKILL). Run on the host (not inside vcan-run), with
+VCAN_RUN_MODE=uml: the path taken where the kernel has no CAN."""
+import os
+import pathlib
+import shutil
+import signal
+import subprocess
+import time
+
+import pytest
+
+from conftest import ROOT
+
+VCAN_RUN = str(ROOT / "tools" / "vcan-run")
+BOOT = 60    # s: User-Mode Linux boots in about 3 s; generous for a loaded machine
+PROMPT = 4   # s: from the signal to the end of vcan-run, when the command obeys it
+
+
+@pytest.fixture(autouse=True)
+def uml_present():
+    if shutil.which("linux.uml") is None:
+        pytest.fail("linux.uml is missing (Debian user-mode-linux): run tools/setup")
+
+
+def uml_pids(umid):
+    """Host processes of the User-Mode Linux instance with this umid."""
+    pids = []
+    for p in pathlib.Path("/proc").iterdir():
+        if p.name.isdigit():
+            try:
+                args = p.joinpath("cmdline").read_bytes().split(b"\0")
+            except OSError:
+                continue
+            if f"umid={umid}".encode() in args:
+                pids.append(int(p.name))
+    return pids
+
+
+def start(tmp_path, script, **env):
+    """vcan-run bash -c SCRIPT, with $D = tmp_path (shared with the inside
+    through hostfs) and TMPDIR there too (vcan-run's work directory)."""
+    work = tmp_path / "tmp"
+    work.mkdir(exist_ok=True)
+    e = dict(os.environ, VCAN_RUN_MODE="uml", TMPDIR=str(work), D=str(tmp_path), **env)
+    return subprocess.Popen([VCAN_RUN, "bash", "-c", script], env=e, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+
+
+def wait_file(path, proc):
+    end = time.monotonic() + BOOT
+    while not path.exists():
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < end, "the command did not start inside User-Mode Linux"
+        time.sleep(0.05)
+
+
+def assert_torn_down(umid, tmp_path):
+    assert uml_pids(umid) == [], f"linux.uml processes of {umid} left running"
+    assert list((tmp_path / "tmp").iterdir()) == [], "vcan-run left its work directory"
+
+
+# The command inside: says it runs, then records the first signal it gets.
+RECORDER = """
+for s in INT TERM HUP; do trap "echo $s > $D/got; exit 3" $s; done
+echo ready > $D/ready
+sleep 60 & wait $!
+echo none > $D/got
+"""
+
+
+def test_status_and_output_pass_through(tmp_path):
+    p = start(tmp_path, "ip -br link show vcan1; echo to-stderr >&2; exit 7")
+    out, err = p.communicate(timeout=BOOT)
+    assert p.returncode == 7
+    assert out.startswith("vcan1") and "UP" in out
+    assert "to-stderr" in err
+    assert_torn_down(f"vcanrun{p.pid}", tmp_path)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+def test_signal_reaches_the_command(tmp_path, sig):
+    p = start(tmp_path, RECORDER)
+    wait_file(tmp_path / "ready", p)
+    assert uml_pids(f"vcanrun{p.pid}") != []
+    t = time.monotonic()
+    p.send_signal(sig)
+    _, err = p.communicate(timeout=30)
+    took = time.monotonic() - t
+    assert (tmp_path / "got").read_text().strip() == sig.name[3:], err
+    assert p.returncode == -sig, err  # ends by the signal: a shell shows 128+N
+    assert took < PROMPT, f"{took:.1f} s from the signal to the end"
+    assert_torn_down(f"vcanrun{p.pid}", tmp_path)
+
+
+def test_timeout_tears_down(tmp_path):
+    """`timeout 5 tools/vcan-run sleep 60`: ends at 5 s, nothing left."""
+    work = tmp_path / "tmp"
+    work.mkdir()
+    e = dict(os.environ, VCAN_RUN_MODE="uml", TMPDIR=str(work))
+    t = time.monotonic()
+    # exec keeps the PID, which names the UML instance (umid=vcanrun<PID>).
+    p = subprocess.Popen(["timeout", "5", "bash", "-c", 'echo $$; exec "$0" sleep 60', VCAN_RUN],
+                         env=e, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    pid = int(p.stdout.readline())
+    _, err = p.communicate(timeout=30)
+    took = time.monotonic() - t
+    assert p.returncode == 124, err  # timeout's "timed out"
+    assert took < 5 + PROMPT, f"ended {took:.1f} s after the start"
+    assert_torn_down(f"vcanrun{pid}", tmp_path)
+
+
+def test_command_ignoring_the_signal_gets_the_grace_time(tmp_path):
+    p = start(tmp_path, "trap '' INT TERM HUP; echo ready > $D/ready; sleep 60",
+              VCAN_RUN_GRACE="1")
+    wait_file(tmp_path / "ready", p)
+    t = time.monotonic()
+    p.send_signal(signal.SIGTERM)
+    _, err = p.communicate(timeout=30)
+    took = time.monotonic() - t
+    assert p.returncode == -signal.SIGTERM, err
+    assert 1 <= took < 1 + PROMPT, f"{took:.1f} s from the signal to the end"
+    assert_torn_down(f"vcanrun{p.pid}", tmp_path)
+
+
+def test_sigkill_of_vcan_run_leaves_no_uml(tmp_path):
+    """Nothing can be trapped: UML's parent-death signal ends it."""
+    p = start(tmp_path, "echo ready > $D/ready; sleep 60")
+    wait_file(tmp_path / "ready", p)
+    umid = f"vcanrun{p.pid}"
+    p.kill()
+    p.communicate(timeout=30)
+    end = time.monotonic() + PROMPT
+    while uml_pids(umid) and time.monotonic() < end:
+        time.sleep(0.1)
+    assert uml_pids(umid) == [], f"linux.uml processes of {umid} left running"
