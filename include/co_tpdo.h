@@ -43,7 +43,7 @@ typedef struct co_tpdo {
     bool have_last;      /* last[] holds the last data sent (type 0) or sampled (252) */
     uint16_t cob_id;
     uint16_t event_ms;
-    uint16_t inhibit;      /* inhibit time, in the product's unit (co_node_cfg_t) */
+    uint32_t inhibit_us;   /* inhibit time (us; in the dictionary in the product's unit) */
     uint32_t next_event;   /* time of the next event-timer send */
     uint32_t inhibit_end;  /* earliest time of the next event-driven send */
     const co_od_entry_t *map[CO_PDO_MAP_MAX]; /* mapped entries */

@@ -30,6 +30,15 @@ static bool event_driven(const co_tpdo_t *t)
     return t->type >= TYPE_EVENT_MFR;
 }
 
+/* The inhibit time in us: u16 x a unit of at most 1000 us (co_node_cfg_t)
+ * is at most 65 535 000 us, far inside co_time_before's 2^31 us horizon. */
+static uint32_t inhibit_us(const co_node_t *node, uint32_t inhibit)
+{
+    uint32_t unit = co_cfg(node)->inhibit_unit_us != 0u ? co_cfg(node)->inhibit_unit_us : 100u;
+    unit = co_min_u32(unit, 1000u);
+    return (uint32_t)(uint16_t)inhibit * unit;
+}
+
 static void start_one(co_node_t *node, co_tpdo_t *t)
 {
     t->sync_count = 0;
@@ -69,7 +78,7 @@ void co_tpdo_reconfig(co_node_t *node, unsigned n)
     }
     uint32_t cob = get_or(node, comm, 1, 0x80000000u);
     t->type = (uint8_t)get_or(node, comm, 2, 254);
-    t->inhibit = (uint16_t)get_or(node, comm, 3, 0);
+    t->inhibit_us = inhibit_us(node, get_or(node, comm, 3, 0));
     t->event_ms = (uint16_t)get_or(node, comm, 5, 0);
     t->cob_id = (uint16_t)(cob & 0x7FFu);
     t->rtr_allowed = (cob & 0x40000000u) == 0u;
@@ -329,24 +338,6 @@ void co_tpdo_event(co_node_t *node, unsigned n)
     }
 }
 
-/* The inhibit time in us: u16 x a unit of at most 1000 us (co_node_cfg_t)
- * is at most 65 535 000 us, far inside co_time_before's 2^31 us horizon. */
-static uint32_t inhibit_us(const co_node_t *node, const co_tpdo_t *t)
-{
-    uint32_t unit = co_cfg(node)->inhibit_unit_us != 0u ? co_cfg(node)->inhibit_unit_us : 100u;
-    unit = co_min_u32(unit, 1000u);
-    return (uint32_t)t->inhibit * unit;
-}
-
-/* The inhibit time of t still runs at now. Its end is never more than one
- * inhibit time ahead; a stamp that seems further ahead went stale more than
- * 2^31 us ago without a send since (an event-driven PDO whose data did not
- * change for 36 minutes): it ran out long ago (found by fuzz_node.c). */
-static bool inhibited(const co_node_t *node, const co_tpdo_t *t, uint32_t now)
-{
-    return co_time_before(now, t->inhibit_end) && t->inhibit_end - now <= inhibit_us(node, t);
-}
-
 uint32_t co_tpdo_poll(co_node_t *node, uint32_t now)
 {
     uint32_t next = CO_NEVER;
@@ -361,14 +352,19 @@ uint32_t co_tpdo_poll(co_node_t *node, uint32_t now)
         uint32_t period = (uint32_t)t->event_ms * 1000u; /* <= 65 535 000 us: no overflow */
         bool timer_due = t->timer_armed && !co_time_before(now, t->next_event);
         if (timer_due || t->pending) {
-            if (inhibited(node, t, now)) {
+            /* The inhibit time still runs while its end is 1 .. inhibit_us ahead
+             * (one compare). Not co_time_before(): an end that seems further
+             * ahead went stale more than 2^31 us ago without a send since
+             * (an event-driven PDO whose data did not change for 36 min),
+             * and the event waited up to 36 min for it (fuzz_node.c). */
+            if (t->inhibit_end - now - 1u < t->inhibit_us) {
                 t->pending = true; /* keep the event until the inhibit time ends */
                 next = co_min_u32(next, t->inhibit_end - now);
                 continue;
             }
             send(node, n);
             t->pending = false;
-            t->inhibit_end = now + inhibit_us(node, t);
+            t->inhibit_end = now + t->inhibit_us;
             if (t->timer_armed) {
                 /* A timer send keeps the cadence; an event send restarts it. */
                 t->next_event = timer_due ? t->next_event + period : now + period;

@@ -12,7 +12,7 @@ uint32_t flash_ee_size(const flash_ee_t *fe)
      * each other's pages and past the last one. Such a geometry gives no
      * EEPROM at all (every access fails, the store reports a hardware
      * error) rather than one that half works (found by fuzz_flash_ee.c). */
-    if (fe->page_size < CO_STORE_SLOT || (fe->page_size & 1u) != 0u || (fe->base & 1u) != 0u) {
+    if (fe->page_size < CO_STORE_SLOT || ((fe->page_size | fe->base) & 1u) != 0u) {
         return 0;
     }
     return fe->pages * CO_STORE_SLOT;

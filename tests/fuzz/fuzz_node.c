@@ -211,10 +211,9 @@ static uint64_t config_bound(co_node_t *n)
 {
     uint64_t b = CO_SDO_TIMEOUT_US;
     b = max64(b, (uint64_t)n->hb.period_ms * 1000u);
-    uint32_t unit = co_cfg(n)->inhibit_unit_us != 0u ? co_cfg(n)->inhibit_unit_us : 100u;
     for (unsigned j = 0; j < CO_TPDO_MAX; j++) {
         b = max64(b, (uint64_t)n->tpdo[j].event_ms * 1000u);
-        b = max64(b, (uint64_t)n->tpdo[j].inhibit * unit);
+        b = max64(b, n->tpdo[j].inhibit_us);
     }
     b = max64(b, guard_life_us(n));
     b = max64(b, (uint64_t)n->hbc.time_ms * 1000u);
