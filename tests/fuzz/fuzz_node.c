@@ -46,6 +46,10 @@
  *
  * FUZZ_TRACE=1 in the environment prints every op and frame (to follow a
  * finding: build-fuzz/bin/fuzz_node FILE).
+ *
+ * White box: some invariants read the node's own state (the guard's event
+ * and request, the SDO server's state from sdo_internal.h, the configured
+ * timers), so a change of those fields must be followed here.
  */
 #include <stdio.h>
 #include <stdlib.h>
