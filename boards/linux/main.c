@@ -441,7 +441,7 @@ int main(int argc, char **argv)
     epoll_ctl(ep, EPOLL_CTL_ADD, sfd, &ev);
     ev.data.u32 = 101;
     /* A pipe or terminal is polled; a regular file or /dev/null cannot be
-     * (EPERM): it never blocks, so it is read to its end after the start. */
+     * (EPERM): it never blocks, and is read a block at a time in the loop. */
     bool stdin_polled = epoll_ctl(ep, EPOLL_CTL_ADD, STDIN_FILENO, &ev) == 0;
     int stdin_errno = stdin_polled ? 0 : errno;
     for (unsigned i = 0; i < a.nnodes; i++) {
@@ -464,10 +464,13 @@ int main(int argc, char **argv)
                product_kbps(a.prod, a.nodes[i]->bitrate));
     }
     log_store_status(&a, &nvm);
+    /* A regular file or a device never blocks: read one block a pass of the
+     * loop below, at most one a millisecond, so that the nodes run and
+     * signals are heard however long (/dev/zero: endless) it is. */
+    bool stdin_file = !stdin_polled && stdin_errno == EPERM;
     if (!stdin_polled) {
-        if (stdin_errno == EPERM) {
-            while (!a.sim.quit && read_stdin(&a)) {
-            }
+        if (stdin_file) {
+            lp_log("standard input is a file or device: read a block a millisecond");
         } else {
             lp_log("standard input cannot be polled (%s)", strerror(stdin_errno));
             end_of_input(&a);
@@ -510,6 +513,10 @@ int main(int argc, char **argv)
         }
         if (backlog) {
             wait = co_min_u32(wait, 1000u); /* retry the kernel's full queue soon */
+        }
+        if (stdin_file && !a.sim.quit) {
+            stdin_file = read_stdin(&a);
+            wait = stdin_file ? co_min_u32(wait, 1000u) : wait;
         }
         struct epoll_event evs[8];
         int timeout_ms = (int)((wait + 999u) / 1000u);
