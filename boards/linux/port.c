@@ -89,6 +89,15 @@ static lp_link_t link_probe(lp_port_t *p, int *index, const char **cause)
     memset(&ifr, 0, sizeof(ifr));
     snprintf(ifr.ifr_name, sizeof(ifr.ifr_name), "%s", p->iface);
     *cause = NULL;
+    /* A missing interface is looked for in sysfs first: for root, the
+     * kernel answers SIOCGIFINDEX on an unknown name by running modprobe,
+     * which blocked the whole process (every node) for 0.16 s a probe. */
+    char path[64];
+    snprintf(path, sizeof(path), "/sys/class/net/%s", p->iface);
+    if (access("/sys/class/net", F_OK) == 0 && access(path, F_OK) != 0) {
+        *cause = "no such network interface";
+        return LP_LINK_ABSENT;
+    }
     if (ioctl(p->fd, SIOCGIFINDEX, &ifr) < 0) {
         *cause = errno == ENODEV ? "no such network interface" : strerror(errno);
         return LP_LINK_ABSENT;
