@@ -59,6 +59,7 @@
 #include "co_node.h"
 #include "co_port.h"
 #include "fuzz_format.h"
+#include "fuzz_input.h"
 #include "product.h"
 #include "sdo_internal.h"
 
@@ -92,31 +93,7 @@ static unsigned g_op;
 
 /* ---- the input -------------------------------------------------------- */
 
-typedef struct fz {
-    const uint8_t *p;
-    size_t n;
-} fz_t;
-
-static uint8_t u8(fz_t *in)
-{
-    if (in->n == 0u) {
-        return 0;
-    }
-    in->n--;
-    return *in->p++;
-}
-
-static uint16_t u16(fz_t *in)
-{
-    uint16_t lo = u8(in);
-    return (uint16_t)(lo | (uint16_t)(u8(in) << 8));
-}
-
-static uint32_t u32(fz_t *in)
-{
-    uint32_t lo = u16(in);
-    return lo | ((uint32_t)u16(in) << 16);
-}
+/* fz_t, u8(), u16(), u32(): fuzz_input.h */
 
 /* ---- the simulated device --------------------------------------------- */
 
