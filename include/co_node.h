@@ -169,7 +169,7 @@ static inline void co_node_wake(co_node_t *node)
     node->dirty = true;
 }
 
-/* A write hook runs for co_od_validate(): validate the value, act on nothing. */
+/* A write hook runs for co_od_validate(): check the value held, store nothing (co_od_write_fn). */
 static inline bool co_od_checking(const co_node_t *node)
 {
     return node->od_checking;

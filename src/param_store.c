@@ -172,10 +172,8 @@ static void set_defaults(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi
 }
 
 /* Read the newest valid record's entries of class cls with index in
- * [lo, hi] into RAM, or their defaults. Not inlined: its frame (the slot
- * summary) is off the stack again before validate() calls the hooks. */
-static co_store_status_t load(co_node_t *node, co_cls_t cls, uint16_t lo,
-                                          uint16_t hi)
+ * [lo, hi] into RAM, or their defaults. */
+static co_store_status_t load(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)
 {
     newest_t nw = newest(node, cls);
     int k = nw.k;
