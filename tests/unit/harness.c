@@ -18,6 +18,14 @@ void fake_port_init(fake_port_t *p)
     p->reads_left = -1;
 }
 
+bool co_port_can_bitrate(void *port, uint16_t kbps)
+{
+    fake_port_t *p = port;
+    p->kbps = kbps;
+    p->bitrate_calls++;
+    return kbps != 0u;
+}
+
 bool co_port_can_send(void *port, const co_frame_t *frame)
 {
     fake_port_t *p = port;

@@ -88,6 +88,8 @@ typedef struct fake_port {
     bool nvm_read_fails;
     long reads_left;   /* NVM reads that still succeed; -1 = all (a read fault after that) */
     unsigned read_faults; /* reads refused because reads_left ran out */
+    uint16_t kbps;     /* last co_port_can_bitrate() */
+    unsigned bitrate_calls;
 } fake_port_t;
 
 void fake_port_init(fake_port_t *p);
