@@ -86,16 +86,19 @@ def free_port():
 class Emu:
     """One tools/emu process (and its QEMU) with an SDO client on its serial line."""
 
-    def __init__(self, flash, board, product=PRODUCT):
-        self.args = [EMU, "--board", board, "--product", product, "--port", str(free_port())]
+    def __init__(self, flash, board, product=PRODUCT, qemu=None):
+        self.port = free_port()
+        self.args = [EMU, "--board", board, "--product", product, "--port", str(self.port)]
         if flash is not None:
             self.args += ["--flash", str(flash)]
+        if qemu is not None:  # QEMU itself, started with this function of the port
+            self.args = qemu(self.port)
         self.proc = None
         self.bus = None
 
     def start(self, timeout=10):
         """Start, connect, wait for the boot-up; returns an SDO client."""
-        port = self.args[self.args.index("--port") + 1]
+        port = self.port
         self.proc = subprocess.Popen(self.args, stderr=subprocess.PIPE, start_new_session=True)
         end = time.monotonic() + timeout
         while True:
@@ -294,6 +297,34 @@ def test_without_flash_file(board, emus):
         sdo = e.start()
         assert u16(sdo, 0x1017) == default
     assert e.stop() == 0
+
+
+def test_rv32_read_only_flash_reads_but_refuses_saves(emus, tmp_path):
+    """QEMU with the flash file read-only sets the status register's erase
+    error bit (5) on a block erase: the driver sees it, the save is refused
+    (SDO abort 06060000h) and the file is unchanged, while the stored set
+    still loads."""
+    flash = tmp_path / "flash.bin"
+    e = emus(flash, "rv32-virt")
+    sdo = e.start()
+    set_heartbeat(sdo, 1234)
+    save(sdo)
+    assert e.stop() == 0
+    before = flash.read_bytes()
+    image = ROOT / "build-rv32-virt" / "bin" / f"fw-{PRODUCT}.elf"
+    e = emus(None, "rv32-virt", qemu=lambda port: [
+        "qemu-system-riscv32", "-M", "virt", "-display", "none", "-monitor", "none",
+        "-serial", f"tcp:127.0.0.1:{port},server=on,wait=on", "-bios", str(image),
+        "-drive", f"if=pflash,unit=1,format=raw,readonly=on,file={flash}"])
+    sdo = e.start()
+    assert u16(sdo, 0x1017) == 1234
+    assert errors(sdo) & ERR_CHECKSUM == 0
+    set_heartbeat(sdo, 2345)
+    with pytest.raises(SdoAbort) as abort:
+        save(sdo)
+    assert abort.value.code == 0x06060000
+    e.power_cut()
+    assert flash.read_bytes() == before
 
 
 @pytest.mark.parametrize("args, message", [
