@@ -25,7 +25,9 @@
  *   before they touch FLASH_CR or FLASH_AR again or start the next
  *   operation (a violation here); FLASH_AR is write-blocked while BSY.
  *   A read of the flash memory during an operation stalls the bus until it
- *   ends (here: the read completes the operation first).
+ *   ends (here: the read completes the operation first). BSY shows at
+ *   once after STRT (the manual asks for a cycle before the first check,
+ *   which the Cortex-M0 always leaves: its store ends before the next load).
  */
 #include <string.h>
 
@@ -62,6 +64,7 @@ static struct {
     unsigned busy_left; /* FLASH_SR reads until the operation ends */
     unsigned busy_reads;
     unsigned erases, programs;
+    uint32_t worn; /* offset + 1 of a worn-out half-word; 0: none */
 } fl;
 
 static uint8_t image_byte(uint32_t off)
@@ -80,6 +83,7 @@ void flash_reset(bool new_chip)
         fl.busy_reads = 3u;
         fl.erases = 0;
         fl.programs = 0;
+        fl.worn = 0;
     }
     /* A reset in the middle of an operation: the memory stays as it is. */
     fl.cr = CR_LOCK;
@@ -103,6 +107,11 @@ void stm_flash_write_protect(unsigned sector, bool on)
     } else {
         fl.wrpr |= 1u << sector;
     }
+}
+
+void stm_flash_wear_out(uint32_t addr)
+{
+    fl.worn = addr - STM_FLASH_BASE + 1u;
 }
 
 void stm_flash_busy_reads(unsigned n)
@@ -141,6 +150,8 @@ static void finish(void)
     if (fl.op == OP_ERASE) {
         memset(&fl.mem[fl.op_addr], 0xFF, STM_FLASH_PAGE);
         fl.erases++;
+    } else if (fl.op == OP_PROGRAM && fl.op_addr + 1u == fl.worn) {
+        fl.programs++; /* a worn-out cell: the bits do not move */
     } else if (fl.op == OP_PROGRAM) {
         fl.mem[fl.op_addr] &= (uint8_t)fl.op_value;
         fl.mem[fl.op_addr + 1u] &= (uint8_t)(fl.op_value >> 8);

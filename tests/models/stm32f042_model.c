@@ -76,9 +76,7 @@ void stm_violations_clear(void)
     vdropped = 0;
 }
 
-static uint32_t spin_addr;
-static uint32_t spin_val;
-static unsigned spin_count;
+static unsigned spin_count; /* reads since the last write or change */
 static jmp_buf *hang_exit;
 
 void stm_progress(void)
@@ -86,19 +84,15 @@ void stm_progress(void)
     spin_count = 0;
 }
 
-/* One more read of addr returning v: a poll that cannot end is a hang. */
+/* One more read (of addr, returning v) with nothing written and nothing
+ * changed since the last one: a loop of such reads, of one register or of
+ * several, can never end. */
 static void spin_check(uint32_t addr, uint32_t v)
 {
-    if (addr != spin_addr || v != spin_val) {
-        spin_addr = addr;
-        spin_val = v;
-        spin_count = 0;
-        return;
-    }
     if (++spin_count < STM_SPIN_LIMIT) {
         return;
     }
-    stm_violation("hang: %u identical reads of 0x%08X (0x%08X) and nothing can change it",
+    stm_violation("hang: %u register reads and nothing written or changed (the last: 0x%08X = 0x%08X)",
                   STM_SPIN_LIMIT, (unsigned)addr, (unsigned)v);
     spin_count = 0;
     if (hang_exit != NULL) {
@@ -533,7 +527,6 @@ uint32_t stm_rd32(uint32_t addr)
 void stm_wr32(uint32_t addr, uint32_t v)
 {
     stm_progress();
-    spin_addr = 0;
     if ((addr & 3u) != 0u) {
         stm_violation("unaligned word write at 0x%08X", (unsigned)addr);
     }
@@ -575,7 +568,6 @@ uint16_t stm_rd16(uint32_t addr)
 void stm_wr16(uint32_t addr, uint16_t v)
 {
     stm_progress();
-    spin_addr = 0;
     if (!IN(addr, STM_FLASH_BASE, STM_FLASH_SIZE)) {
         stm_violation("half-word write at 0x%08X: not flash memory", (unsigned)addr);
         return;

@@ -20,9 +20,11 @@
  * Time in the models is counted in register reads: a handshake bit (INAK,
  * SLAK, HSI48RDY, SWS, BSY) changes only after the code has polled for it,
  * so code that does not wait is caught. A poll that can never end (the bus
- * held dominant while the code waits for the controller to join it) is
- * detected after STM_SPIN_LIMIT identical reads: recorded as a violation,
- * and the code is abandoned when it was started through stm_run().
+ * held dominant while the code waits for the controller to join it; an
+ * interrupt handler that never releases the FIFO) is detected after
+ * STM_SPIN_LIMIT reads with nothing written or changed: recorded as a
+ * violation, and the code is abandoned when it was started through
+ * stm_run(), else the test program stops with the violation printed.
  *
  * Not modelled (the board does not use them): CAN FIFO 1 interrupts beyond
  * their flags, time-triggered mode, the LOW flags of CAN_TSR, silent and
@@ -62,8 +64,8 @@ unsigned stm_wfi_count(void);
 
 /* ---- checks ------------------------------------------------------------ */
 
-/* Identical reads of one register, nothing else happening, after which a
- * poll is taken for a hang. */
+/* Register reads with nothing written and nothing changed in the models,
+ * after which the code reading is taken for hanging in a poll. */
 #define STM_SPIN_LIMIT 100000u
 
 /* Violations recorded and not taken yet. */
@@ -152,6 +154,9 @@ unsigned stm_can_tx_pending(void);
 const uint8_t *stm_flash_mem(void);
 /* Write protection of 4-KB sector s (FLASH_WRPR bit s cleared). */
 void stm_flash_write_protect(unsigned sector, bool on);
+/* The half-word at addr is worn out (beyond the datasheet's endurance):
+ * programs of it end normally (EOP) but leave its bits as they were. */
+void stm_flash_wear_out(uint32_t addr);
 /* FLASH_SR reads an erase or a program keeps BSY set (default 3). */
 void stm_flash_busy_reads(unsigned n);
 /* Page erases and half-word programs performed since stm_chip_new(). */
