@@ -196,6 +196,12 @@ static void flash_unlock(void)
     }
 }
 
+/* Known and left: the code runs from the flash it erases, so the core
+ * stalls for the page erase (tens of ms, datasheet); interrupts wait, the
+ * bxCAN FIFO (3 frames) can overrun on a busy bus and SysTick loses all
+ * but one of the milliseconds (time is late, never backwards). A save is a
+ * master's explicit request; running the erase from RAM with the vectors
+ * there would cost flash the X730 does not have. */
 static bool f042_erase(void *ctx, uint32_t page)
 {
     (void)ctx;
