@@ -639,7 +639,8 @@ static void test_flash_driver(void)
     CHECK_EQ(stm_peek32(FLASH_CR), FLASH_CR_LOCK);
     CHECK(co_port_nvm_read(NULL, 0, back, sizeof(back)) && memcmp(back, rec, sizeof(rec)) == 0);
     CHECK(co_port_nvm_write(NULL, 4u * CO_STORE_SLOT, rec, 8)); /* 0x08007000: sector 7 */
-    CHECK(!co_port_nvm_write(NULL, 66, rec, 2)); /* programming refused too */
+    CHECK(!co_port_nvm_write(NULL, 100, rec, 2)); /* an erased half-word: programming refused too */
+    CHECK_EQ(stm_flash_mem()[EE_BASE - STM_FLASH_BASE + 100u], 0xFF);
     CHECK_EQ(stm_peek32(FLASH_SR), 0);
     stm_flash_write_protect(6, false);
     /* A worn-out cell: the program ends (EOP) but the read-back differs. */
