@@ -114,13 +114,15 @@ typedef enum { STM_CAN_SLEEP, STM_CAN_INIT, STM_CAN_NORMAL } stm_can_mode_t;
 #define STM_CAN_FILTERED (-1) /* acknowledged, no active filter took it */
 #define STM_CAN_OFF_BUS (-2)  /* the controller does not take part in bus traffic */
 
-/* Another node sends f: the controller receives it when it is in normal
- * mode, not bus-off and its filters are active (FINIT clear); a filter
- * match stores it in that FIFO (overrun rules of RFLM). */
+/* Another node sends f, after the 11 recessive bits that end the frame
+ * before it (they let a controller that left initialization join, and
+ * count for a bus-off recovery): the controller receives it when it is in
+ * normal mode, not bus-off and its filters are active (FINIT clear); a
+ * filter match stores it in that FIFO (overrun rules of RFLM). */
 int stm_can_bus_send(const stm_can_frame_t *f);
 /* The bus takes the next frame the controller transmits (the transmit
- * priority of TXFP) and acknowledges it; false when nothing is pending or
- * the controller is not on the bus. */
+ * priority of TXFP), after the same 11 recessive bits, and acknowledges
+ * it; false when nothing is pending or the controller is not on the bus. */
 bool stm_can_bus_take(stm_can_frame_t *f);
 /* The next transmission fails: a bit error (TEC + 8), or an acknowledgement
  * error (TEC + 8, except while error passive: ISO 11898-1 fault
