@@ -95,6 +95,14 @@ static void create(h_dev_t *d)
 {
     void *ports[PRODUCT_MAX_NODES] = {&d->port, &d->port};
     d->prod->create(d->prod, d->mem, ports, d->nodes);
+#ifdef CO_FIXED_CFG
+    for (unsigned i = 0; i < d->prod->nodes; i++) {
+        if (d->nodes[i]->cfg != &CO_FIXED_CFG) {
+            h_foreign_boot(d->prod->id); /* nothing of it runs: back to h_run */
+        }
+    }
+    h_own_boot();
+#endif
     d->nnodes = d->prod->nodes;
     d->node = d->nodes[0];
     /* One sample before start, as a board reads its sensor before booting. */
