@@ -144,7 +144,7 @@ class Emu:
 
 
 @pytest.fixture
-def emus():
+def emus(tmp_path):
     made = []
 
     def make(*a, **kw):
@@ -156,6 +156,10 @@ def emus():
     for e in made:
         if e.proc is not None and e.proc.poll() is None:
             e.power_cut()
+    # The flash files are 32 MiB on rv32-virt (erased flash cannot be
+    # sparse) and pytest keeps the last runs' directories: not these files.
+    for f in tmp_path.glob("*.bin"):
+        f.unlink()
 
 
 def u16(sdo, index, sub=0):
