@@ -17,6 +17,7 @@ import signal
 import socket
 import struct
 import subprocess
+import tempfile
 import time
 import zlib
 
@@ -224,8 +225,12 @@ def test_saved_value_survives_restart_and_power_cut(board, emus, tmp_path):
     time.sleep(0.3)  # the micro:bit's next snapshot (every 100 ms) has it
     e.power_cut()
 
+    cut = e.proc.pid
     sdo = e.start()
     assert u16(sdo, 0x1017) == 2345
+    # The killed emulator could not remove its temporary directory; the next
+    # one did (tools/emu, clean_stale_tmp).
+    assert not list(pathlib.Path(tempfile.gettempdir()).glob(f"emu-{cut}-*"))
     sdo.download(0x1011, 1, b"load")  # restore defaults at the next reset
     assert e.stop() == 0
     sdo = e.start()
