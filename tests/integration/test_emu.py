@@ -13,6 +13,8 @@ The boards: rv32-virt, and microbit once its toolchain file
 one is missing)."""
 import os
 import pathlib
+import random
+import select
 import signal
 import socket
 import struct
@@ -79,9 +81,17 @@ class Sdo:
 
 
 def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+    """A free port below the kernel's ephemeral range, so that no client's
+    own source port can take it meanwhile."""
+    low = int(pathlib.Path("/proc/sys/net/ipv4/ip_local_port_range").read_text().split()[0])
+    while True:
+        port = random.randrange(10000, max(low, 10001))
+        with socket.socket() as s:
+            try:
+                s.bind(("127.0.0.1", port))
+                return port
+            except OSError:
+                continue
 
 
 class Emu:
@@ -92,8 +102,10 @@ class Emu:
         self.args = [EMU, "--board", board, "--product", product, "--port", str(self.port)]
         if flash is not None:
             self.args += ["--flash", str(flash)]
+        self.ready = b"emu: ready: "  # tools/emu's word that QEMU listens
         if qemu is not None:  # QEMU itself, started with this function of the port
             self.args = qemu(self.port)
+            self.ready = b"QEMU waiting for connection on"
         self.proc = None
         self.bus = None
 
@@ -102,21 +114,23 @@ class Emu:
         port = self.port
         self.proc = subprocess.Popen(self.args, stderr=subprocess.PIPE, start_new_session=True)
         end = time.monotonic() + timeout
-        while True:
-            try:
-                bus = can.Bus(interface="slcan", channel=f"socket://127.0.0.1:{port}",
-                              sleep_after_open=0)
-                break
-            except Exception:  # pyserial: connection refused until QEMU listens
-                assert self.proc.poll() is None, self.proc.stderr.read().decode()
-                assert time.monotonic() < end, "tools/emu did not listen"
-                time.sleep(0.02)
+        # Connect once tools/emu says QEMU listens.
+        err = b""
+        while self.ready not in err:
+            left = end - time.monotonic()
+            assert left > 0, f"tools/emu not ready: {err.decode()}"
+            if select.select([self.proc.stderr], [], [], left)[0]:
+                chunk = os.read(self.proc.stderr.fileno(), 4096)
+                assert chunk, f"tools/emu ended: {err.decode()}"
+                err += chunk
+        bus = can.Bus(interface="slcan", channel=f"socket://127.0.0.1:{port}", sleep_after_open=0)
         seen = []
         while (m := bus.recv(timeout=max(0.0, end - time.monotonic()))) is not None:
             seen.append(m)
             if m.arbitration_id == 0x700 + NODE:
                 break
-        assert m is not None and bytes(m.data) == b"\0", f"no boot-up; frames: {seen}"
+        assert m is not None and bytes(m.data) == b"\0", \
+            f"no boot-up; frames: {seen}; tools/emu: {self.proc.poll()}, {err.decode()}"
         self.bus = bus
         return Sdo(bus)
 
