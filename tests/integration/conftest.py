@@ -25,9 +25,13 @@ def pytest_addoption(parser):
     group.addoption("--target", default="linux", choices=("linux", "rv32-virt", "microbit"),
                     help="where the products run: linux (canopen-sensor on vcan0, through "
                          "tools/vcan-run) or an emulated board (tools/emu, qemu)")
-    group.addoption("--products", default="ci",
+    group.addoption("--products", default=os.environ.get("CO_TEST_PRODUCTS", "ci"),
                     help="ci (one of each family, facts.CI_PRODUCTS), all, or IDs "
-                         "separated by commas")
+                         "separated by commas; default $CO_TEST_PRODUCTS, else ci "
+                         "(tools/check --all-products sets it to all)")
+    group.addoption("--shard", default="1/1", metavar="K/N",
+                    help="run the K-th of N shares of the products (ctest runs the "
+                         "shares of a board in parallel)")
 
 
 def pytest_sessionstart(session):

@@ -30,18 +30,26 @@ OPERATIONAL, STOPPED, PREOP = 0x05, 0x04, 0x7F
 
 
 def selected_products(config):
+    """--products, then the K-th of N shares of them (--shard K/N)."""
     target = config.getoption("--target")
     want = config.getoption("--products")
     if want == "ci":
-        return list(CI_PRODUCTS[target])
-    if want == "all":
-        return list(PRODUCTS)
-    ids = [p for p in want.split(",") if p]
-    unknown = [p for p in ids if p not in PRODUCTS]
-    if unknown:
-        raise pytest.UsageError(f"--products: unknown product {', '.join(unknown)} "
-                                f"(known: {', '.join(PRODUCTS)})")
-    return ids
+        ids = list(CI_PRODUCTS[target])
+    elif want == "all":
+        ids = list(PRODUCTS)
+    else:
+        ids = [p for p in want.split(",") if p]
+        unknown = [p for p in ids if p not in PRODUCTS]
+        if unknown:
+            raise pytest.UsageError(f"--products: unknown product {', '.join(unknown)} "
+                                    f"(known: {', '.join(PRODUCTS)})")
+    shard = re.fullmatch(r"([1-9][0-9]*)/([1-9][0-9]*)", config.getoption("--shard"))
+    if shard is None or int(shard[1]) > int(shard[2]):
+        raise pytest.UsageError("--shard K/N: 1 <= K <= N")
+    k, n = int(shard[1]), int(shard[2])
+    if not ids[k - 1::n]:
+        raise pytest.UsageError(f"--shard {k}/{n}: no product in it (of {len(ids)})")
+    return ids[k - 1::n]
 
 
 def pytest_generate_tests(metafunc):
