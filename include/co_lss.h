@@ -4,7 +4,12 @@
  *
  * Services: switch state global (04h) and selective (40h-43h -> 44h),
  * configure node-ID (11h) and bit timing (13h), activate bit timing (15h),
- * store configuration (17h), inquire vendor / product / revision / serial /
+ * store configuration (17h: the configured bit rate becomes the product's
+ * stored one), activate bit timing (15h: after the switch delay the board
+ * runs at the configured rate, co_port_can_bitrate(), until a reset node
+ * applies the stored one; the second delay, in which CiA 305 keeps the
+ * slave from sending, is not enforced: a slave in configuration state has
+ * only its heartbeat to send), inquire vendor / product / revision / serial /
  * node-ID (5Ah-5Eh), identify remote slave (46h-4Bh -> 4Fh), identify
  * non-configured slave (4Ch -> 50h) and Fastscan (51h -> 4Fh).
  *
@@ -31,6 +36,8 @@ typedef struct co_lss {
     uint8_t identify;    /* identify-remote-slave progress */
     uint8_t fs_sub;      /* Fastscan: which LSS address part is checked next */
     bool fs_active;      /* Fastscan: confirmed so far */
+    bool switching;      /* activate bit timing: the switch is due at switch_at */
+    uint32_t switch_at;  /* (us) */
 } co_lss_t;
 
 void co_lss_init(co_node_t *node);

@@ -101,6 +101,7 @@ typedef struct co_node_cfg {
     bool save_includes_lss;     /* 0x1010 "save" stores the node-ID / bit-rate set too */
     bool lss;                   /* LSS slave (CiA 305): list co_lss_service too */
     uint16_t lss_bitrates;      /* CiA 305 bit-timing indices supported (bit n = index n) */
+    const uint16_t *kbps;       /* kbit/s of each bit-rate code (16 codes; 0: unused), or NULL */
 } co_node_cfg_t;
 
 struct co_node {
@@ -116,6 +117,8 @@ struct co_node {
     bool due_never;             /* the last full poll found no deadline at all */
     bool od_checking;           /* write hooks only validate (co_od_validate) */
     co_nmt_t nmt;
+    uint16_t can_kbps;          /* bit rate the board was last asked for (co_port_can_bitrate);
+                                 * here, in what was padding before cfg */
     const co_node_cfg_t *cfg;
     void *port;                 /* board context for co_port_* */
     void *app;                  /* product context for its hooks */

@@ -20,6 +20,16 @@
 bool co_port_can_send(void *port, const co_frame_t *frame);
 
 /*
+ * Bring the CAN controller to kbps kbit/s. Called at start and whenever
+ * the node's active bit rate changes: a reset that activates another
+ * bit-rate code, and LSS "activate bit timing" (CiA 305) after its switch
+ * delay. kbps 0: the active code names no bit rate (an unusable stored
+ * code; the board picks its default). Returns false when the board cannot
+ * run at that rate (it keeps the one it has; the stack goes on).
+ */
+bool co_port_can_bitrate(void *port, uint16_t kbps);
+
+/*
  * EEPROM emulation: byte-addressed non-volatile memory of co_port_nvm_size()
  * bytes. A read of never-written memory returns 0xFF. Reads and writes are
  * synchronous; a write returns only when the bytes are durable.

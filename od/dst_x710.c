@@ -92,6 +92,7 @@ const co_node_cfg_t dst_x710_cfg = {
     .ram_size = {0, sizeof(dst_vol_t), sizeof(dst_para_t), sizeof(co_lss_para_t)},
     .default_node_id = 0x7F,
     .default_bitrate = 3, /* 250 kbit/s */
+    .kbps = product_kbps_cia,
     .tpdo_dlc = 8,        /* the manual's frames are always 8 bytes (C-4) */
     .inhibit_unit_us = 1000, /* "unit 1 ms" as printed (C-19) */
     .store_write_limit = DST_WRITE_LIMIT,

@@ -93,6 +93,7 @@ const co_node_cfg_t dst_x730_cfg = {
     .ram_size = {0, sizeof(dst_vol_t), sizeof(dst_para_t), sizeof(co_lss_para_t)},
     .default_node_id = 0x7F,
     .default_bitrate = 3, /* 250 kbit/s */
+    .kbps = product_kbps_cia,
     .tpdo_dlc = 8,        /* the manual's frames are always 8 bytes (C-4) */
     .store_write_limit = DST_WRITE_LIMIT,
 };

@@ -81,7 +81,7 @@ _Static_assert(sizeof(gsh_dev_t) <= PRODUCT_INST_MAX, "instance must fit PRODUCT
      .ram_size = {0, 0, sizeof(gsh_para_t), sizeof(co_lss_para_t)},                    \
      .default_node_id = (id), .default_bitrate = 3, .tpdo_dlc = 8,                     \
      .store_write_limit = 100000u /* L308 */, .save_includes_lss = true /* C-21 */,    \
-     .comm_reset_applies_id = true /* C-24 */}
+     .comm_reset_applies_id = true /* C-24 */, .kbps = product_kbps_cia}
 const co_node_cfg_t gsh_ch1_cfg = GSH_CFG(&ch1_od, 0x13);
 const co_node_cfg_t gsh_ch2_cfg = GSH_CFG(&ch2_od, 0x14);
 
@@ -89,7 +89,7 @@ const co_node_cfg_t gsh_ch2_cfg = GSH_CFG(&ch2_od, 0x14);
     {{"length", PRODUCT_TEXT("mm"), 0, 100000},                                          \
      {"angle", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT},                                            \
      {"field", PRODUCT_TEXT("%"), 100000, 1000}}
-#define GSH_FAULTS {PRODUCT_TEXT("extension-element"), PRODUCT_TEXT("tilt-element"), NULL, NULL}
+#define GSH_FAULTS {PRODUCT_FAULT("extension-element"), PRODUCT_FAULT("tilt-element"), NULL, NULL}
 #define GSH_BITRATES                                                                     \
     (PRODUCT_BR_20K | PRODUCT_BR_50K | PRODUCT_BR_125K | PRODUCT_BR_250K | PRODUCT_BR_500K | \
      PRODUCT_BR_800K | PRODUCT_BR_1000K)

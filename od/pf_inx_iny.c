@@ -92,7 +92,8 @@ static const co_service_t *const pf_services[] = {&co_guard_service, &co_rtr_ser
      .sdo_segmented = co_sdo_segmented, .sdo_block = co_sdo_block,                   \
      .ram_size = {0, 0, sizeof(pf_para_t), sizeof(co_lss_para_t)},                   \
      .default_node_id = 1, .default_bitrate = PF_BR_250K, .tpdo_dlc = 0,             \
-     .autosave = true /* G2 */, .load_keeps_lss = true /* G2, R51 */}
+     .autosave = true /* G2 */, .load_keeps_lss = true /* G2, R51 */, \
+     .kbps = product_kbps_pf}
 const co_node_cfg_t pf_inx_cfg = PF_CFG(&inx_od);
 const co_node_cfg_t pf_iny_cfg = PF_CFG(&iny_od);
 
@@ -104,14 +105,14 @@ static const pf_variant_t v_iny = {.cfg = &pf_iny_cfg, .axes = 2};
 const product_t pf_inx360d = {
     .id = PRODUCT_TEXT("inx360d"), .summary = PRODUCT_TEXT("Pepperl+Fuchs INX360D single axis 0..359.9 deg (CiA 410)"),
     .inputs = {{"x", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}},
-    .faults = {PRODUCT_TEXT("range-x"), PRODUCT_TEXT(PRODUCT_TEXT("range-y")), PRODUCT_TEXT("undervoltage"), NULL},
+    .faults = {PRODUCT_FAULT("range-x"), PRODUCT_FAULT("range-y"), PRODUCT_FAULT("undervoltage"), NULL},
     .nodes = 1, .inst_size = sizeof(pf_dev_t), .create = pf_create, .sample = pf_sample,
     .variant = &v_inx, .cfg = &pf_inx_cfg, .vendor = PRODUCT_TEXT("Pepperl+Fuchs"), .bitrates = PF_EDS_BITRATES,
     .kbps = product_kbps_pf};
 const product_t pf_iny360d = {
     .id = PRODUCT_TEXT("iny360d"), .summary = PRODUCT_TEXT("Pepperl+Fuchs INY360D dual axis 0..359.9 deg (CiA 410)"),
     .inputs = {{"x", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}, {"y", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}},
-    .faults = {PRODUCT_TEXT("range-x"), PRODUCT_TEXT(PRODUCT_TEXT("range-y")), PRODUCT_TEXT("undervoltage"), NULL},
+    .faults = {PRODUCT_FAULT("range-x"), PRODUCT_FAULT("range-y"), PRODUCT_FAULT("undervoltage"), NULL},
     .nodes = 1, .inst_size = sizeof(pf_dev_t), .create = pf_create, .sample = pf_sample,
     .variant = &v_iny, .cfg = &pf_iny_cfg, .vendor = PRODUCT_TEXT("Pepperl+Fuchs"), .bitrates = PF_EDS_BITRATES,
     .kbps = product_kbps_pf};

@@ -23,11 +23,21 @@ typedef struct product product_t;
 
 /* Texts for people (ID, summary, vendor, units, fault names): an MCU image
  * prints none of them and leaves them out (CO_OD_NO_NAMES, as the
- * dictionary's names); input names stay, they end the input list. */
+ * dictionary's names). Input names stay: they end the input list. */
 #ifdef CO_OD_NO_NAMES
 #define PRODUCT_TEXT(s) NULL
 #else
 #define PRODUCT_TEXT(s) (s)
+#endif
+
+/* Names of simulated faults: kept wherever a board takes the simulated-input
+ * language by name (the Linux program, the emulated boards' serial line:
+ * boards/common/serial_link.h); an image for real hardware has no simulated
+ * faults and leaves them out (CO_NO_SIM_INPUT, boards/CMakeLists.txt). */
+#ifdef CO_NO_SIM_INPUT
+#define PRODUCT_FAULT(s) NULL
+#else
+#define PRODUCT_FAULT(s) (s)
 #endif
 
 /* Largest magnitude of a simulated angle input (deg): ten turns each way.

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "co_node.h"
+#include "co_port.h"
 
 enum {
     CS_SWITCH_GLOBAL = 0x04,
@@ -29,6 +30,9 @@ enum {
 
 #define LSS_WAITING 0u
 #define LSS_CONFIG 1u
+
+/* kbit/s of each CiA 305 bit-timing index (5: reserved; 9: auto, none). */
+static const uint16_t lss_kbps[16] = {1000, 800, 500, 250, 125, 0, 50, 20, 10};
 
 void co_lss_init(co_node_t *node)
 {
@@ -230,8 +234,12 @@ bool co_lss_receive(co_node_t *node, const co_frame_t *f)
         break;
     }
     case CS_ACTIVATE_BIT_TIMING:
-        /* A board with a real controller switches after the delay; vcan has
-         * no bit rate, so the configured one is only stored. */
+        /* The switch delay (ms) in bytes 1-2; no bit timing configured:
+         * nothing to activate (no answer either way: CiA 305). */
+        if (l->pending_br != 0xFFu) {
+            l->switching = true;
+            l->switch_at = node->now + 1000u * co_get_u16(&d[1]);
+        }
         break;
     case CS_STORE:
         store(node);
@@ -248,5 +256,21 @@ bool co_lss_receive(co_node_t *node, const co_frame_t *f)
     return true;
 }
 
-const co_service_t co_lss_service = {.receive = co_lss_receive, .reset = co_lss_init,
-                                     .always = true};
+/* Activate bit timing: switch when the delay is over. */
+static uint32_t co_lss_poll(co_node_t *node, uint32_t now)
+{
+    co_lss_t *l = &node->lss;
+    if (!l->switching) {
+        return CO_NEVER;
+    }
+    if (co_time_before(now, l->switch_at)) {
+        return co_time_until(now, l->switch_at);
+    }
+    l->switching = false;
+    node->can_kbps = lss_kbps[l->pending_br & 15u];
+    (void)co_port_can_bitrate(node->port, node->can_kbps);
+    return CO_NEVER;
+}
+
+const co_service_t co_lss_service = {.receive = co_lss_receive, .poll = co_lss_poll,
+                                     .reset = co_lss_init, .always = true};

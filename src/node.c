@@ -91,6 +91,16 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
             (*sv)->reset(node);
         }
     }
+    /* The active bit-rate code reaches the controller: at start, and after
+     * a reset that activated another one (an unusable code: 0 kbit/s, the
+     * board's default; a config without a table: 0 too). Codes are 0..15
+     * (co_node_cfg_t.kbps): stored ones are range-checked on restore. */
+    const uint16_t *table = co_cfg(node)->kbps;
+    uint16_t kbps = table != NULL ? table[node->bitrate & 15u] : 0u; /* 16 codes */
+    if (kbps != node->can_kbps) {
+        node->can_kbps = kbps;
+        (void)co_port_can_bitrate(node->port, kbps);
+    }
     if (node->node_id == CO_LSS_UNCONFIGURED) {
         return; /* no node-ID: silent but for LSS until one is configured */
     }
@@ -109,6 +119,7 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
 void co_node_start(co_node_t *node, uint32_t now)
 {
     node->now = now;
+    node->can_kbps = 0xFFFFu; /* none yet: the reset tells the board */
     co_store_init(node);
     co_node_reset(node, CO_RESET_NODE);
 }

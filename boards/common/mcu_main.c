@@ -22,6 +22,17 @@
 
 extern const product_t PRODUCT_SYM;
 
+/* The stack's bit-rate requests (at start, after a reset that activated
+ * another code, LSS activate bit timing) go to the board; an unusable code
+ * (0 kbit/s) gets the common default, 250 kbit/s, so that the node is on
+ * the bus somewhere. A rate the controller refuses leaves it where it was
+ * (the boards here take every bit rate the products name). */
+bool co_port_can_bitrate(void *port, uint16_t kbps)
+{
+    (void)port;
+    return board_can_bitrate(kbps != 0u ? kbps : 250u);
+}
+
 /* The LEDs; not inlined, so that its locals are not part of main's frame,
  * on which every other call of the loop stacks. Returns the delay until
  * either LED changes. */
@@ -65,10 +76,7 @@ int main(void)
     p->sample(mem, values, faults);
     uint32_t now = board_now_us();
     for (unsigned i = 0; i < p->nodes; i++) {
-        co_node_start(nodes[i], now);
-    }
-    if (!board_can_bitrate(product_kbps(p, nodes[0]->bitrate))) {
-        (void)board_can_bitrate(250); /* an unusable stored code: the common default */
+        co_node_start(nodes[i], now); /* brings the controller to its bit rate */
     }
     uint32_t next_sample = now + CO_FILTER_PERIOD_US;
     for (;;) {

@@ -153,7 +153,7 @@ static void apply_can_command(app_t *a, uint32_t now)
     }
     a->sim.can_request = false;
     for (unsigned i = 0; i < a->nnodes; i++) {
-        uint32_t kbps = product_kbps(a->prod, a->nodes[i]->bitrate);
+        uint32_t kbps = a->ports[i].kbps;
         if (kbps == 0u) {
             kbps = 125u; /* a code the product does not define: the usual default */
         }

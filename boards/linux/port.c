@@ -346,6 +346,20 @@ unsigned lp_flush(lp_port_t *p)
     return p->txn;
 }
 
+/* vcan has no bit rate: the rate is kept (bus-off recovery time) and a
+ * change after the start (reset node with a new code, LSS activate bit
+ * timing) is logged. */
+bool co_port_can_bitrate(void *port, uint16_t kbps)
+{
+    lp_port_t *p = port;
+    if (p->kbps_set && kbps != p->kbps) {
+        lp_log("node %u: bit rate now %u kbit/s (vcan has no bit rate to set)", p->node, kbps);
+    }
+    p->kbps = kbps;
+    p->kbps_set = true;
+    return true;
+}
+
 bool co_port_can_send(void *port, const co_frame_t *frame)
 {
     lp_port_t *p = port;

@@ -63,6 +63,8 @@ typedef struct lp_port {
     int fd;               /* CAN_RAW socket, non-blocking; kept across link changes */
     const char *iface;
     unsigned node;        /* index, for log lines */
+    uint16_t kbps;        /* the node's bit rate (co_port_can_bitrate; vcan has none) */
+    bool kbps_set;        /* kbps was given (at the node's start) */
     lp_nvm_t *nvm;
     co_frame_t txq[LP_TXQ]; /* frames the kernel could not take yet */
     unsigned txh, txn;

@@ -2,21 +2,27 @@
  * board.c - a RISC-V (rv32imac) port for QEMU's "virt" machine, the second
  * architecture the stack builds for. The machine has no CAN controller, so
  * frames travel as SLCAN text lines ("t1FF8...", Lawicel's serial-line CAN
- * protocol) on the 16550 UART; time comes from the CLINT's mtime (10 MHz);
- * the "EEPROM" is RAM (lost at reset: QEMU's virt flash is not used); the
- * sensor is the same fixed test pattern as the Cortex-M0 board's.
- * The receive line buffer and the EEPROM array are the board's state.
+ * protocol) on the 16550 UART, and the simulated sensor's input lines
+ * ("set x=10", "fault sensor on") on the same line (serial_link.h); time
+ * comes from the CLINT's mtime (10 MHz); the "EEPROM" is RAM (lost at
+ * reset: QEMU's virt flash is not used).
+ * The serial line's state and the EEPROM array are the board's state.
  */
 #include "board.h"
 
 #include "co_port.h"
 #include "co_store.h"
+#include "serial_link.h"
 
 #define UART 0x10000000u
 #define UART_THR (*(volatile uint8_t *)(UART + 0u))
 #define UART_RBR (*(volatile uint8_t *)(UART + 0u))
 #define UART_LSR (*(volatile uint8_t *)(UART + 5u))
 #define MTIME_LO (*(volatile uint32_t *)0x0200BFF8u)
+
+/* The serial line: SLCAN frames and simulated-input lines (serial_link.h). */
+static serial_link_t link;
+static void put(char c);
 
 int main(void);
 void reset_c(void) __attribute__((used)); /* called from the assembly above: LTO must keep it */
@@ -47,9 +53,10 @@ bool board_init(void)
     return true;
 }
 
+/* Told on the line the way an SLCAN adapter is ("S6": 500 kbit/s). */
 bool board_can_bitrate(uint16_t kbps)
 {
-    return kbps != 0u; /* a serial line has no CAN bit rate to set */
+    return serial_link_bitrate(&link, kbps, put);
 }
 
 uint32_t board_now_us(void)
@@ -71,68 +78,18 @@ static void put(char c)
     UART_THR = (uint8_t)c;
 }
 
-static char hex_digit(unsigned v)
-{
-    return "0123456789ABCDEF"[v & 15u];
-}
-
 bool co_port_can_send(void *port, const co_frame_t *f)
 {
     (void)port;
-    put(f->rtr ? 'r' : 't');
-    put(hex_digit(f->id >> 8));
-    put(hex_digit(f->id >> 4));
-    put(hex_digit(f->id));
-    put(hex_digit(f->dlc));
-    for (unsigned i = 0; i < f->dlc && !f->rtr; i++) {
-        put(hex_digit(f->data[i] >> 4u));
-        put(hex_digit(f->data[i]));
-    }
-    put('\r');
+    serial_link_tx(f, put);
     return true;
-}
-
-static char line[32];
-static unsigned line_len;
-
-static int hex_value(char c)
-{
-    return c >= '0' && c <= '9' ? c - '0' : (c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1);
-}
-
-static unsigned hex_at(unsigned at, unsigned n, bool *ok)
-{
-    unsigned v = 0;
-    for (unsigned i = 0; i < n; i++) {
-        int h = hex_value(line[at + i]);
-        *ok = *ok && h >= 0;
-        v = v * 16u + (unsigned)(h < 0 ? 0 : h);
-    }
-    return v;
 }
 
 bool board_can_receive(co_frame_t *f)
 {
     while ((UART_LSR & 1u) != 0u) {
-        char c = (char)UART_RBR;
-        if (c != '\r' && c != '\n') {
-            if (line_len < sizeof(line)) {
-                line[line_len++] = c;
-            }
-            continue;
-        }
-        unsigned n = line_len;
-        line_len = 0;
-        bool ok = n >= 5u && (line[0] == 't' || line[0] == 'r');
-        f->rtr = line[0] == 'r';
-        f->id = (uint16_t)hex_at(1, 3, &ok);
-        f->dlc = (uint8_t)hex_at(4, 1, &ok);
-        ok = ok && f->dlc <= 8u && (f->rtr || n == 5u + 2u * f->dlc);
-        for (unsigned i = 0; ok && !f->rtr && i < f->dlc; i++) {
-            f->data[i] = (uint8_t)hex_at(5u + 2u * i, 2, &ok);
-        }
-        if (ok) {
-            return true; /* malformed lines are dropped */
+        if (serial_link_rx(&link, (char)UART_RBR, f, put)) {
+            return true;
         }
     }
     return false;
@@ -140,7 +97,7 @@ bool board_can_receive(co_frame_t *f)
 
 uint8_t board_can_state(void)
 {
-    return CO_CAN_ACTIVE;
+    return (uint8_t)serial_link_can_state(&link, board_now_us());
 }
 
 void board_leds(bool green, bool red)
@@ -149,14 +106,17 @@ void board_leds(bool green, bool red)
     (void)red; /* no LEDs on the virt machine */
 }
 
+/* The true inputs as the serial line set them (the product's initial
+ * values until a `set` line). */
 void board_sensor(const product_t *p, int32_t values[], uint32_t *faults)
 {
-    uint32_t t = (board_now_us() / 1000u) % 20000u;
-    int32_t tri = (int32_t)(t < 10000u ? t : 20000u - t) - 5000;
-    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && p->inputs[i].name != 0; i++) {
-        values[i] = p->inputs[i].initial + tri * p->inputs[i].limit / 50;
+    if (link.prod != p) {
+        serial_link_init(&link, p);
     }
-    *faults = 0;
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
+        values[i] = link.values[i];
+    }
+    *faults = link.faults;
 }
 
 static uint8_t eeprom[2u * CO_STORE_NVM_SIZE];

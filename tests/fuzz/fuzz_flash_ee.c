@@ -164,6 +164,14 @@ static const product_t *g_prod;
 static dev_t g_dev, g_scratch, g_snap;
 static int g_port[PRODUCT_MAX_NODES]; /* each node's port: its number */
 
+/* No controller here: every bit rate is taken. */
+bool co_port_can_bitrate(void *port, uint16_t kbps)
+{
+    (void)port;
+    (void)kbps;
+    return true;
+}
+
 bool co_port_can_send(void *port, const co_frame_t *frame)
 {
     if (port == &g_port[0] && frame->id == 0x580u + g_dev.nodes[0]->node_id) {

@@ -36,6 +36,12 @@ def test_lss_configure_store_and_activate(sensor_factory, network, bus):
         lss.configure_bit_timing(8)  # 10 kbit/s: not supported
     lss.store_configuration()
     lss.activate_bit_timing(10)
+    # The port is told after the 10 ms switch delay (vcan has no bit rate:
+    # the program logs it).
+    deadline = time.monotonic() + 2
+    while "node 0: bit rate now 500 kbit/s" not in sensor.log_text():
+        assert time.monotonic() < deadline, "activate bit timing did not reach the port"
+        time.sleep(0.02)
     lss.send_switch_state_global(lss.WAITING_STATE)
     del network[NODE]
     bus.clear()

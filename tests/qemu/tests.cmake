@@ -4,4 +4,5 @@
 # build them) and by tests/CMakeLists.txt (to run them under qemu-system-arm).
 set(CO_BARE_TESTS test_dst_manual test_pf_manual test_gsh_manual test_jd_manual
   test_stack test_store test_profile test_hardening test_flash_ee test_div
-  test_sdo_edge test_store_faults test_node_services test_jd_edge test_products_edge)
+  test_sdo_edge test_store_faults test_node_services test_jd_edge test_products_edge
+  test_serial_link)

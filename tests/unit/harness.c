@@ -18,6 +18,14 @@ void fake_port_init(fake_port_t *p)
     p->reads_left = -1;
 }
 
+bool co_port_can_bitrate(void *port, uint16_t kbps)
+{
+    fake_port_t *p = port;
+    p->kbps = kbps;
+    p->bitrate_calls++;
+    return kbps != 0u;
+}
+
 bool co_port_can_send(void *port, const co_frame_t *frame)
 {
     fake_port_t *p = port;
@@ -87,6 +95,14 @@ static void create(h_dev_t *d)
 {
     void *ports[PRODUCT_MAX_NODES] = {&d->port, &d->port};
     d->prod->create(d->prod, d->mem, ports, d->nodes);
+#ifdef CO_FIXED_CFG
+    for (unsigned i = 0; i < d->prod->nodes; i++) {
+        if (d->nodes[i]->cfg != &CO_FIXED_CFG) {
+            h_foreign_boot(d->prod->id); /* nothing of it runs: back to h_run */
+        }
+    }
+    h_own_boot();
+#endif
     d->nnodes = d->prod->nodes;
     d->node = d->nodes[0];
     /* One sample before start, as a board reads its sensor before booting. */

@@ -288,18 +288,36 @@ static void test_main_loop_nmt_start(void)
     CHECK_EQ(sent_on(0x1FF, 0, start), sent_on(0x1FF, 100000u, start));
 }
 
-/* A controller that refuses the product's bit rate is given the common
- * default (250 kbit/s); the node runs all the same. */
+/* The node brings the controller to the product's bit rate at start (the
+ * DST's default code 3: 250 kbit/s), once. A controller that refuses it
+ * stays where it was; the node runs all the same. */
 static void test_main_loop_bitrate_refused(void)
 {
+    board_reset(true, true, 100000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_any();
+    }
+    CHECK_EQ(bd.nkbps, 1);
+    CHECK_EQ(bd.kbps[0], 250);
     board_reset(true, false, 100000u);
     memset(nvm, 0xFF, sizeof(nvm));
     if (setjmp(bd.out) == 0) {
         (void)mcu_main_any();
     }
-    CHECK_EQ(bd.nkbps, 2);
-    CHECK_EQ(bd.kbps[1], 250);
+    CHECK_EQ(bd.nkbps, 1);
     CHECK(bd.ntx >= 1u && bd.tx[0].id == 0x77F);
+}
+
+/* The port function: an unusable code (0 kbit/s) gets the common default. */
+static void test_port_bitrate_default(void)
+{
+    board_reset(true, true, 0);
+    CHECK(co_port_can_bitrate(NULL, 500));
+    CHECK(co_port_can_bitrate(NULL, 0));
+    CHECK_EQ(bd.nkbps, 2);
+    CHECK_EQ(bd.kbps[0], 500);
+    CHECK_EQ(bd.kbps[1], 250);
 }
 
 /* A board that fails to start, or an image built with another product's
@@ -333,6 +351,7 @@ int main(void)
     RUN(test_main_loop_runs_the_product);
     RUN(test_main_loop_nmt_start);
     RUN(test_main_loop_bitrate_refused);
+    RUN(test_port_bitrate_default);
     RUN(test_main_loop_refuses_to_run);
     return h_finish();
 }

@@ -173,6 +173,35 @@ static void test_leds(void)
     CHECK(g == CO_LED_OFF && r == CO_LED_BLINK);
 }
 
+/* LSS "activate bit timing" (CiA 305): the configured rate reaches the
+ * board after the switch delay, not before; no configured rate, nothing;
+ * a reset node then applies the stored code again. */
+static void test_lss_activate_bit_timing(void)
+{
+    boot(&jd2xxx);
+    CHECK_EQ(d->port.kbps, 125);
+    unsigned calls = d->port.bitrate_calls;
+    h_rx(d, 0x7E5, "04 01 00 00 00 00 00 00");
+    h_rx(d, 0x7E5, "15 0A 00 00 00 00 00 00"); /* nothing configured yet */
+    h_advance(d, 20000);
+    CHECK_EQ(d->port.bitrate_calls, calls);
+    h_rx(d, 0x7E5, "13 00 02 00 00 00 00 00"); /* index 2: 500 kbit/s */
+    EXPECT(d, 0x7E4, "13 00 00 00 00 00 00 00");
+    h_rx(d, 0x7E5, "15 E8 03 00 00 00 00 00"); /* after 1000 ms */
+    h_advance(d, 999000);
+    CHECK_EQ(d->port.kbps, 125);
+    CHECK_EQ(d->port.bitrate_calls, calls);
+    h_advance(d, 2000);
+    CHECK_EQ(d->port.kbps, 500);
+    CHECK_EQ(d->port.bitrate_calls, calls + 1u);
+    h_rx(d, 0x7E5, "04 00 00 00 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x000, "81 0A"); /* not stored: reset node goes back to 125 k */
+    EXPECT(d, 0x70A, "00");
+    CHECK_EQ(d->port.kbps, 125);
+    CHECK_EQ(d->port.bitrate_calls, calls + 2u);
+}
+
 /* LSS "store" writes 3000h/3001h (R47): an unconfigured node-ID (0xFF)
  * and no bit timing leave them as they are; an EEPROM that refuses the
  * write answers error 2. */
@@ -206,6 +235,7 @@ static void test_lss_store_edges(void)
 
 int main(void)
 {
+    RUN(test_lss_activate_bit_timing);
     RUN(test_jd1_preset_and_wrap);
     RUN(test_jd2_lateral_preset_inverted);
     RUN(test_jd2_slope_limits);

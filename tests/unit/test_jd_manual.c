@@ -115,13 +115,16 @@ static void test_c_node_number_example(void)
 static void test_d_bitrate_save_with_reset(void)
 {
     boot(&jd2xxx);
+    CHECK_EQ(d->port.kbps, 125); /* the default code 3 reached the board */
     SDO(d, "22 01 30 00 05 00 00 00", "60 01 30 00 00 00 00 00"); /* D1 */
     h_drain(d);
+    CHECK_EQ(d->port.kbps, 125); /* a new code waits for the reset */
     /* D2 with the code of L1113 (C9); confirmation first, then the reset. */
     h_rx(d, 0x60A, "22 00 23 00 55 AA AA 55");
     EXPECT(d, 0x58A, "60 00 23 00 00 00 00 00"); /* D-D2 */
     h_advance(d, 1);
     EXPECT(d, 0x70A, "00"); /* D-D3: boot-up (at 500 kbit/s) */
+    CHECK_EQ(d->port.kbps, 500); /* the board was told before the boot-up */
     SDO(d, "40 01 30 00 00 00 00 00", "4F 01 30 00 05 00 00 00");
     SDO(d, "22 00 23 00 55 AA AA 56", "80 00 23 00 20 00 00 08");
     SDO(d, "40 00 23 00 00 00 00 00", "80 00 23 00 01 00 01 06");

@@ -92,7 +92,10 @@ static void test_incl_arithmetic(void)
     p.diff[0] = -32768;
     p.offset[0] = -32768;
     CHECK_EQ(co_incl_slope(&in, 0), -32768);
-    CHECK_EQ(co_incl_slope(&in, 5), 0); /* no such axis */
+    /* No such axis. Through a volatile: with a constant 5, gcc's array-bounds
+     * check sees the out[] access the axes test keeps it from reaching. */
+    volatile unsigned no_axis = 5;
+    CHECK_EQ(co_incl_slope(&in, no_axis), 0);
     /* Same resolution: offsets kept. New one: cleared. */
     p.diff[0] = 7;
     CHECK_EQ(co_incl_set_resolution(&in, 50), CO_OK);

@@ -1,0 +1,365 @@
+/*
+ * serial_link.c - see serial_link.h.
+ */
+#include "serial_link.h"
+
+/* Longest bus-off hold a `can bus-off SECONDS` line may ask for. */
+#define HOLD_MAX_S 60u
+/* Bus-off recovery: 128 occurrences of 11 recessive bits (CiA 301 / ISO 11898). */
+#define RECOVERY_BITS (128u * 11u)
+
+void serial_link_init(serial_link_t *s, const product_t *p)
+{
+    *s = (serial_link_t){.prod = p, .can_state = CO_CAN_ACTIVE, .kbps = 250};
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && p->inputs[i].name != NULL; i++) {
+        s->values[i] = p->inputs[i].initial;
+    }
+}
+
+/* ---- output --------------------------------------------------------------- */
+
+static void put_str(serial_put_fn put, const char *t)
+{
+    while (*t != '\0') {
+        put(*t++);
+    }
+}
+
+static void put_uint(serial_put_fn put, uint32_t v)
+{
+    char d[10];
+    unsigned n = 0;
+    do {
+        d[n++] = (char)('0' + v % 10u);
+        v /= 10u;
+    } while (v != 0u);
+    while (n > 0u) {
+        put(d[--n]);
+    }
+}
+
+static char hex_digit(unsigned v)
+{
+    return "0123456789ABCDEF"[v & 15u];
+}
+
+void serial_link_tx(const co_frame_t *f, serial_put_fn put)
+{
+    put(f->rtr ? 'r' : 't');
+    put(hex_digit((unsigned)f->id >> 8));
+    put(hex_digit((unsigned)f->id >> 4));
+    put(hex_digit(f->id));
+    put(hex_digit(f->dlc));
+    for (unsigned i = 0; i < f->dlc && !f->rtr; i++) {
+        put(hex_digit((unsigned)f->data[i] >> 4));
+        put(hex_digit(f->data[i]));
+    }
+    put('\r');
+}
+
+bool serial_link_bitrate(serial_link_t *s, uint16_t kbps, serial_put_fn put)
+{
+    static const uint16_t rates[] = {10, 20, 50, 100, 125, 250, 500, 800, 1000};
+    for (unsigned i = 0; i < sizeof(rates) / sizeof(rates[0]); i++) {
+        if (rates[i] == kbps) {
+            s->kbps = kbps;
+            put('S');
+            put((char)('0' + i));
+            put('\r');
+            return true;
+        }
+    }
+    return false;
+}
+
+co_can_state_t serial_link_can_state(serial_link_t *s, uint32_t now)
+{
+    if (s->busoff_pending) {
+        s->busoff_pending = false;
+        uint32_t recovery_us = (RECOVERY_BITS * 1000u + s->kbps - 1u) / s->kbps;
+        s->busoff_end = now + s->busoff_hold_ms * 1000u + recovery_us;
+    }
+    if (s->can_state == CO_CAN_BUSOFF && !co_time_before(now, s->busoff_end)) {
+        s->can_state = CO_CAN_ACTIVE;
+    }
+    return (co_can_state_t)s->can_state;
+}
+
+/* ---- input lines -------------------------------------------------------------- */
+
+static int hex_value(char c)
+{
+    if (c >= '0' && c <= '9') {
+        return c - '0';
+    }
+    if (c >= 'A' && c <= 'F') {
+        return c - 'A' + 10;
+    }
+    return c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1;
+}
+
+/* Tokens: the line split at spaces, in place. */
+typedef struct tokens {
+    char *at;
+} tokens_t;
+
+static char *next_token(tokens_t *t)
+{
+    while (*t->at == ' ' || *t->at == '\t') {
+        t->at++;
+    }
+    if (*t->at == '\0') {
+        return NULL;
+    }
+    char *start = t->at;
+    while (*t->at != '\0' && *t->at != ' ' && *t->at != '\t') {
+        t->at++;
+    }
+    if (*t->at != '\0') {
+        *t->at++ = '\0';
+    }
+    return start;
+}
+
+static bool equal(const char *a, const char *b)
+{
+    while (*a != '\0' && *a == *b) {
+        a++;
+        b++;
+    }
+    return *a == *b;
+}
+
+/*
+ * A decimal number of at most 3 decimals ("-12.5", "30", "0.125") within
+ * +-limit, in thousandths. False for anything else (more decimals too: a
+ * value the input cannot hold is refused, not rounded).
+ */
+static bool parse_milli(const char *t, int32_t limit, int32_t *out)
+{
+    bool neg = *t == '-';
+    t += (*t == '-' || *t == '+') ? 1 : 0;
+    uint32_t v = 0;
+    unsigned digits = 0;
+    while (*t >= '0' && *t <= '9') {
+        if (v > (uint32_t)limit) {
+            return false; /* already too large; stops before v x 10 overflows */
+        }
+        v = v * 10u + (uint32_t)(*t++ - '0');
+        digits++;
+    }
+    uint32_t frac = 0;
+    unsigned decimals = 0;
+    if (*t == '.') {
+        t++;
+        while (*t >= '0' && *t <= '9' && decimals < 3u) {
+            frac = frac * 10u + (uint32_t)(*t++ - '0');
+            decimals++;
+        }
+    }
+    if (*t != '\0' || digits + decimals == 0u || v > (uint32_t)limit) {
+        return false;
+    }
+    for (; decimals < 3u; decimals++) {
+        frac *= 10u;
+    }
+    uint32_t milli = v * 1000u + frac; /* limit < 2^31 / 1000: fits */
+    if (milli > (uint32_t)limit * 1000u) {
+        return false;
+    }
+    *out = neg ? -(int32_t)milli : (int32_t)milli;
+    return true;
+}
+
+/* The answer to a rejected line: "error: " and the cause's parts. */
+static bool fail(serial_put_fn put, const char *a, const char *b, const char *c)
+{
+    put_str(put, "error: ");
+    put_str(put, a);
+    put_str(put, b);
+    put_str(put, c);
+    put('\r');
+    return false;
+}
+
+static bool cmd_set(serial_link_t *s, tokens_t *t, serial_put_fn put)
+{
+    int32_t v[PRODUCT_MAX_INPUTS];
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
+        v[i] = s->values[i];
+    }
+    unsigned count = 0;
+    char *tok;
+    while ((tok = next_token(t)) != NULL) {
+        char *eq = tok;
+        while (*eq != '\0' && *eq != '=') {
+            eq++;
+        }
+        int in = -1;
+        if (*eq == '=') {
+            *eq = '\0';
+            for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && s->prod->inputs[i].name != NULL; i++) {
+                if (equal(tok, s->prod->inputs[i].name)) {
+                    in = (int)i;
+                }
+            }
+        }
+        if (in < 0) {
+            return fail(put, "'", tok, "': not an input of this product (NAME=VALUE)");
+        }
+        int32_t limit = s->prod->inputs[in].limit;
+        if (!parse_milli(eq + 1, limit, &v[in])) {
+            put_str(put, "error: '");
+            put_str(put, eq + 1);
+            put_str(put, "': not a number within +-");
+            put_uint(put, (uint32_t)limit);
+            put_str(put, " (3 decimals at most)\r");
+            return false;
+        }
+        count++;
+    }
+    if (count == 0u) {
+        return fail(put, "usage: set NAME=VALUE [NAME=VALUE...]", "", "");
+    }
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
+        s->values[i] = v[i];
+    }
+    return true;
+}
+
+static bool cmd_fault(serial_link_t *s, tokens_t *t, serial_put_fn put)
+{
+    char *what = next_token(t);
+    char *onoff = next_token(t);
+    int k = -1;
+    for (unsigned i = 0; what != NULL && i < PRODUCT_MAX_INPUTS && s->prod->faults[i] != NULL; i++) {
+        if (equal(what, s->prod->faults[i])) {
+            k = (int)i;
+        }
+    }
+    if (s->prod->faults[0] == NULL) {
+        return fail(put, "this product has no simulated faults", "", "");
+    }
+    if (k < 0 || onoff == NULL || (!equal(onoff, "on") && !equal(onoff, "off")) ||
+        next_token(t) != NULL) {
+        put_str(put, "error: usage: fault ");
+        for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && s->prod->faults[i] != NULL; i++) {
+            put_str(put, i == 0u ? "" : "|");
+            put_str(put, s->prod->faults[i]);
+        }
+        put_str(put, " on|off\r");
+        return false;
+    }
+    if (equal(onoff, "on")) {
+        s->faults |= 1u << k;
+    } else {
+        s->faults &= ~(1u << k);
+    }
+    return true;
+}
+
+static bool cmd_can(serial_link_t *s, tokens_t *t, serial_put_fn put)
+{
+    static const struct {
+        const char *name;
+        uint8_t state;
+    } states[] = {{"active", CO_CAN_ACTIVE}, {"warning", CO_CAN_WARNING},
+                  {"passive", CO_CAN_PASSIVE}, {"bus-off", CO_CAN_BUSOFF}};
+    char *what = next_token(t);
+    char *arg = next_token(t);
+    int k = -1;
+    for (unsigned i = 0; what != NULL && i < sizeof(states) / sizeof(states[0]); i++) {
+        if (equal(what, states[i].name)) {
+            k = (int)i;
+        }
+    }
+    int32_t hold_ms = 0;
+    bool ok = k >= 0 && next_token(t) == NULL &&
+              (arg == NULL || (states[k].state == CO_CAN_BUSOFF &&
+                               parse_milli(arg, (int32_t)HOLD_MAX_S, &hold_ms) && hold_ms >= 0));
+    if (!ok) {
+        return fail(put, "usage: can bus-off [SECONDS, 0..60] | can passive|warning|active", "", "");
+    }
+    s->can_state = states[k].state;
+    s->busoff_pending = states[k].state == CO_CAN_BUSOFF;
+    s->busoff_hold_ms = (uint32_t)hold_ms;
+    return true;
+}
+
+/* One complete input line, NUL-terminated in s->line. */
+static void input_line(serial_link_t *s, serial_put_fn put)
+{
+    tokens_t t = {.at = s->line};
+    char *cmd = next_token(&t);
+    bool ok;
+    if (cmd == NULL) {
+        return; /* blank: nothing to answer */
+    } else if (equal(cmd, "set")) {
+        ok = cmd_set(s, &t, put);
+    } else if (equal(cmd, "fault")) {
+        ok = cmd_fault(s, &t, put);
+    } else if (equal(cmd, "can")) {
+        ok = cmd_can(s, &t, put);
+    } else {
+        ok = fail(put, "unknown command '", cmd, "' (set, fault, can)");
+    }
+    if (ok) {
+        put_str(put, "ok\r");
+    }
+}
+
+/* A frame line of n characters ("t" or "r", 3 hex digits of identifier,
+ * 1 of length, the data) into *f; false for anything else. */
+static bool frame_line(const serial_link_t *s, unsigned n, co_frame_t *f)
+{
+    if (n < 5u || (s->line[0] != 't' && s->line[0] != 'r')) {
+        return false;
+    }
+    unsigned v[21];
+    for (unsigned i = 1; i < n; i++) {
+        v[i] = (unsigned)hex_value(s->line[i]); /* hex checked by the caller */
+    }
+    f->rtr = s->line[0] == 'r';
+    f->id = (uint16_t)(v[1] << 8 | v[2] << 4 | v[3]);
+    f->dlc = (uint8_t)v[4];
+    if (f->dlc > 8u || n != (f->rtr ? 5u : 5u + 2u * f->dlc) || f->id > 0x7FFu) {
+        return false;
+    }
+    for (unsigned i = 0; i < f->dlc && !f->rtr; i++) {
+        f->data[i] = (uint8_t)(v[5u + 2u * i] << 4 | v[6u + 2u * i]);
+    }
+    return true;
+}
+
+bool serial_link_rx(serial_link_t *s, char c, co_frame_t *f, serial_put_fn put)
+{
+    if (c != '\r' && c != '\n') {
+        if (s->len < SERIAL_LINE_MAX) {
+            s->line[s->len++] = c;
+        } else {
+            s->overflow = true;
+        }
+        s->nul = s->nul || c == '\0';
+        return false;
+    }
+    unsigned n = s->len;
+    bool bad = s->overflow || s->nul;
+    const char *why = s->overflow ? "line too long" : "line holds a NUL byte";
+    s->len = 0;
+    s->overflow = false;
+    s->nul = false;
+    /* SLCAN: a command letter and hex digits only. */
+    bool slcan = n > 0u;
+    for (unsigned i = 1; i < n && slcan; i++) {
+        slcan = hex_value(s->line[i]) >= 0;
+    }
+    if (slcan) {
+        return !bad && n <= 21u && frame_line(s, n, f);
+    }
+    if (bad) {
+        return fail(put, why, "", "");
+    }
+    s->line[n] = '\0';
+    input_line(s, put);
+    return false;
+}

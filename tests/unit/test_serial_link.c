@@ -1,0 +1,244 @@
+/*
+ * test_serial_link.c - the emulated boards' serial line
+ * (boards/common/serial_link.c): SLCAN frames both ways, the simulated-input
+ * lines and their answers, and everything malformed in between.
+ */
+#include <stdbool.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "harness.h"
+#include "serial_link.h"
+
+/* What the link sent back on the line. */
+static char out[512];
+static unsigned nout;
+
+static void put(char c)
+{
+    if (nout + 1u < sizeof(out)) {
+        out[nout++] = c;
+        out[nout] = '\0';
+    }
+}
+
+static serial_link_t s;
+
+/* String helpers of our own: the bare-metal build has no C library. */
+static size_t length(const char *a)
+{
+    size_t n = 0;
+    while (a[n] != '\0') {
+        n++;
+    }
+    return n;
+}
+
+static bool starts(const char *a, const char *prefix)
+{
+    size_t n = length(prefix);
+    return length(a) >= n && memcmp(a, prefix, n) == 0;
+}
+
+static bool same(const char *a, const char *b)
+{
+    return length(a) == length(b) && starts(a, b);
+}
+
+/* Feed a whole text; returns how many frames it completed (the last in *f). */
+static unsigned feed(const char *text, size_t n, co_frame_t *f)
+{
+    unsigned frames = 0;
+    nout = 0;
+    out[0] = '\0';
+    for (size_t i = 0; i < n; i++) {
+        co_frame_t g;
+        if (serial_link_rx(&s, text[i], &g, put)) {
+            *f = g;
+            frames++;
+        }
+    }
+    return frames;
+}
+
+#define FEED(text, f) feed((text), sizeof(text) - 1u, (f))
+
+extern const product_t jd2xxx, gsh_a, dst_x730_xy30;
+
+static void test_frames_in(void)
+{
+    serial_link_init(&s, &jd2xxx);
+    co_frame_t f;
+    CHECK_EQ(FEED("t60A84000100000000000\r", &f), 1);
+    CHECK(f.id == 0x60A && f.dlc == 8 && !f.rtr && f.data[0] == 0x40 && f.data[1] == 0x00 &&
+          f.data[2] == 0x10);
+    CHECK_EQ(out[0], '\0'); /* frames are not answered */
+    CHECK_EQ(FEED("t0002810a\n", &f), 1); /* lower-case hex, LF ends a line too */
+    CHECK(f.id == 0 && f.dlc == 2 && f.data[0] == 0x81 && f.data[1] == 0x0A);
+    CHECK_EQ(FEED("r70A0\r", &f), 1);
+    CHECK(f.id == 0x70A && f.rtr && f.dlc == 0);
+    CHECK_EQ(FEED("t1230\r", &f), 1);
+    CHECK(f.id == 0x123 && f.dlc == 0);
+    /* Malformed or not for this node: dropped, unanswered. */
+    CHECK_EQ(FEED("t60A9000000000000000000\r", &f), 0); /* DLC 9 */
+    CHECK_EQ(FEED("t60A201\r", &f), 0);                 /* short data */
+    CHECK_EQ(FEED("t60A10102\r", &f), 0);               /* long data */
+    CHECK_EQ(FEED("t8001FF\r", &f), 0);                 /* id above 0x7FF */
+    CHECK_EQ(FEED("T0000060A200\r", &f), 0);            /* extended frame */
+    CHECK_EQ(FEED("t60\r", &f), 0);                     /* cut short */
+    CHECK_EQ(FEED("O\rC\rS6\rV\r\r\n", &f), 0);         /* adapter commands, blank lines */
+    CHECK_EQ(out[0], '\0');
+    /* One too long for the line, then a good one: only the good one. */
+    CHECK_EQ(FEED("t60A80000000000000000000000000000000000000000000000000000\rt0010\r", &f), 1);
+    CHECK(f.id == 0x001);
+    CHECK_EQ(out[0], '\0');
+    /* A NUL byte spoils a frame line. */
+    CHECK_EQ(feed("t0011\0000\r", 8, &f), 0);
+}
+
+static void test_frames_out(void)
+{
+    co_frame_t f = {.id = 0x18A, .dlc = 3, .data = {0x01, 0xAB, 0xFF}};
+    nout = 0;
+    serial_link_tx(&f, put);
+    CHECK(same(out, "t18A301ABFF\r"));
+    co_frame_t r = {.id = 0x70A, .dlc = 1, .rtr = true};
+    nout = 0;
+    serial_link_tx(&r, put);
+    CHECK(same(out, "r70A1\r"));
+}
+
+static void test_set(void)
+{
+    serial_link_init(&s, &jd2xxx);
+    CHECK_EQ(s.values[0], jd2xxx.inputs[0].initial);
+    co_frame_t f;
+    CHECK_EQ(FEED("set x=10.5 y=-3.25\r", &f), 0);
+    CHECK(same(out, "ok\r"));
+    CHECK_EQ(s.values[0], 10500);
+    CHECK_EQ(s.values[1], -3250);
+    CHECK_EQ(FEED("set  x=+0.001\r\n", &f), 0); /* CR LF: one answer */
+    CHECK(same(out, "ok\r"));
+    CHECK_EQ(s.values[0], 1);
+    CHECK_EQ(FEED("set x=3600 y=-3600\r", &f), 0);
+    CHECK_EQ(s.values[0], 3600000);
+    CHECK_EQ(s.values[1], -3600000);
+    /* Rejected whole: nothing of the line changes anything. */
+    static const char *const bad[] = {"set x=1 y=3600.001", "set x=1 y=abc", "set x=1 q=2",
+                                      "set x=1 y", "set x=1 y=", "set x=1 y=1.2345",
+                                      "set x=99999999999999", "set x=1 y=-", "set x=1 y=.",
+                                      "set x=1 y=1e3", "set x=1 =5"};
+    for (unsigned i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
+        char line[64];
+        size_t n = length(bad[i]);
+        memcpy(line, bad[i], n);
+        line[n] = '\r';
+        CHECK_EQ(feed(line, n + 1u, &f), 0);
+        CHECK(starts(out, "error: "));
+        CHECK_EQ(s.values[0], 3600000);
+        CHECK_EQ(s.values[1], -3600000);
+    }
+    CHECK_EQ(FEED("set x=1 y=abc\r", &f), 0);
+    CHECK(same(out, "error: 'abc': not a number within +-3600 (3 decimals at most)\r"));
+    CHECK_EQ(FEED("set q=1\r", &f), 0);
+    CHECK(same(out, "error: 'q': not an input of this product (NAME=VALUE)\r"));
+    CHECK_EQ(FEED("set\r", &f), 0);
+    CHECK(same(out, "error: usage: set NAME=VALUE [NAME=VALUE...]\r"));
+    CHECK_EQ(FEED("set x=.5\r", &f), 0); /* no integer digits: still a number */
+    CHECK_EQ(s.values[0], 500);
+}
+
+static void test_fault_and_unknown(void)
+{
+    serial_link_init(&s, &gsh_a);
+    co_frame_t f;
+    CHECK_EQ(FEED("fault tilt-element on\r", &f), 0);
+    CHECK(same(out, "ok\r"));
+    CHECK_EQ(s.faults, 2u);
+    CHECK_EQ(FEED("fault extension-element on\r", &f), 0);
+    CHECK_EQ(s.faults, 3u);
+    CHECK_EQ(FEED("fault tilt-element off\r", &f), 0);
+    CHECK_EQ(s.faults, 1u);
+    CHECK_EQ(FEED("fault tilt-element maybe\r", &f), 0);
+    CHECK(same(out, "error: usage: fault extension-element|tilt-element on|off\r"));
+    CHECK_EQ(FEED("fault nothing on\r", &f), 0);
+    CHECK(starts(out, "error: usage: fault"));
+    CHECK_EQ(FEED("fault tilt-element on now\r", &f), 0);
+    CHECK(starts(out, "error: "));
+    CHECK_EQ(s.faults, 1u);
+    serial_link_init(&s, &dst_x730_xy30);
+    CHECK_EQ(FEED("fault sensor on\r", &f), 0);
+    CHECK(same(out, "ok\r"));
+    CHECK_EQ(s.faults, 1u);
+    serial_link_t jd;
+    serial_link_init(&jd, &jd2xxx);
+    nout = 0;
+    for (const char *c = "fault sensor on\r"; *c != '\0'; c++) {
+        CHECK(!serial_link_rx(&jd, *c, &f, put));
+    }
+    CHECK(same(out, "error: this product has no simulated faults\r"));
+    CHECK_EQ(FEED("quit\r", &f), 0);
+    CHECK(same(out, "error: unknown command 'quit' (set, fault, can)\r"));
+    CHECK_EQ(FEED("   \r", &f), 0); /* blank input line: no answer */
+    CHECK_EQ(out[0], '\0');
+    /* Too long, or a NUL byte: an error, the line is not applied. */
+    CHECK_EQ(FEED("set x=1 x=1 x=1 x=1 x=1 x=1 x=1 x=1 x=1 x=1 x=1 x=1 x=2\r", &f), 0);
+    CHECK(same(out, "error: line too long\r"));
+    CHECK_EQ(s.values[0], dst_x730_xy30.inputs[0].initial);
+    CHECK_EQ(feed("set x=1\0\r", 9, &f), 0);
+    CHECK(same(out, "error: line holds a NUL byte\r"));
+    CHECK_EQ(s.values[0], dst_x730_xy30.inputs[0].initial);
+    /* The next line is whole again. */
+    CHECK_EQ(FEED("set x=2\r", &f), 0);
+    CHECK_EQ(s.values[0], 2000);
+}
+
+static void test_can_state_and_bitrate(void)
+{
+    serial_link_init(&s, &jd2xxx);
+    co_frame_t f;
+    CHECK_EQ(serial_link_can_state(&s, 0), CO_CAN_ACTIVE);
+    nout = 0;
+    CHECK(serial_link_bitrate(&s, 500, put));
+    CHECK(same(out, "S6\r"));
+    nout = 0;
+    CHECK(!serial_link_bitrate(&s, 33, put));
+    CHECK_EQ(nout, 0);
+    CHECK(serial_link_bitrate(&s, 10, put) && out[1] == '0');
+    nout = 0;
+    CHECK(serial_link_bitrate(&s, 1000, put) && same(out, "S8\r"));
+    CHECK_EQ(FEED("can passive\r", &f), 0);
+    CHECK(same(out, "ok\r"));
+    CHECK_EQ(serial_link_can_state(&s, 0), CO_CAN_PASSIVE);
+    /* Bus-off 0.5 s, then 128 x 11 bits at 1 Mbit/s (1.408 ms). */
+    CHECK_EQ(FEED("can bus-off 0.5\r", &f), 0);
+    CHECK(same(out, "ok\r"));
+    uint32_t t0 = 0xFFFFF000u; /* across the clock's wrap */
+    CHECK_EQ(serial_link_can_state(&s, t0), CO_CAN_BUSOFF);
+    CHECK_EQ(serial_link_can_state(&s, t0 + 501407u), CO_CAN_BUSOFF);
+    CHECK_EQ(serial_link_can_state(&s, t0 + 501408u), CO_CAN_ACTIVE);
+    CHECK_EQ(FEED("can bus-off\r", &f), 0);
+    CHECK_EQ(serial_link_can_state(&s, 0), CO_CAN_BUSOFF);
+    CHECK_EQ(serial_link_can_state(&s, 1408), CO_CAN_ACTIVE);
+    static const char *const bad[] = {"can bus-off 61", "can bus-off -1", "can passive 1",
+                                      "can nothing", "can", "can bus-off 1 2"};
+    for (unsigned i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
+        char line[32];
+        size_t n = length(bad[i]);
+        memcpy(line, bad[i], n);
+        line[n] = '\r';
+        CHECK_EQ(feed(line, n + 1u, &f), 0);
+        CHECK(starts(out, "error: usage: can"));
+        CHECK_EQ(serial_link_can_state(&s, 5000), CO_CAN_ACTIVE);
+    }
+}
+
+int main(void)
+{
+    RUN(test_frames_in);
+    RUN(test_frames_out);
+    RUN(test_set);
+    RUN(test_fault_and_unknown);
+    RUN(test_can_state_and_bitrate);
+    return h_finish();
+}
