@@ -4,14 +4,15 @@
  * frames travel as SLCAN text lines ("t1FF8...", Lawicel's serial-line CAN
  * protocol) on the 16550 UART, and the simulated sensor's input lines
  * ("set x=10", "fault sensor on") on the same line (serial_link.h); time
- * comes from the CLINT's mtime (10 MHz); the "EEPROM" is RAM (lost at
- * reset: QEMU's virt flash is not used).
- * The serial line's state and the EEPROM array are the board's state.
+ * comes from the CLINT's mtime (10 MHz); the EEPROM is emulated in the
+ * machine's CFI flash (cfi_flash.c, see the end of this file).
+ * The serial line's state and the flash's description are the board's state.
  */
 #include "board.h"
 
+#include "cfi_flash.h"
 #include "co_port.h"
-#include "co_store.h"
+#include "flash_ee.h"
 #include "serial_link.h"
 
 #define UART 0x10000000u
@@ -119,34 +120,65 @@ void board_sensor(const product_t *p, int32_t values[], uint32_t *faults)
     *faults = link.faults;
 }
 
-static uint8_t eeprom[2u * CO_STORE_NVM_SIZE];
+/* ---- flash EEPROM ---------------------------------------------------------- */
+
+/*
+ * The EEPROM emulation (boards/common/flash_ee.c, as on the Nucleo) in the
+ * virt machine's second CFI flash bank (QEMU: -drive if=pflash,unit=1,
+ * format=raw,file=F, a 32 MiB file; tools/emu makes it). Each
+ * parameter-store slot gets an erase block of its own: 8 slots (two nodes
+ * x two classes x two copies) in the first 8 blocks of 256 KiB.
+ *
+ * Without a drive QEMU still maps the bank, but as zero-filled RAM that
+ * takes every command and forgets it at exit: it reads 0x00 where an
+ * erased flash reads 0xFF. The last word of the bank, which nothing here
+ * ever programs, tells the two apart: 0x00000000 means no flash file, and
+ * the board then has no EEPROM at all. Every access fails, so the node runs
+ * on its defaults and reports the stored set as unreadable, as on a board
+ * whose EEPROM is missing (CO_STORE_HW: EMCY 6300h, or the product's own
+ * report such as the DST's 0x4001); a save answers SDO abort 0x06060000.
+ * A flash file whose last word someone zeroed is taken as missing too.
+ */
+#define FLASH_BANK1 0x22000000u
+#define EEPROM_SLOTS 8u
+
+static cfi_flash_t flash;
+static flash_ee_t eeprom;
+static bool eeprom_probed;
+
+/* The EEPROM, probed at its first use (the first store access, at node
+ * creation); NULL when there is none. */
+static const flash_ee_t *nvm(void)
+{
+    if (!eeprom_probed) {
+        eeprom_probed = true;
+        if (cfi_flash_probe(&flash, FLASH_BANK1) &&
+            flash.block_size * (EEPROM_SLOTS + 1u) <= flash.size &&
+            *(const volatile uint32_t *)(uintptr_t)(flash.base + flash.size - 4u) != 0u) {
+            eeprom = (flash_ee_t){.ops = &cfi_flash_ops, .ctx = &flash, .base = flash.base,
+                                  .page_size = flash.block_size, .pages = EEPROM_SLOTS};
+        }
+    }
+    return eeprom.ops != NULL ? &eeprom : NULL;
+}
 
 uint32_t co_port_nvm_size(void *port)
 {
     (void)port;
-    return sizeof(eeprom);
+    const flash_ee_t *fe = nvm();
+    return fe != NULL ? flash_ee_size(fe) : 0u;
 }
 
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     (void)port;
-    if (addr > sizeof(eeprom) || len > sizeof(eeprom) - addr) {
-        return false;
-    }
-    for (uint32_t i = 0; i < len; i++) {
-        ((uint8_t *)buf)[i] = eeprom[addr + i];
-    }
-    return true;
+    const flash_ee_t *fe = nvm();
+    return fe != NULL && flash_ee_read(fe, addr, buf, len);
 }
 
 bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
 {
     (void)port;
-    if (addr > sizeof(eeprom) || len > sizeof(eeprom) - addr) {
-        return false;
-    }
-    for (uint32_t i = 0; i < len; i++) {
-        eeprom[addr + i] = ((const uint8_t *)buf)[i];
-    }
-    return true;
+    const flash_ee_t *fe = nvm();
+    return fe != NULL && flash_ee_write(fe, addr, buf, len);
 }
