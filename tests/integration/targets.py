@@ -193,12 +193,9 @@ class EmuTarget(Target):
         return [str(EMU), "--board", self.board, "--product", self.product,
                 "--port", str(port), "--flash", str(self.flash)]
 
-    def _check_launcher(self):
+    def start(self):
         if not os.access(EMU, os.X_OK):
             raise TargetError(f"{EMU} is missing: the emulated targets need tools/emu")
-
-    def start(self):
-        self._check_launcher()
         if not self.image.exists():
             raise TargetError(f"{self.image} is missing: build the {self.board} images "
                               f"(cmake -B build-{self.board} ...; see README)")
@@ -215,6 +212,8 @@ class EmuTarget(Target):
             if self.bus is not None:
                 return self.bus
             self._reap(signal.SIGKILL)
+            if "port" not in self.log.read_text().splitlines()[-1]:
+                break  # not a port another program took meanwhile: no retry
         raise TargetError(f"{self.board}: no serial line from tools/emu; its output:\n"
                           + self.log.read_text()[-2000:])
 
@@ -279,27 +278,10 @@ class EmuTarget(Target):
         self.release()
 
 
-class LocalRv32Target(EmuTarget):
-    """Until tools/emu lands: the rv32-virt image straight in qemu, as the
-    issue's verified command line has it, with no flash at all (the image
-    keeps its EEPROM in RAM), so every check that needs a restart to keep
-    a value fails, as it must."""
-
-    def _command(self, port):
-        return ["qemu-system-riscv32", "-M", "virt", "-bios", "none", "-kernel", str(self.image),
-                "-display", "none", "-monitor", "none",
-                "-serial", f"tcp:127.0.0.1:{port},server=on,wait=on,nodelay=on"]
-
-    def _check_launcher(self):
-        pass  # qemu itself: tools/setup installs it
-
-
 def make_target(name, product, tmp_path):
     """The target called name (TARGETS) for one product."""
     if name == "linux":
         return LinuxTarget(product, tmp_path)
-    if name == "rv32-virt" and not EMU.exists():
-        return LocalRv32Target(product, tmp_path, name)
     return EmuTarget(product, tmp_path, name)
 
 
@@ -392,8 +374,10 @@ class Master:
                 if not want:
                     break
         missing = ", ".join(f"{c - 0x700:#04x}" for c in sorted(want))
+        seen = "; ".join(f"{m.arbitration_id:03X} {bytes(m.data).hex()}"
+                         for m in self.boot_frames[:8]) or "nothing"
         assert not want, f"{self.target.name}: no boot-up from node {missing} within " \
-                         f"{self.BOOT_TIMEOUT} s of power on"
+                         f"{self.BOOT_TIMEOUT} s of power on (saw {seen})"
         return self
 
     def _let_go(self):

@@ -413,7 +413,7 @@ def test_facts_cover_every_product():
     """facts.PRODUCTS has every product the Linux program and the MCU image
     list know, and no other (so a new product cannot miss this suite)."""
     assert set(list_products()) == set(PRODUCTS)
-    cmake = (Path(__file__).resolve().parents[2] / "boards" / "CMakeLists.txt").read_text()
+    cmake = (Path(__file__).resolve().parents[2] / "boards" / "products.cmake").read_text()
     block = cmake[cmake.index("set(CO_MCU_PRODUCTS"):]
     block = block[:block.index(")\n")]
     assert set(re.findall(r'^\s*"([a-z0-9-]+) ', block, re.M)) == set(PRODUCTS)
