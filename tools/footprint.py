@@ -11,8 +11,11 @@ from pathlib import Path
 
 from stack_depth import depth
 
-TARGET_FLASH, TARGET_RAM = 10 * 1024, 1024  # DST X730 on the Cortex-M0 (issue 4)
-M0_RAM = 6 * 1024  # STM32F042K6: every image's RAM and worst-case stack must fit
+TARGET_FLASH, TARGET_RAM = 10 * 1024, 1024  # DST X730 on the Nucleo's Cortex-M0 (issue 4)
+TARGET_BOARD = "nucleo-f042k6"
+# RAM of the Cortex-M0 boards: every image's RAM and worst-case stack must fit.
+BOARD_RAM = {"nucleo-f042k6": 6 * 1024,  # STM32F042K6
+             "microbit": 16 * 1024}  # nRF51822
 
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -65,7 +68,8 @@ def main(argv):
     argv = [a for a in argv if a != "--check"]
     failed = False
     overflow = False
-    for build, size_tool, title in zip(argv[0::3], argv[1::3], argv[2::3]):
+    for board, size_tool, title in zip(argv[0::3], argv[1::3], argv[2::3]):
+        build = f"build-{board}"
         print(f"\n{title}")
         print(f"{'product ID':<18} {'flash':>7} {'RAM':>6} {'stack':>7} {'od':>6} {'board':>6}"
               f" {'SP max':>7}")
@@ -78,11 +82,11 @@ def main(argv):
             sp = depth(elf)[0] if arm else None  # the analysis reads Thumb code only
             print(f"{pid:<18} {text + data:>7} {data + bss:>6} {s['stack']:>7} {s['od']:>6} {s['board']:>6}"
                   f" {sp if sp is not None else '-':>7}")
-            if arm and data + bss + sp > M0_RAM:
+            if arm and data + bss + sp > BOARD_RAM[board]:
                 print(f"footprint: {pid} needs {data + bss + sp} bytes of RAM with its stack",
                       file=sys.stderr)
                 overflow = True
-            if check and arm and pid.startswith("dst-x730-"):
+            if check and board == TARGET_BOARD and pid.startswith("dst-x730-"):
                 failed |= text + data > TARGET_FLASH or data + bss + sp > TARGET_RAM
     if overflow:
         return 1
