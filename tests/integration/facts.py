@@ -101,6 +101,7 @@ class Facts:
                                  # event timer at 50 ms
     fault: Fault
     stored: tuple                # two (index, sub, struct format) objects of one stored set
+    defaults: tuple              # their factory values
     set_a: tuple                 # their values of the first save
     set_b: tuple                 # and of the second (the one a power cut hits)
     autosave: bool               # every SDO write is stored at once
@@ -145,6 +146,7 @@ DST = Facts(
                 emcy=bytes.fromhex("0010000001000000"),    # 0x1000, 0x4001 = 0x01 (B-22)
                 emcy_off=bytes(8)),
     stored=(HEARTBEAT, EVENT_TIMER),
+    defaults=(0, 100),
     set_a=(300, 40),
     set_b=(500, 60),
     autosave=False,
@@ -178,6 +180,7 @@ GSH = Facts(
     fault=Fault(on=("fault extension-element on",), off=("fault extension-element off",),
                 pdo_alarm=(5, 0x02)),
     stored=(HEARTBEAT, EVENT_TIMER),
+    defaults=(0, 100),
     set_a=(300, 40),
     set_b=(500, 60),
     autosave=False,
@@ -209,6 +212,7 @@ JD = Facts(
                 emcy=bytes.fromhex("2081110000000000"),    # 8120h CAN error passive (R34)
                 emcy_off=bytes(8)),
     stored=(HEARTBEAT, EVENT_TIMER),
+    defaults=(0, 10),
     set_a=(300, 40),
     set_b=(500, 60),
     autosave=False,
@@ -243,6 +247,7 @@ PF = Facts(
                 emcy=bytes.fromhex("1050110000000000"),    # 5010h, register 0x11
                 emcy_off=bytes(8)),
     stored=(HEARTBEAT, EVENT_TIMER),
+    defaults=(0, 0),
     set_a=(300, 40),
     set_b=(500, 60),
     autosave=True,                                         # G2: every write is stored
