@@ -97,8 +97,8 @@ class Facts:
     aborts: tuple                # Abort
     sync_type: int               # 0x1800:2 value "every 2nd SYNC"; None: no SYNC transmission
     sync_refused: int            # abort code of writing 0x1800:2 where sync_type is None
-    event_mode: tuple            # (index, sub, data) writes for one TPDO1 per 50 ms with the
-                                 # event timer at 50 ms
+    event_mode: tuple            # (index, sub, data) writes for one TPDO1 per event timer
+                                 # period (test_targets.EVENT_MS, 50 ms)
     fault: Fault
     stored: tuple                # two (index, sub, struct format) objects of one stored set
     defaults: tuple              # their factory values

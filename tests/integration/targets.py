@@ -37,6 +37,15 @@ TARGETS = ("linux",) + BOARDS
 EMU = ROOT / "tools" / "emu"
 
 
+# How long a write to the device's non-volatile memory may take to reach
+# the file a restart reads: canopen-sensor writes its --nvm file before it
+# answers, rv32-virt's CFI flash is written through by qemu; the micro:bit's
+# flash lives in qemu's memory and tools/emu copies the EEPROM pages to the
+# file every 100 ms (--snapshot-ms), so a power cut there acts up to 100 ms
+# earlier.
+PERSIST_S = {"microbit": 0.15}
+
+
 class TargetError(AssertionError):
     """A target could not do what the test asked (an assertion: the test fails
     and says why, it is never skipped)."""
@@ -74,6 +83,11 @@ class Target:
     def inject(self, line):
         """One line of the simulated input language (`set ...`, `fault ...`, `can ...`)."""
         raise NotImplementedError
+
+    def settle(self):
+        """Wait until what the device wrote to its non-volatile memory would
+        survive a power cut (see PERSIST_S)."""
+        time.sleep(PERSIST_S.get(self.name, 0.0))
 
     def close(self):
         """End whatever still runs (the test's teardown)."""
