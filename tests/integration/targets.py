@@ -117,10 +117,22 @@ class LinuxTarget(Target):
     def kill(self):
         return self.sensor.kill()
 
-    def inject(self, line):
+    def inject(self, line, timeout=1.0):
+        """Writes the line on its standard input and waits for its log to take
+        it ("stdin: LINE") or to reject it, which fails the test."""
         if not self.sensor.alive():
             raise TargetError(f"inject {line!r}: canopen-sensor is not running")
-        self.sensor.send(line)  # errors go to its stderr and log; none expected
+        seen = len(self.sensor.log_text())
+        self.sensor.send(line)
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            for entry in self.sensor.log_text()[seen:].splitlines():
+                if entry.endswith(f"stdin: {line}"):
+                    return
+                if "stdin rejected: " in entry:
+                    raise TargetError(f"linux: {line!r} rejected: {entry}")
+            time.sleep(0.01)
+        raise TargetError(f"linux: {line!r} not in canopen-sensor's log within {timeout} s")
 
     def close(self):
         self.sensor.stop()
