@@ -134,10 +134,10 @@ DST = Facts(
     app_param=(0x6014, 0, i16(-120), i16(0)),
     aborts=COMMON_ABORTS + (
         Abort("r", 0x1010, 1, 0x06010001),                 # wo (spec 2)
-        Abort("w", 0x1017, 0, 0x06090030, u16(10)),        # 1..19 not accepted (B-...)
+        Abort("w", 0x1017, 0, 0x06090030, u16(10)),        # 1..19 not accepted (B-17)
         Abort("w", 0x1800, 2, 0x06090030, u8(255)),        # 1..240, 254 only (C-18)
         Abort("w", 0x20F0, 0, 0x06090032, u8(0)),          # node-ID 1..127 (B-42)
-        Abort("w", 0x2001, 0, 0x05040001, bytes(9)),       # expedited only: segmented refused (B-36)
+        Abort("w", 0x2001, 0, 0x05040001, bytes(9)),       # expedited only (B-33): segmented refused
     ),
     sync_type=2,
     sync_refused=None,
@@ -150,7 +150,9 @@ DST = Facts(
     set_a=(300, 40),
     set_b=(500, 60),
     autosave=False,
-    corrupt=Corrupt(sdo_bit=(0x4001, 0, 0x40)),            # "stored set corrupt"
+    # 0x4001 bit 6: the LSS set's checksum (B-31); a bad PARA set only
+    # brings the defaults back, which the stored-set checks catch.
+    corrupt=Corrupt(sdo_bit=(0x4001, 0, 0x40)),
     # B-41..B-44: both copies, stored by the device itself, active after a reset.
     node_id_change=NodeIdChange(steps=(("sdo", 0x20F0, 0, u8(6)), ("sdo", 0x20F1, 0, u8(6)),
                                        ("power-cycle",)), new_id=6),
@@ -289,9 +291,4 @@ CI_PRODUCTS = {
     "microbit": ("dst-x730-z360", "dst-x710-xy90", "gsh-a", "gsh-a-redundant", "jd2xxx",
                  "inx360d"),
 }
-
-
-def family_of(pid):
-    """The family key of a product: its facts' family (dst-x730, gsh, ...)."""
-    return PRODUCTS[pid].family
 

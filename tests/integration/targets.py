@@ -32,8 +32,6 @@ from serial.urlhandler import protocol_socket
 
 from conftest import BINARY, ROOT, Sensor
 
-BOARDS = ("rv32-virt", "microbit")
-TARGETS = ("linux",) + BOARDS
 EMU = ROOT / "tools" / "emu"
 
 
