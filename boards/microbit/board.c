@@ -40,6 +40,10 @@ void timer0_handler(void);
 void timer0_handler(void)
 {
     TIMER0_EVENTS_COMPARE(ALARM_CC) = 0u; /* the alarm only wakes the core */
+    /* Read back: the write reaches the peripheral before the handler
+     * returns, else its interrupt fires once more (nRF51 reference manual,
+     * peripheral interface). */
+    (void)TIMER0_EVENTS_COMPARE(ALARM_CC);
 }
 
 /* ---- UART: the serial line --------------------------------------------- */
