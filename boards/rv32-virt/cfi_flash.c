@@ -79,6 +79,8 @@ bool cfi_flash_probe(cfi_flash_t *f, uint32_t base)
     return ok;
 }
 
+/* Erase the block holding addr: clear status, erase setup + confirm, wait.
+ * QEMU erases at the setup command, and writes the block to its file. */
 static bool cfi_erase(void *ctx, uint32_t addr)
 {
     const cfi_flash_t *f = ctx;
@@ -124,6 +126,7 @@ static bool cfi_program16(void *ctx, uint32_t addr, uint16_t v)
     return finish(w) && *w == val;
 }
 
+/* Plain byte reads: the bank is always left in read-array mode. */
 static void cfi_read(void *ctx, uint32_t addr, void *buf, uint32_t len)
 {
     (void)ctx;
