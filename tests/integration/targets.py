@@ -319,6 +319,8 @@ class EmuTarget(Target):
     def close(self):
         self._reap(signal.SIGTERM)
         self.release()
+        # 32 MiB on rv32-virt: not for pytest's kept directories (the log stays).
+        self.flash.unlink(missing_ok=True)
 
 
 def make_target(name, product, tmp_path):
