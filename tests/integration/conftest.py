@@ -19,6 +19,21 @@ BINARY = os.environ.get("CANOPEN_SENSOR", str(ROOT / "build" / "bin" / "canopen-
 IFACE = "vcan0"
 
 
+def pytest_addoption(parser):
+    """test_targets.py runs on one target, for a list of products."""
+    group = parser.getgroup("targets", "the one suite on three targets (test_targets.py)")
+    group.addoption("--target", default="linux", choices=("linux", "rv32-virt", "microbit"),
+                    help="where the products run: linux (canopen-sensor on vcan0, through "
+                         "tools/vcan-run) or an emulated board (tools/emu, qemu)")
+    group.addoption("--products", default=os.environ.get("CO_TEST_PRODUCTS", "ci"),
+                    help="ci (one of each family, facts.CI_PRODUCTS), all, or IDs "
+                         "separated by commas; default $CO_TEST_PRODUCTS, else ci "
+                         "(tools/check --all-products sets it to all)")
+    group.addoption("--shard", default="1/1", metavar="K/N",
+                    help="run the K-th of N shares of the products (ctest runs the "
+                         "shares of a board in parallel)")
+
+
 def pytest_sessionstart(session):
     if not os.access(BINARY, os.X_OK):
         pytest.exit(f"{BINARY} is missing: build first (see README)", returncode=3)

@@ -1,0 +1,294 @@
+"""What the one integration suite (test_targets.py) expects of each product,
+as a table: the checks are the same code for every product and target,
+and every way a family differs is a value here (shared/specs/<family>.md
+is the source of each; the spec's rule numbers are given where a value is
+not plain CiA 301).
+
+A value written ID(base) means base + the node's node-ID.
+"""
+from dataclasses import dataclass, replace
+import struct
+
+SAVE = b"save"  # 0x1010 signature, CiA 301
+
+
+def u8(v):
+    return struct.pack("<B", v)
+
+
+def u16(v):
+    return struct.pack("<H", v)
+
+
+def i16(v):
+    return struct.pack("<h", v)
+
+
+def u32(v):
+    return struct.pack("<I", v)
+
+
+@dataclass(frozen=True)
+class ID:
+    """A value relative to the node-ID (COB-IDs)."""
+    base: int
+
+    def of(self, node_id):
+        return self.base + node_id
+
+
+@dataclass(frozen=True)
+class Read:
+    index: int
+    sub: int
+    value: object  # bytes, or ID(base) read as UNSIGNED32
+
+
+@dataclass(frozen=True)
+class Abort:
+    """An SDO access that must be refused with this abort code."""
+    op: str  # "r" upload, "w" download
+    index: int
+    sub: int
+    code: int
+    data: bytes = b""
+
+
+@dataclass(frozen=True)
+class Fault:
+    """An injected fault and what the master must see of it."""
+    on: tuple            # simulated input lines that raise it
+    off: tuple           # lines that clear it
+    emcy: bytes = None   # the EMCY frame it raises (None: the product sends none)
+    emcy_off: bytes = None  # the EMCY frame that clears it (error reset)
+    pdo_alarm: tuple = None  # (byte, mask) of TPDO1 that shows it instead
+
+
+@dataclass(frozen=True)
+class Corrupt:
+    """How the product reports a corrupt stored set at boot: a bit of an
+    object, or an EMCY code; None where it only falls back to defaults."""
+    sdo_bit: tuple = None  # (index, sub, mask)
+    emcy_code: int = None
+
+
+# Steps of a node-ID change, as the product's manual gives it:
+#   ("sdo", index, sub, data)   download to the node (its current ID)
+#   ("lss-node-id", new)        CiA 305: configure node-ID, store, back to waiting
+#   ("nmt", command)            NMT to the node (0x81 reset node, 0x82 reset comm)
+#   ("power-cycle",)            clean power off, power on
+@dataclass(frozen=True)
+class NodeIdChange:
+    steps: tuple
+    new_id: int
+
+
+@dataclass(frozen=True)
+class Facts:
+    family: str
+    nodes: tuple                 # factory node-IDs, one per node of the device
+    device_type: int             # 0x1000
+    identity: dict               # 0x1018 sub -> value
+    name: bytes                  # 0x1008
+    boot_state: int              # heartbeat state after boot-up: 0x7F pre-op, 0x05 operational
+    reads: tuple                 # more SDO reads (Read)
+    rw: tuple                    # (index, sub, data): written, read back the same
+    app_param: tuple             # (index, sub, new, default): an application parameter
+    aborts: tuple                # Abort
+    sync_type: int               # 0x1800:2 value "every 2nd SYNC"; None: no SYNC transmission
+    sync_refused: int            # abort code of writing 0x1800:2 where sync_type is None
+    event_mode: tuple            # (index, sub, data) writes for one TPDO1 per event timer
+                                 # period (test_targets.EVENT_MS, 50 ms)
+    fault: Fault
+    stored: tuple                # two (index, sub, struct format) objects of one stored set
+    defaults: tuple              # their factory values
+    set_a: tuple                 # their values of the first save
+    set_b: tuple                 # and of the second (the one a power cut hits)
+    autosave: bool               # every SDO write is stored at once
+    corrupt: Corrupt
+    node_id_change: NodeIdChange
+    tpdo_cob: ID = ID(0x180)
+
+
+# Heartbeat and event timer: every product has a rw 0x1017 and 0x1800:5.
+HEARTBEAT = (0x1017, 0, "<H")
+EVENT_TIMER = (0x1800, 5, "<H")
+
+COMMON_ABORTS = (
+    Abort("r", 0x2FFF, 0, 0x06020000),            # no such object
+    Abort("r", 0x1018, 5, 0x06090011),            # no such sub-index
+    Abort("w", 0x1000, 0, 0x06010002, u32(0)),    # read-only
+    Abort("w", 0x1010, 1, 0x08000020, b"sav!"),   # wrong signature
+)
+
+DST = Facts(
+    family="dst",
+    nodes=(0x7F,),
+    device_type=0x0008019A,
+    identity={1: 0x93, 2: 0x64, 3: 1, 4: 0},
+    name=b"GIB",
+    boot_state=0x7F,
+    reads=(Read(0x1009, 0, b"1.00"), Read(0x1200, 1, ID(0x600)), Read(0x1200, 2, ID(0x580)),
+           Read(0x1800, 1, ID(0x180)), Read(0x1800, 5, u16(100))),
+    rw=((0x1017, 0, u16(250)), (0x2001, 0, u8(2))),
+    app_param=(0x6014, 0, i16(-120), i16(0)),
+    aborts=COMMON_ABORTS + (
+        Abort("r", 0x1010, 1, 0x06010001),                 # wo (spec 2)
+        Abort("w", 0x1017, 0, 0x06090030, u16(10)),        # 1..19 not accepted (B-17)
+        Abort("w", 0x1800, 2, 0x06090030, u8(255)),        # 1..240, 254 only (C-18)
+        Abort("w", 0x20F0, 0, 0x06090032, u8(0)),          # node-ID 1..127 (B-42)
+        Abort("w", 0x2001, 0, 0x05040001, bytes(9)),       # expedited only (B-33): segmented refused
+    ),
+    sync_type=2,
+    sync_refused=None,
+    event_mode=(),                                         # 254 + event timer by default
+    fault=Fault(on=("fault sensor on",), off=("fault sensor off",),
+                emcy=bytes.fromhex("0010000001000000"),    # 0x1000, 0x4001 = 0x01 (B-22)
+                emcy_off=bytes(8)),
+    stored=(HEARTBEAT, EVENT_TIMER),
+    defaults=(0, 100),
+    set_a=(300, 40),
+    set_b=(500, 60),
+    autosave=False,
+    # 0x4001 bit 6: the LSS set's checksum (B-31); a bad PARA set only
+    # brings the defaults back, which the stored-set checks catch.
+    corrupt=Corrupt(sdo_bit=(0x4001, 0, 0x40)),
+    # B-41..B-44: both copies, stored by the device itself, active after a reset.
+    node_id_change=NodeIdChange(steps=(("sdo", 0x20F0, 0, u8(6)), ("sdo", 0x20F1, 0, u8(6)),
+                                       ("power-cycle",)), new_id=6),
+)
+
+GSH = Facts(
+    family="gsh",
+    nodes=(0x13,),
+    device_type=0xFFFF0196,
+    identity={1: 0x93, 2: 0x67, 3: 1},                     # sub 4 is per unit (C-31)
+    name=b"GSHA",
+    boot_state=0x05,                                       # 0x5000 = 1: starts by itself (R-02)
+    reads=(Read(0x100A, 0, b"1.00"), Read(0x1200, 1, ID(0x600)), Read(0x1800, 1, ID(0x180)),
+           Read(0x1800, 2, u8(254)), Read(0x5000, 0, u8(1))),
+    rw=((0x1017, 0, u16(250)), (0x1800, 5, u16(200))),
+    app_param=(0x5000, 0, u8(0), u8(1)),
+    aborts=COMMON_ABORTS + (
+        Abort("r", 0x1010, 1, 0x06010001),                 # wo (R-24)
+        Abort("r", 0x1011, 1, 0x06020000),                 # no 0x1011 (C-09)
+        Abort("w", 0x3001, 0, 0x06090032, u8(0)),          # node-ID 1..127 (R-27)
+        Abort("w", 0x1800, 5, 0x06090032, u16(3)),         # 0 or 4..65535 ms (D-38)
+    ),
+    sync_type=None,                                        # type 254, fixed (C-11)
+    sync_refused=0x06010002,
+    event_mode=(),
+    # No EMCY at all (R-14, C-37): the alarm word of TPDO1 (bytes 4-5) shows it.
+    fault=Fault(on=("fault extension-element on",), off=("fault extension-element off",),
+                pdo_alarm=(5, 0x02)),
+    stored=(HEARTBEAT, EVENT_TIMER),
+    defaults=(0, 100),
+    set_a=(300, 40),
+    set_b=(500, 60),
+    autosave=False,
+    corrupt=Corrupt(),                                     # defaults only (C-38)
+    # R-27..R-29: write, save, reset (power cycle in the manual's example).
+    node_id_change=NodeIdChange(steps=(("sdo", 0x3001, 0, u8(6)), ("sdo", 0x1010, 1, SAVE),
+                                       ("power-cycle",)), new_id=6),
+)
+
+JD = Facts(
+    family="jd",
+    nodes=(10,),
+    device_type=0x0002019A,
+    identity={1: 0x0069666D, 2: 0, 3: 0x00010000, 4: 0x0000D001},
+    name=b"JD2xxx",
+    boot_state=0x7F,
+    reads=(Read(0x1009, 0, b"HW 1.0"), Read(0x1800, 1, ID(0x180)), Read(0x1801, 1, ID(0x280)),
+           Read(0x1800, 2, u8(1)), Read(0x3000, 0, u8(9)), Read(0x1010, 1, u32(1))),
+    rw=((0x1017, 0, u16(250)), (0x3100, 0, u16(4))),
+    app_param=(0x3100, 0, u16(4), u16(0)),
+    aborts=COMMON_ABORTS + (
+        Abort("w", 0x3000, 0, 0x06090031, u8(0x7F)),       # node number 0..0x7E (C1)
+        Abort("w", 0x1800, 3, 0x06090030, u16(10)),        # inhibit only while invalid (R21)
+    ),
+    sync_type=2,
+    sync_refused=None,
+    event_mode=((0x1800, 2, u8(254)),),
+    fault=Fault(on=("can passive",), off=("can active",),
+                emcy=bytes.fromhex("2081110000000000"),    # 8120h CAN error passive (R34)
+                emcy_off=bytes(8)),
+    stored=(HEARTBEAT, EVENT_TIMER),
+    defaults=(0, 10),
+    set_a=(300, 40),
+    set_b=(500, 60),
+    autosave=False,
+    corrupt=Corrupt(emcy_code=0x6300),
+    # R41, R44: LSS configure node-ID + store, then reset communication.
+    node_id_change=NodeIdChange(steps=(("lss-node-id", 32), ("nmt", 0x82)), new_id=32),
+)
+
+PF = Facts(
+    family="pf",
+    nodes=(1,),
+    device_type=0x0000019A,
+    identity={1: 0, 2: 0, 3: 0, 4: 0},                     # placeholders (G4)
+    name=b"INY360D-F99-B16-V15",
+    boot_state=0x7F,
+    reads=(Read(0x1010, 1, u32(3)), Read(0x1800, 1, ID(0x180)), Read(0x1800, 2, u8(1)),
+           Read(0x2000, 0, u8(1)), Read(0x2001, 0, u8(2)), Read(0x6000, 0, u16(100))),
+    rw=((0x1017, 0, u16(250)), (0x6014, 0, i16(-200))),
+    app_param=(0x6014, 0, i16(-200), i16(0)),
+    aborts=COMMON_ABORTS + (
+        Abort("r", 0x1200, 0, 0x06020000),                 # fixed SDO COB-IDs: no 0x1200
+        Abort("w", 0x2001, 0, 0x06090030, u8(3)),          # 1, 2, 4, 8 only
+        Abort("w", 0x6014, 0, 0x06090031, i16(5000)),      # -3599..3599
+        Abort("w", 0x1800, 2, 0x06090030, u8(245)),        # F1h-FBh refused
+    ),
+    sync_type=2,
+    sync_refused=None,
+    # FEh is sent after each calculation, like FFh (R26, C10), the event timer
+    # only adds to that (R31): the inhibit time (R27) makes the 50 ms here.
+    event_mode=((0x1800, 2, u8(0xFE)), (0x1800, 3, u16(500))),
+    fault=Fault(on=("fault range-x on",), off=("fault range-x off",),
+                emcy=bytes.fromhex("1050110000000000"),    # 5010h, register 0x11
+                emcy_off=bytes(8)),
+    stored=(HEARTBEAT, EVENT_TIMER),
+    defaults=(0, 0),
+    set_a=(300, 40),
+    set_b=(500, 60),
+    autosave=True,                                         # G2: every write is stored
+    corrupt=Corrupt(emcy_code=0x6300),                     # R52
+    # L297-307: write 2000h, active after Reset Node.
+    node_id_change=NodeIdChange(steps=(("sdo", 0x2000, 0, u8(15)), ("nmt", 0x81)), new_id=15),
+)
+
+
+def _dst(pid):
+    x710 = pid.startswith("dst-x710")
+    reads = DST.reads + (Read(0x100A, 0, b"1.10" if x710 else b"1.24"),)
+    aborts = DST.aborts + ((Abort("r", 0x5001, 0, 0x06020000),) if x710 else ())  # no 0x5001
+    return replace(DST, family="dst-x710" if x710 else "dst-x730", reads=reads, aborts=aborts)
+
+
+DST_IDS = tuple(f"dst-{m}-{v}" for m in ("x730", "x710")
+                for v in ("xy10", "xy15", "xy20", "xy30", "xy45", "xy60", "xy90", "z360"))
+
+PRODUCTS = {pid: _dst(pid) for pid in DST_IDS}
+PRODUCTS.update({
+    "gsh-a": GSH,
+    # Two independent nodes in one device; on one bus here (one serial line).
+    "gsh-a-redundant": replace(GSH, family="gsh-redundant", nodes=(0x13, 0x14)),
+    "jd2xxx": JD,
+    "jd1xxx": replace(JD, device_type=0x0001019A, name=b"JD1xxx"),
+    "iny360d": PF,
+    "inx360d": replace(PF, name=b"INX360D-F99-B16-V15"),
+})
+
+# What CI runs on each target: one product of each family (and the
+# redundant GSH-A), the emulated boards taking the other variant of each
+# pair, so that CI runs every one of them on some MCU. tools/check
+# --all-products runs every product ID on each.
+CI_PRODUCTS = {
+    "linux": ("dst-x730-xy30", "dst-x710-z360", "gsh-a", "gsh-a-redundant", "jd2xxx", "inx360d"),
+    "rv32-virt": ("dst-x730-xy10", "dst-x710-xy45", "gsh-a", "gsh-a-redundant", "jd1xxx",
+                  "iny360d"),
+    "microbit": ("dst-x730-z360", "dst-x710-xy90", "gsh-a", "gsh-a-redundant", "jd2xxx",
+                 "inx360d"),
+}
+

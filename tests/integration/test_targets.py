@@ -1,0 +1,440 @@
+"""One suite, three targets: the same master checks against the Linux
+program on vcan and against the bare-metal images in qemu (rv32-virt,
+microbit) over their SLCAN serial line.
+
+    tools/vcan-run build/venv/bin/python -m pytest tests/integration/test_targets.py
+    build/venv/bin/python -m pytest tests/integration/test_targets.py --target rv32-virt
+    ... --products all | --products gsh-a,jd1xxx
+
+Every check runs once per product (--products, default the CI set of
+facts.CI_PRODUCTS) on the one target (--target, default linux). What a
+product is expected to do is in facts.py, one table, so the checks below
+have no product names in them. A target that cannot do what a check
+needs (no tools/emu yet, an image without the input language) fails the
+check and says so: nothing here is skipped.
+"""
+import re
+import struct
+import time
+from pathlib import Path
+
+import pytest
+from canopen.lss import LssMaster
+from canopen.sdo.exceptions import SdoAbortedError
+
+from facts import CI_PRODUCTS, ID, PRODUCTS, SAVE
+from targets import Master, list_products, make_target
+
+NMT_START, NMT_STOP, NMT_PREOP, NMT_RESET_NODE, NMT_RESET_COMM = 0x01, 0x02, 0x80, 0x81, 0x82
+OPERATIONAL, STOPPED, PREOP = 0x05, 0x04, 0x7F
+# Periods and the window they are counted in: short, so that a product's
+# checks take about 10 s on a target (the count is exact to one frame at
+# the window's ends, the mean period to a fifth).
+HB_MS, EVENT_MS, WINDOW_S = 50, 50, 0.5
+
+
+def selected_products(config):
+    """--products, then the K-th of N shares of them (--shard K/N)."""
+    target = config.getoption("--target")
+    want = config.getoption("--products")
+    if want == "ci":
+        ids = list(CI_PRODUCTS[target])
+    elif want == "all":
+        ids = list(PRODUCTS)
+    else:
+        ids = [p for p in want.split(",") if p]
+        unknown = [p for p in ids if p not in PRODUCTS]
+        if unknown:
+            raise pytest.UsageError(f"--products: unknown product {', '.join(unknown)} "
+                                    f"(known: {', '.join(PRODUCTS)})")
+    shard = re.fullmatch(r"([1-9][0-9]*)/([1-9][0-9]*)", config.getoption("--shard"))
+    if shard is None or int(shard[1]) > int(shard[2]):
+        raise pytest.UsageError("--shard K/N: 1 <= K <= N")
+    k, n = int(shard[1]), int(shard[2])
+    if not ids[k - 1::n]:
+        raise pytest.UsageError(f"--shard {k}/{n}: no product in it (of {len(ids)})")
+    return ids[k - 1::n]
+
+
+def pytest_generate_tests(metafunc):
+    if "product" in metafunc.fixturenames:
+        metafunc.parametrize("product", selected_products(metafunc.config))
+
+
+@pytest.fixture
+def facts(product):
+    return PRODUCTS[product]
+
+
+@pytest.fixture
+def dut(request, product, tmp_path):
+    """The master on the device: product on --target, not yet powered."""
+    master = Master(make_target(request.config.getoption("--target"), product, tmp_path))
+    yield master
+    master.close()
+
+
+# --- helpers: the master's SDO, NMT and heartbeat, in bytes ---------------
+
+def up(dut, node_id, index, sub):
+    return bytes(dut.node(node_id).sdo.upload(index, sub))
+
+
+def down(dut, node_id, index, sub, data):
+    dut.node(node_id).sdo.download(index, sub, bytes(data))
+
+
+def expect(value, node_id):
+    return struct.pack("<I", value.of(node_id)) if isinstance(value, ID) else value
+
+
+def abort_code(fn):
+    with pytest.raises(SdoAbortedError) as e:
+        fn()
+    return e.value.code
+
+
+def nmt(dut, command, node_id):
+    dut.send(0x000, bytes([command, node_id]))
+
+
+def heartbeat_state(dut, node_id, timeout=1.0):
+    """The state byte of the node's next heartbeat (None: none came)."""
+    m = dut.frames.wait_for(0x700 + node_id, timeout=timeout, pred=lambda m: len(m.data) == 1)
+    return None if m is None else m.data[0] & 0x7F
+
+
+def wait_state(dut, node_id, state, timeout=1.0):
+    """Heartbeats until one reports state; its state, or the last one seen."""
+    seen = None
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        seen = heartbeat_state(dut, node_id, timeout=end - time.monotonic())
+        if seen == state:
+            break
+    return seen
+
+
+def boot_up(dut, node_id, timeout=2.0):
+    return dut.frames.wait_for(0x700 + node_id, timeout=timeout,
+                               pred=lambda m: bytes(m.data) == b"\0")
+
+
+def sdo_answers(dut, node_id, timeout=0.3):
+    """Whether node_id answers an SDO read of 0x1000 (raw, no retries)."""
+    dut.frames.clear()
+    dut.send(0x600 + node_id, bytes.fromhex("4000100000000000"))
+    return dut.frames.wait_for(0x580 + node_id, timeout=timeout) is not None
+
+
+def write_set(dut, node_id, facts, values):
+    for (index, sub, fmt), v in zip(facts.stored, values):
+        down(dut, node_id, index, sub, struct.pack(fmt, v))
+
+
+def read_set(dut, node_id, facts):
+    return tuple(struct.unpack(fmt, up(dut, node_id, index, sub))[0]
+                 for index, sub, fmt in facts.stored)
+
+
+def expedited(index, sub, data):
+    """A raw SDO expedited download request (CiA 301)."""
+    cmd = 0x23 | ((4 - len(data)) << 2)
+    return bytes([cmd, index & 0xFF, index >> 8, sub]) + bytes(data) + bytes(4 - len(data))
+
+
+def assert_no_corrupt_set(dut, node_id, facts):
+    """The product's own report of a corrupt stored set is absent."""
+    c = facts.corrupt
+    if c.sdo_bit is not None:
+        index, sub, mask = c.sdo_bit
+        assert up(dut, node_id, index, sub)[0] & mask == 0, "reports a corrupt stored set"
+    if c.emcy_code is not None:
+        bad = [m for m in dut.boot_frames if m.arbitration_id == 0x80 + node_id
+               and int.from_bytes(m.data[0:2], "little") == c.emcy_code]
+        late = dut.frames.wait_for(0x80 + node_id, timeout=0.2,
+                                   pred=lambda m: int.from_bytes(m.data[0:2], "little")
+                                   == c.emcy_code)
+        assert not bad and late is None, f"EMCY {c.emcy_code:04X}h: corrupt stored set"
+
+
+# --- the checks -------------------------------------------------------------
+
+def test_boot_up(dut, facts):
+    """Each node's first frame after power on is its boot-up (0x700 + ID, one
+    byte 00), and nothing of it comes before. A new device (no EEPROM file,
+    erased flash) runs on defaults and reports no corrupt stored set."""
+    dut.power_on(facts.nodes)
+    for n in facts.nodes:
+        own = {0x80 + n, facts.tpdo_cob.of(n), 0x580 + n, 0x700 + n}
+        first = next(m for m in dut.boot_frames if m.arbitration_id in own)
+        assert first.arbitration_id == 0x700 + n and bytes(first.data) == b"\0", \
+            f"node {n:#x}: first frame {first}"
+        assert_no_corrupt_set(dut, n, facts)
+        assert read_set(dut, n, facts) == facts.defaults
+
+
+def test_identity(dut, facts):
+    """0x1000, 0x1018 and 0x1008 through the canopen SDO client (0x1008
+    segmented where it is longer than 4 bytes)."""
+    dut.power_on(facts.nodes)
+    for n in facts.nodes:
+        assert up(dut, n, 0x1000, 0) == struct.pack("<I", facts.device_type)
+        for sub, value in facts.identity.items():
+            assert up(dut, n, 0x1018, sub) == struct.pack("<I", value), f"0x1018 sub {sub}"
+        assert up(dut, n, 0x1008, 0) == facts.name
+
+
+def test_sdo_reads_writes_aborts(dut, facts):
+    dut.power_on(facts.nodes)
+    n = facts.nodes[0]
+    for r in facts.reads:
+        assert up(dut, n, r.index, r.sub) == expect(r.value, n), f"{r.index:04X}h/{r.sub}"
+    for index, sub, data in facts.rw:
+        down(dut, n, index, sub, data)
+        assert up(dut, n, index, sub) == data, f"{index:04X}h/{sub} read back"
+    for a in facts.aborts:
+        if a.op == "r":
+            got = abort_code(lambda: up(dut, n, a.index, a.sub))
+        else:
+            got = abort_code(lambda: down(dut, n, a.index, a.sub, a.data))
+        assert got == a.code, f"{a.op} {a.index:04X}h/{a.sub}: abort {got:08X}h, want {a.code:08X}h"
+    for index, sub, data in facts.rw:  # refused writes changed nothing
+        assert up(dut, n, index, sub) == data
+
+
+def test_nmt_states(dut, facts):
+    dut.power_on(facts.nodes)
+    n = facts.nodes[0]
+    index, sub, new, default = facts.app_param
+    down(dut, n, 0x1017, 0, struct.pack("<H", HB_MS))
+    assert heartbeat_state(dut, n) == facts.boot_state
+    nmt(dut, NMT_PREOP, n)
+    assert wait_state(dut, n, PREOP) == PREOP
+    nmt(dut, NMT_START, n)
+    assert wait_state(dut, n, OPERATIONAL) == OPERATIONAL
+    nmt(dut, NMT_STOP, n)
+    assert wait_state(dut, n, STOPPED) == STOPPED
+    assert not sdo_answers(dut, n), "SDO answered in stopped"
+    nmt(dut, NMT_PREOP, 0)  # broadcast
+    assert wait_state(dut, n, PREOP) == PREOP
+    down(dut, n, index, sub, new)
+    # Reset communication: boot-up, 0x1000-0x1FFF from the stored set (the
+    # heartbeat period with it), the application parameter kept.
+    dut.frames.clear()
+    nmt(dut, NMT_RESET_COMM, n)
+    assert boot_up(dut, n) is not None, "no boot-up after reset communication"
+    beat = heartbeat_state(dut, n, timeout=3 * HB_MS / 1000)
+    assert (beat is not None) == facts.autosave, f"heartbeat after reset communication: {beat}"
+    assert up(dut, n, index, sub) == new
+    # Reset node: boot-up, every parameter from the stored set.
+    dut.frames.clear()
+    nmt(dut, NMT_RESET_NODE, n)
+    assert boot_up(dut, n) is not None, "no boot-up after reset node"
+    assert up(dut, n, index, sub) == (new if facts.autosave else default)
+    for other in facts.nodes[1:]:  # the other node of the device went on
+        assert sdo_answers(dut, other)
+
+
+def test_heartbeat_period(dut, facts):
+    dut.power_on(facts.nodes)
+    n = facts.nodes[0]
+    down(dut, n, 0x1017, 0, struct.pack("<H", HB_MS))
+    heartbeat_state(dut, n)
+    beats = dut.frames.collect(0x700 + n, WINDOW_S + 0.01)
+    want = WINDOW_S * 1000 / HB_MS
+    assert want - 1 <= len(beats) <= want + 1, f"{len(beats)} heartbeats in {WINDOW_S} s " \
+                                               f"at {HB_MS} ms"
+    assert all(bytes(m.data) == bytes([facts.boot_state]) for _, m in beats)
+    mean = (beats[-1][0] - beats[0][0]) / (len(beats) - 1)
+    assert abs(mean * 1000 - HB_MS) <= HB_MS / 5, f"mean period {mean * 1000:.1f} ms"
+    down(dut, n, 0x1017, 0, struct.pack("<H", 0))
+    dut.frames.clear()
+    assert heartbeat_state(dut, n, timeout=3 * HB_MS / 1000) is None, "heartbeat after 0x1017 = 0"
+
+
+def test_tpdo_by_sync(dut, facts):
+    dut.power_on(facts.nodes)
+    n = facts.nodes[0]
+    cob = facts.tpdo_cob.of(n)
+    if facts.sync_type is None:
+        # Event-driven only (its manual): 0x1800:2 refuses, and with the event
+        # timer off no SYNC makes a PDO.
+        assert abort_code(lambda: down(dut, n, 0x1800, 2, b"\x01")) == facts.sync_refused
+        down(dut, n, 0x1800, 5, struct.pack("<H", 0))
+        want = 0
+    else:
+        down(dut, n, 0x1800, 2, bytes([facts.sync_type]))
+        want = 6 // facts.sync_type
+    nmt(dut, NMT_START, n)
+    time.sleep(0.1)
+    dut.frames.clear()
+    assert not dut.frames.collect(cob, 0.2), "TPDO without SYNC"
+    for _ in range(6):
+        dut.send(0x080)
+        time.sleep(0.02)
+    got = dut.frames.collect(cob, 0.3)
+    assert len(got) == want, f"{len(got)} TPDOs for 6 SYNCs, want {want}"
+
+
+def test_tpdo_by_event_timer(dut, facts):
+    dut.power_on(facts.nodes)
+    n = facts.nodes[0]
+    cob = facts.tpdo_cob.of(n)
+    nmt(dut, NMT_PREOP, n)
+    for index, sub, data in facts.event_mode:
+        down(dut, n, index, sub, data)
+    down(dut, n, 0x1800, 5, struct.pack("<H", EVENT_MS))
+    dut.frames.clear()
+    assert not dut.frames.collect(cob, 0.15), "TPDO in pre-operational"
+    nmt(dut, NMT_START, n)
+    dut.frames.wait_for(cob, timeout=0.5)
+    got = dut.frames.collect(cob, WINDOW_S)
+    want = WINDOW_S * 1000 / EVENT_MS
+    assert want - 1 <= len(got) <= want + 1, f"{len(got)} TPDOs in {WINDOW_S} s at {EVENT_MS} ms"
+
+
+def test_emcy_on_injected_fault(dut, facts):
+    dut.power_on(facts.nodes)
+    n = facts.nodes[0]
+    f = facts.fault
+    nmt(dut, NMT_START, n)
+    time.sleep(0.1)
+    dut.frames.clear()
+    for line in f.on:
+        dut.target.inject(line)
+    if f.emcy is not None:
+        m = dut.frames.wait_for(0x80 + n, timeout=2)
+        assert m is not None and bytes(m.data) == f.emcy, f"EMCY {m}"
+    else:
+        byte, mask = f.pdo_alarm
+        m = dut.frames.wait_for(facts.tpdo_cob.of(n), timeout=2, pred=lambda m: m.data[byte] & mask)
+        assert m is not None, "fault not in the PDO's alarm word"
+        assert not dut.frames.collect(0x80 + n, 0.3), "EMCY from a product that has none"
+    for line in f.off:
+        dut.target.inject(line)
+    if f.emcy_off is not None:
+        m = dut.frames.wait_for(0x80 + n, timeout=2)
+        assert m is not None and bytes(m.data) == f.emcy_off, f"error reset {m}"
+    if f.pdo_alarm is not None:
+        byte, mask = f.pdo_alarm
+        m = dut.frames.wait_for(facts.tpdo_cob.of(n), timeout=2,
+                                pred=lambda m: not m.data[byte] & mask)
+        assert m is not None, "alarm not cleared"
+
+
+def test_save_restart_keeps_value(dut, facts):
+    dut.power_on(facts.nodes)
+    n = facts.nodes[0]
+    write_set(dut, n, facts, facts.set_a)
+    down(dut, n, 0x1010, 1, SAVE)
+    write_set(dut, n, facts, facts.set_b)  # after the save: stored only where autosaved
+    assert dut.power_off() == 0
+    dut.power_on(facts.nodes)
+    want = facts.set_b if facts.autosave else facts.set_a
+    got = read_set(dut, n, facts)
+    assert got == want, f"after the restart {got}, saved {want}"
+    assert_no_corrupt_set(dut, n, facts)
+
+
+CUTS = 6  # power cuts during saves, a product and target
+
+
+def test_power_cut_during_save(dut, facts):
+    """SIGKILL while a save is under way: the first cut right after the
+    request, the next ones by bisection between it and the save's answer
+    (a cut before the answer moves the next one later, one after it
+    earlier), so that they close in on the end of the flash writes. After
+    each, power on: the stored set is the old or the new one, whole, and
+    not reported corrupt. (On the microbit tools/emu copies the EEPROM
+    pages to the file every 100 ms, so there a cut acts at the last of those
+    copies, which rarely falls inside the device's own save of about 1 ms.)"""
+    dut.power_on(facts.nodes)
+    n = facts.nodes[0]
+    write_set(dut, n, facts, facts.set_a)
+    dut.frames.clear()
+    t0 = time.monotonic()
+    dut.send(0x600 + n, expedited(0x1010, 1, SAVE))
+    assert dut.frames.wait_for(0x580 + n, timeout=2, pred=lambda m: m.data[0] == 0x60)
+    save_s = time.monotonic() - t0
+    dut.target.settle()
+    old, new = facts.set_a, facts.set_b
+    landed, cuts = 0, []
+    lo, hi, delay = 0.0, save_s, 0.0
+    for _ in range(CUTS):
+        if facts.autosave:
+            # Each write stores itself: the cut hits the last write's store.
+            before = (new[0],) + old[1:]
+            write_set(dut, n, facts, before)
+            dut.target.settle()
+            index, sub, fmt = facts.stored[-1]
+            request = expedited(index, sub, struct.pack(fmt, new[-1]))
+        else:
+            before = old
+            write_set(dut, n, facts, new)
+            request = expedited(0x1010, 1, SAVE)
+        sent = dut.power_cut_after(0x600 + n, request, delay)
+        answered = any(m.arbitration_id == 0x580 + n for m in sent)
+        landed += not answered
+        cuts.append(f"{delay * 1000:.1f}{'a' if answered else ''}")
+        dut.power_on(facts.nodes)
+        got = read_set(dut, n, facts)
+        assert got in (before, new), f"cut {delay * 1000:.1f} ms after the request: " \
+                                     f"stored {got}, want {before} or {new}"
+        assert_no_corrupt_set(dut, n, facts)
+        old, new = got, (old if got == new else new)
+        lo, hi = (lo, delay) if answered else (delay, hi)
+        delay = (lo + hi) / 2
+    print(f"{dut.target.name} {facts.family}: save {save_s * 1000:.1f} ms; cuts at "
+          f"{' '.join(cuts)} ms (a: after the answer); {landed}/{CUTS} before it")
+    assert landed >= 1, "every cut came after the save's answer: this proved nothing"
+
+
+def test_node_id_change(dut, facts):
+    """The product's own way (facts.node_id_change), then a power cycle:
+    the new ID answers, the old one does not, the device's other node
+    keeps its own."""
+    change = facts.node_id_change
+    dut.power_on(facts.nodes)
+    old = facts.nodes[0]
+    new_ids = (change.new_id,) + facts.nodes[1:]
+    for i, step in enumerate(change.steps):
+        last = i == len(change.steps) - 1
+        kind = step[0]
+        if kind == "sdo":
+            down(dut, old, step[1], step[2], step[3])
+        elif kind == "lss-node-id":
+            lss = dut.network.lss
+            lss.send_switch_state_global(LssMaster.CONFIGURATION_STATE)
+            lss.configure_node_id(step[1])
+            lss.store_configuration()
+            lss.send_switch_state_global(LssMaster.WAITING_STATE)
+        elif kind == "nmt":
+            dut.frames.clear()
+            nmt(dut, step[1], old)
+            want = change.new_id if last else old
+            assert boot_up(dut, want) is not None, f"no boot-up of {want:#x} after NMT {step[1]:#x}"
+        elif kind == "power-cycle":
+            assert dut.power_off() == 0
+            dut.power_on(new_ids if last else facts.nodes)
+        else:
+            raise AssertionError(f"unknown step {step}")
+    assert sdo_answers(dut, change.new_id)
+    assert not sdo_answers(dut, old), f"old node-ID {old:#x} still answers"
+    assert up(dut, change.new_id, 0x1000, 0) == struct.pack("<I", facts.device_type)
+    assert dut.power_off() == 0
+    dut.power_on(new_ids)  # stored
+    for other in facts.nodes[1:]:
+        assert sdo_answers(dut, other)
+
+
+def test_facts_cover_every_product():
+    """facts.PRODUCTS has every product the Linux program and the MCU image
+    list know, and no other (so a new product cannot miss this suite)."""
+    assert set(list_products()) == set(PRODUCTS)
+    cmake = (Path(__file__).resolve().parents[2] / "boards" / "products.cmake").read_text()
+    block = cmake[cmake.index("set(CO_MCU_PRODUCTS"):]
+    block = block[:block.index(")\n")]
+    assert set(re.findall(r'^\s*"([a-z0-9-]+) ', block, re.M)) == set(PRODUCTS)
+    for target, ids in CI_PRODUCTS.items():
+        assert set(ids) <= set(PRODUCTS), target
