@@ -25,6 +25,7 @@ import zlib
 
 import can
 import pytest
+from targets import SerialLine
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 EMU = str(ROOT / "tools" / "emu")
@@ -123,7 +124,9 @@ class Emu:
                 chunk = os.read(self.proc.stderr.fileno(), 4096)
                 assert chunk, f"tools/emu ended: {err.decode()}"
                 err += chunk
-        bus = can.Bus(interface="slcan", channel=f"socket://127.0.0.1:{port}", sleep_after_open=0)
+        # The suite's serial line: keeps what the image sent while pyserial
+        # opened the socket (its open() discards it: a lost boot-up).
+        bus = SerialLine(port)
         seen = []
         while (m := bus.recv(timeout=max(0.0, end - time.monotonic()))) is not None:
             seen.append(m)
