@@ -24,6 +24,7 @@
 /* The serial line: SLCAN frames and simulated-input lines (serial_link.h). */
 static serial_link_t link;
 static void put(char c);
+static void wake_sources_init(void);
 
 int main(void);
 void reset_c(void) __attribute__((used)); /* called from the assembly above: LTO must keep it */
@@ -51,6 +52,7 @@ void reset_c(void)
 
 bool board_init(void)
 {
+    wake_sources_init();
     return true;
 }
 
@@ -65,10 +67,64 @@ uint32_t board_now_us(void)
     return MTIME_LO / 10u; /* 10 MHz */
 }
 
+/*
+ * Sleep in WFI until the CLINT's timer reaches the deadline or the UART has
+ * a byte: the core idles (QEMU then uses no host CPU) instead of spinning.
+ * No trap handler: with mstatus.MIE clear, WFI still wakes on an interrupt
+ * that mie enables and that is pending (RISC-V privileged spec, WFI), so
+ * the timer (MTIE) and the PLIC's external line (MEIE, the UART's source
+ * claimed and completed here) only wake the core.
+ */
+#define MTIME_HI (*(volatile uint32_t *)0x0200BFFCu)
+#define MTIMECMP_LO (*(volatile uint32_t *)0x02004000u)
+#define MTIMECMP_HI (*(volatile uint32_t *)0x02004004u)
+#define UART_IER (*(volatile uint8_t *)(UART + 1u))
+#define PLIC_PRIORITY(src) (*(volatile uint32_t *)(0x0C000000u + 4u * (src)))
+#define PLIC_ENABLE0 (*(volatile uint32_t *)0x0C002000u) /* hart 0, M-mode */
+#define PLIC_THRESHOLD0 (*(volatile uint32_t *)0x0C200000u)
+#define PLIC_CLAIM0 (*(volatile uint32_t *)0x0C200004u)
+#define UART_IRQ 10u /* the virt machine's UART0 at the PLIC */
+#define MIE_MTIE (1u << 7)
+#define MIE_MEIE (1u << 11)
+
+static void wake_sources_init(void)
+{
+    UART_IER = 1u; /* received data available */
+    PLIC_PRIORITY(UART_IRQ) = 1u;
+    PLIC_ENABLE0 = 1u << UART_IRQ;
+    PLIC_THRESHOLD0 = 0u;
+    /* Zicsr for this one instruction: -march stays rv32imac, whose
+     * multilib libgcc the images link. */
+    __asm__ volatile(".option push\n.option arch, +zicsr\ncsrs mie, %0\n.option pop"
+                     :
+                     : "r"(MIE_MTIE | MIE_MEIE));
+}
+
 void board_sleep(uint32_t us)
 {
-    uint32_t end = board_now_us() + us;
-    while (co_time_before(board_now_us(), end) && (UART_LSR & 1u) == 0u) {
+    /* The deadline in mtime ticks (10 MHz), 64 bits: at most 1 s ahead. */
+    uint32_t ticks = (us < 1000000u ? us : 1000000u) * 10u;
+    uint32_t hi;
+    uint32_t lo;
+    do {
+        hi = MTIME_HI;
+        lo = MTIME_LO;
+    } while (hi != MTIME_HI);
+    uint32_t dlo = lo + ticks;
+    uint32_t dhi = hi + (dlo < lo ? 1u : 0u);
+    MTIMECMP_LO = 0xFFFFFFFFu; /* no moment with a deadline in the past */
+    MTIMECMP_HI = dhi;
+    MTIMECMP_LO = dlo;
+    uint32_t claimed = PLIC_CLAIM0; /* a UART interrupt seen before: done */
+    if (claimed != 0u) {
+        PLIC_CLAIM0 = claimed;
+    }
+    if ((UART_LSR & 1u) == 0u) {
+        __asm__ volatile("wfi");
+    }
+    claimed = PLIC_CLAIM0;
+    if (claimed != 0u) {
+        PLIC_CLAIM0 = claimed;
     }
 }
 
