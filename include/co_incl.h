@@ -28,9 +28,12 @@
 #define CO_INCL_OP_INVERT 0x01u
 #define CO_INCL_OP_SCALING 0x02u
 
-/* Stored parameters; products embed this in their PARA struct. */
+/* Stored parameters; products embed this in their PARA struct. Word
+ * aligned (16 bytes, no padding): the slope cache compares it with four
+ * word loads (co_incl_para_same). The products' PARA structs already had
+ * it at a multiple of 4, so no stored layout moved. */
 typedef struct co_incl_para {
-    uint16_t resolution;
+    _Alignas(4) uint16_t resolution;
     uint8_t op[2];
     int16_t preset[2];
     int16_t offset[2];
@@ -73,6 +76,30 @@ void co_incl_sample(co_incl_t *incl, const int32_t mdeg[2]);
 /* co_incl_slope's slow path: recompute the outputs, return one. */
 int16_t co_incl_refresh_slope(co_incl_t *incl, unsigned axis);
 
+_Static_assert(sizeof(co_incl_para_t) == 16u, "co_incl_para_t: four words, no padding");
+
+/* *a equals *b. On a 32-bit core four word compares, not memcmp: there
+ * memcmp is libc_min.c's byte loop, 135 Cortex-M0 instructions per slope
+ * read; the words brought the DST TPDO from 605 to 391 instructions and the
+ * expedited SDO read from 633 to 526 (issue 11), for 8 bytes of flash. */
+static inline bool co_incl_para_same(const co_incl_para_t *a, const co_incl_para_t *b)
+{
+#if defined(__GNUC__) && UINTPTR_MAX <= 0xFFFFFFFFu
+    const co_word_t *x = (const co_word_t *)(const void *)a;
+    const co_word_t *y = (const co_word_t *)(const void *)b;
+    for (unsigned i = 0; i < sizeof(*a) / 4u; i++) {
+        if (x[i] != y[i]) {
+            return false;
+        }
+    }
+    return true;
+#else
+    /* 64-bit hosts: the compiler expands this memcmp into two 8-byte
+     * compares (x86-64: 12 instructions, the word loop took 31). */
+    return memcmp(a, b, sizeof(*a)) == 0;
+#endif
+}
+
 /* The slope object (0x6010 axis 0, 0x6020 axis 1) in resolution units.
  * Recomputed only when a parameter changed since the last sample:
  * parameters reach p through plain dictionary writes and the store too,
@@ -82,7 +109,7 @@ static inline int16_t co_incl_slope(co_incl_t *incl, unsigned axis)
     if (axis >= incl->axes) {
         return 0;
     }
-    if (memcmp(&incl->seen, incl->p, sizeof(incl->seen)) != 0) {
+    if (!co_incl_para_same(&incl->seen, incl->p)) {
         return co_incl_refresh_slope(incl, axis);
     }
     return incl->out[axis];
@@ -93,7 +120,7 @@ static inline int16_t co_incl_slope(co_incl_t *incl, unsigned axis)
 co_res_t co_incl_refresh_read(co_incl_t *incl, unsigned axis, uint32_t *v);
 static inline co_res_t co_incl_read(co_incl_t *incl, unsigned axis, uint32_t *v)
 {
-    if (axis < incl->axes && memcmp(&incl->seen, incl->p, sizeof(incl->seen)) == 0) {
+    if (axis < incl->axes && co_incl_para_same(&incl->seen, incl->p)) {
         *v = (uint32_t)(int32_t)incl->out[axis];
         return CO_OK;
     }
