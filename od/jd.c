@@ -51,26 +51,56 @@ static int32_t isin(int32_t mdeg)
     return sign * (lo + (hi - lo) * f / 1000);
 }
 
+/* Non-negative a mod m (m > 0). Within one turn either side, which is
+ * where a slope's terms are (normalised offsets, a measured angle of
+ * 0..N), without a division: the JD1's slope read (every PDO) divided
+ * three times before. */
 static int32_t mod_pos(int32_t a, int32_t m)
 {
+    if (a >= -m && a < m) {
+        return a < 0 ? a + m : a;
+    }
     int32_t r = a % m;
     return r < 0 ? r + m : r;
 }
 
-/* One turn in resolution units (JD1 wrap). */
-static int32_t turn_lsb(const jd_dev_t *d)
+/* The angles in resolution units and one turn in them: divided once per
+ * sample (jd_sample) and once per change of 0x6000, never per read. A
+ * SYNC with both JD2 TPDOs read four slopes and divided four times: 1,284
+ * of its 2,465 instructions on the Cortex-M0 went to the division helper.
+ * The resolution the figures hold is kept with them: 0x6000 reaches the
+ * parameters through its hook, a restore and a load alike, so a read
+ * compares rather than relies on every writer telling us. */
+static void remeasure(jd_dev_t *d)
 {
-    return TURN / (int32_t)d->para.resolution;
+    int32_t res = (int32_t)d->para.resolution;
+    d->meas_res = d->para.resolution;
+    d->meas_turn = TURN / res;
+    for (unsigned a = 0; a < 2u; a++) {
+        d->meas[a] = co_div_round(d->raw[a], res); /* rounded (R57) */
+    }
+}
+
+/* One turn in resolution units (JD1 wrap). */
+static int32_t turn_lsb(jd_dev_t *d)
+{
+    if (d->meas_res != d->para.resolution) {
+        remeasure(d);
+    }
+    return d->meas_turn;
 }
 
 /* Physical angle in resolution units, rounded (R57). */
-static int32_t measure(const jd_dev_t *d, unsigned axis)
+static int32_t measure(jd_dev_t *d, unsigned axis)
 {
-    return co_div_round(d->raw[axis], (int32_t)d->para.resolution);
+    if (d->meas_res != d->para.resolution) {
+        remeasure(d);
+    }
+    return d->meas[axis];
 }
 
 /* JD1 offsets live in (-N/2, N/2] (R54). */
-static int32_t norm_offset(const jd_dev_t *d, int32_t off)
+static int32_t norm_offset(jd_dev_t *d, int32_t off)
 {
     if (d->axes != 1u) {
         return off;
@@ -93,7 +123,7 @@ static int32_t clamp32(int64_t v)
 /* The largest differential offset, in resolution units: JD1 (-N/2, N/2]
  * (6114h: -17999..18000 at 0.01 deg, L1783-1791), JD2 +-90 deg (the
  * spec's recommendation; the manual gives none). Beyond: 0x06090030. */
-static bool diff_ok(const jd_dev_t *d, int32_t v)
+static bool diff_ok(jd_dev_t *d, int32_t v)
 {
     if (d->axes == 1u) {
         int32_t half = turn_lsb(d) / 2;
@@ -104,7 +134,7 @@ static bool diff_ok(const jd_dev_t *d, int32_t v)
 }
 
 /* The slope of one axis, 16- or 32-bit flavour (R51, R53, R54, R56). */
-static int32_t slope(const jd_dev_t *d, unsigned axis, bool wide)
+static int32_t slope(jd_dev_t *d, unsigned axis, bool wide)
 {
     if (axis >= d->axes) {
         return 0; /* JD1: 6020h / 6120h read 0 (L1671) */
@@ -125,7 +155,11 @@ static int32_t slope(const jd_dev_t *d, unsigned axis, bool wide)
         /* 0..N-1: each term reduced first, so the sum never overflows
          * whatever a stored offset holds (N <= 36000). */
         int32_t n = turn_lsb(d);
-        return mod_pos(mod_pos(v, n) + mod_pos(off, n) + mod_pos(diff, n), n);
+        int32_t sum = mod_pos(v, n) + mod_pos(off, n) + mod_pos(diff, n);
+        while (sum >= n) { /* below 3N: at most two passes, no division */
+            sum -= n;
+        }
+        return sum;
     }
     /* Saturated, never wrapped: the output stops at the type's end (R53:
      * "clamp only to the data type's range"). */
@@ -422,6 +456,12 @@ void jd_sample(void *mem, const int32_t values[], uint32_t faults)
             d->maf_sum[0] -= shift * (int32_t)d->maf_fill;
             d->raw[0] -= shift;
         }
+    }
+    /* A board samples once before the node's first reset loads the
+     * parameters (resolution 0 then): the first read after it computes. */
+    d->meas_res = 0;
+    if (d->para.resolution != 0u) {
+        remeasure(d);
     }
     /* Rates (0.1 deg/s) from the 5 ms sample period, accelerations (mg). */
     int32_t x = values[0];
