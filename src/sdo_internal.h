@@ -31,6 +31,8 @@ enum {
 
 /* Answer, abort and bookkeeping helpers of the server. */
 void co_sdo_reply(co_node_t *node, const uint8_t d[8]);
+/* Send f as the server's answer: f->data filled by the caller, all 8 bytes. */
+void co_sdo_send(co_node_t *node, co_frame_t *f);
 void co_sdo_reply_head(co_node_t *node, uint8_t cmd, const uint8_t *req, uint32_t val);
 void co_sdo_abort(co_node_t *node, const uint8_t *mux, co_res_t r);
 void co_sdo_mux(const co_sdo_t *sdo, uint8_t mux[4]);
