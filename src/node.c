@@ -28,17 +28,14 @@ const co_od_entry_t *co_node_entry(const co_node_t *node, uint16_t index, uint8_
     return co_od_find(co_cfg(node)->od, index, sub, NULL);
 }
 
-bool co_node_send(co_node_t *node, const co_frame_t *f)
+/* co_node_send (co_node.h): a controller in bus-off transmits nothing until
+ * it has seen 128 x 11 recessive bits and is error active again (ISO
+ * 11898-1; the board reports it): what falls due meanwhile is dropped, not
+ * queued for a burst on recovery. */
+bool co_node_tx_drop(co_node_t *node)
 {
-    /* A controller in bus-off transmits nothing until it has seen 128 x 11
-     * recessive bits and is error active again (ISO 11898-1; the board
-     * reports it): what falls due meanwhile is dropped, not queued for a
-     * burst on recovery. */
-    if (node->can_state == CO_CAN_BUSOFF || !co_port_can_send(node->port, f)) {
-        node->tx_dropped++;
-        return false;
-    }
-    return true;
+    node->tx_dropped++;
+    return false;
 }
 
 /* A restore, and the check of a record's values (co_store.h). */
