@@ -50,7 +50,7 @@ typedef struct co_tpdo {
     uint8_t map_drop[CO_PDO_MAP_MAX]; /* 32 - bits of each: the high bits not sent */
     uint8_t len;           /* mapped bytes */
     uint8_t dlc;           /* of its frames: len, or 8 where the product pads */
-    uint8_t last[8];
+    _Alignas(4) uint8_t last[8]; /* word aligned: copied in words (tpdo.c) */
 } co_tpdo_t;
 
 /* Re-read parameters and mapping of TPDO n (0-based) from the dictionary. */
