@@ -6,9 +6,10 @@ Usage: m0count.py [--qemu QEMU] [--nm NM] [--calls N] [--expect K] ELF FUNCTION
 Runs ELF (a bare-metal image for qemu-system-arm's "microbit" machine that
 ends itself over semihosting, like the qemu unit tests) with QEMU's
 instruction trace: -singlestep makes every translation block one
-instruction, -d exec logs one "Trace" line per executed block and nochain
-stops QEMU from jumping block to block without logging (QEMU 7.2 here;
-QEMU 8.1 and later spell -singlestep "-accel tcg,one-insn-per-tb=on").
+instruction, -d exec logs one "Trace" line per executed block (its PC is
+the second field in brackets) and nochain stops QEMU from jumping block to
+block without logging. Checked on QEMU 7.2; from 8.1 the option is
+"-accel tcg,one-insn-per-tb=on", chosen by QEMU's version.
 
 A call starts at the line whose PC is FUNCTION's entry address (from the
 ELF's symbol table) and ends at the first line back in the function that
@@ -42,6 +43,16 @@ def functions(nm, elf):
             funcs.append((start, start + int(f[1], 16), f[3]))
     funcs.sort()
     return funcs
+
+
+def one_insn_per_tb(qemu):
+    """QEMU's option for one instruction per translation block: -singlestep
+    until 8.1, which renamed it (and later releases dropped the old name)."""
+    out = subprocess.run([qemu, "--version"], check=True, capture_output=True, text=True).stdout
+    m = re.search(r"version (\d+)\.(\d+)", out)
+    if m and (int(m.group(1)), int(m.group(2))) >= (8, 1):
+        return ["-accel", "tcg,one-insn-per-tb=on"]
+    return ["-singlestep"]
 
 
 def count(pcs, entry, funcs):
@@ -98,7 +109,7 @@ def main():
         with open(os.path.join(tmp, "out"), "w+") as out:
             qemu = subprocess.Popen([a.qemu, "-M", "microbit", "-display", "none", "-monitor", "none",
                                      "-serial", "none", "-semihosting-config", "enable=on,target=native",
-                                     "-singlestep", "-d", "exec,nochain", "-D", trace,
+                                     *one_insn_per_tb(a.qemu), "-d", "exec,nochain", "-D", trace,
                                      "-kernel", a.elf], stdout=out, stderr=subprocess.STDOUT)
             with open(trace, "rb") as f:
                 pcs = (int(m.group(1), 16) for m in map(TRACE.match, f) if m)
