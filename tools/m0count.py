@@ -27,6 +27,7 @@ import re
 import subprocess
 import sys
 import tempfile
+import threading
 
 TRACE = re.compile(rb"^Trace \d+: \S+ \[[0-9a-f]+/([0-9a-f]+)/")
 
@@ -111,10 +112,24 @@ def main():
                                      "-serial", "none", "-semihosting-config", "enable=on,target=native",
                                      *one_insn_per_tb(a.qemu), "-d", "exec,nochain", "-D", trace,
                                      "-kernel", a.elf], stdout=out, stderr=subprocess.STDOUT)
+            # Bounded: QEMU is killed after 300 s; and when it ends before
+            # opening the trace, opening it here for writing releases the
+            # reader below (it reads nothing and the failure is reported).
+            def watch():
+                try:
+                    qemu.wait(timeout=300)
+                except subprocess.TimeoutExpired:
+                    qemu.kill()
+                    qemu.wait()
+                try:
+                    os.close(os.open(trace, os.O_WRONLY | os.O_NONBLOCK))
+                except OSError:
+                    pass  # the reader is gone already
+            threading.Thread(target=watch, daemon=True).start()
             with open(trace, "rb") as f:
                 pcs = (int(m.group(1), 16) for m in map(TRACE.match, f) if m)
                 calls, traced = count(pcs, entries[0], funcs)
-            status = qemu.wait(timeout=300)
+            status = qemu.wait()
             if status != 0:
                 out.seek(0)
                 sys.stderr.write(out.read())
