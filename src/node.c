@@ -89,12 +89,15 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
         }
     }
     /* The active bit-rate code reaches the controller: at start, and after
-     * a reset that activated another one (an unusable code: 0 kbit/s, the
-     * board's default; a config without a table: 0 too). Codes are 0..15
+     * a reset that activates codes (reset node; reset communication where
+     * it applies the node-ID set) and activated another one (an unusable
+     * code: 0 kbit/s, the board's default; a config without a table: 0
+     * too). Any other reset communication leaves the rate alone: an LSS
+     * "activate bit timing" holds until then (CiA 305). Codes are 0..15
      * (co_node_cfg_t.kbps): stored ones are range-checked on restore. */
     const uint16_t *table = co_cfg(node)->kbps;
     uint16_t kbps = table != NULL ? table[node->bitrate & 15u] : 0u; /* 16 codes */
-    if (kbps != node->can_kbps) {
+    if ((kind == CO_RESET_NODE || co_cfg(node)->comm_reset_applies_id) && kbps != node->can_kbps) {
         node->can_kbps = kbps;
         (void)co_port_can_bitrate(node->port, kbps);
     }

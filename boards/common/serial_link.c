@@ -18,10 +18,15 @@ void serial_link_init(serial_link_t *s, const product_t *p)
 
 /* ---- output --------------------------------------------------------------- */
 
+/* Printable ASCII only: an answer echoes parts of a rejected line, and a
+ * byte such as BEL (an SLCAN line end for python-can) or one above 0x7E
+ * (no text to python-can's decoder) would forge or break the master's
+ * reading of the line. Anything else goes out as '?' (a quoted line holds
+ * no CR: it ended there). */
 static void put_str(serial_put_fn put, const char *t)
 {
-    while (*t != '\0') {
-        put(*t++);
+    for (; *t != '\0'; t++) {
+        put((*t >= ' ' && *t <= '~') || *t == '\r' ? *t : '?'); /* '\r': ours, ends a line */
     }
 }
 
@@ -354,7 +359,9 @@ bool serial_link_rx(serial_link_t *s, char c, co_frame_t *f, serial_put_fn put)
         slcan = hex_value(s->line[i]) >= 0;
     }
     if (slcan) {
-        return !bad && n <= 21u && frame_line(s, n, f);
+        /* A controller in bus-off receives nothing either (as the Linux
+         * program's): frames of that time are lost. */
+        return !bad && n <= 21u && s->can_state != CO_CAN_BUSOFF && frame_line(s, n, f);
     }
     if (bad) {
         return fail(put, why, "", "");

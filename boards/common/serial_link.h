@@ -12,7 +12,8 @@
  *   can passive|warning|active       the controller's error state
  *
  * Each input line is answered on the line with "ok" or "error: <cause>"
- * (python-can's slcan ignores lines that are not frames). A bad line is
+ * (python-can's slcan ignores lines that are not frames; an answer holds
+ * printable ASCII only, '?' for any other byte of the line it quotes). A bad line is
  * rejected whole: nothing of it changes anything.
  *
  * Which is which: SLCAN lines are one command letter and hex digits ("t"
@@ -22,7 +23,8 @@
  * unknown command). Of the SLCAN lines, standard data and remote frames
  * ("t", "r") are received; extended frames and adapter commands (open,
  * close, bit rate, version) are ignored: the board is the CAN side, it has
- * no adapter to configure. A line is at most SERIAL_LINE_MAX characters;
+ * no adapter to configure; while the simulated controller is bus-off,
+ * received frames are lost. A line is at most SERIAL_LINE_MAX characters;
  * a longer one, or one with a NUL byte, is dropped whole (an input line:
  * answered "error").
  *

@@ -365,6 +365,7 @@ def test_rv32_read_only_flash_reads_but_refuses_saves(emus, tmp_path):
     (["--board", "rv32-virt", "--product", PRODUCT, "--port", "1", "--image", "/nonexistent.elf"],
      "cmake --build build-rv32-virt --target fw-" + PRODUCT),
     (["--board", "rv32-virt", "--product", PRODUCT], "required"),
+    (["--board", "microbit", "--product", PRODUCT, "--port", "1", "--flash", ""], "empty path"),
 ])
 def test_usage_errors(args, message):
     r = subprocess.run([EMU] + args, capture_output=True, text=True, timeout=30)
@@ -392,6 +393,21 @@ def test_refuses_busy_port_bad_flash_and_shared_flash(emus, tmp_path):
                         str(free_port()), "--flash", str(flash)], capture_output=True, text=True,
                        timeout=30)
     assert r.returncode == 2 and "in use by another emulator" in r.stderr
+
+
+def test_flash_path_with_a_comma_through_a_symbolic_link(board, emus, tmp_path):
+    """A comma is no QEMU option separator in the path, and a symbolic link
+    leads to its file: the save lands in the real file, the link stays."""
+    real = tmp_path / "a,b.bin"
+    link = tmp_path / "link.bin"
+    link.symlink_to(real)
+    e = emus(link, board)
+    sdo = e.start()
+    set_heartbeat(sdo, 1234)
+    save(sdo)
+    assert e.stop() == 0
+    assert link.is_symlink() and real.is_file()
+    assert slots(real, board)[:2].count("valid") == 1
 
 
 def test_help_documents_the_interface():

@@ -196,6 +196,10 @@ static void test_lss_activate_bit_timing(void)
     CHECK_EQ(d->port.bitrate_calls, calls + 1u);
     h_rx(d, 0x7E5, "04 00 00 00 00 00 00 00");
     h_drain(d);
+    h_rx(d, 0x000, "82 0A"); /* reset communication: the activated rate holds */
+    EXPECT(d, 0x70A, "00");
+    CHECK_EQ(d->port.kbps, 500);
+    CHECK_EQ(d->port.bitrate_calls, calls + 1u);
     h_rx(d, 0x000, "81 0A"); /* not stored: reset node goes back to 125 k */
     EXPECT(d, 0x70A, "00");
     CHECK_EQ(d->port.kbps, 125);

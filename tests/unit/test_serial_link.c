@@ -146,6 +146,12 @@ static void test_set(void)
     CHECK(same(out, "error: usage: set NAME=VALUE [NAME=VALUE...]\r"));
     CHECK_EQ(FEED("set x=.5\r", &f), 0); /* no integer digits: still a number */
     CHECK_EQ(s.values[0], 500);
+    /* An answer quotes printable ASCII only: BEL would end an SLCAN line
+     * for python-can (a forged frame), 0xB0 breaks its text decoding. */
+    CHECK_EQ(FEED("set x=12,5\xb0 \a\r", &f), 0);
+    CHECK(same(out, "error: '12,5?': not a number within +-3600 (3 decimals at most)\r"));
+    CHECK_EQ(FEED("\at1FF8AABBCCDDEEFF0011 z\r", &f), 0);
+    CHECK(same(out, "error: unknown command '?t1FF8AABBCCDDEEFF0011' (set, fault, can)\r"));
 }
 
 static void test_fault_and_unknown(void)
@@ -219,7 +225,9 @@ static void test_can_state_and_bitrate(void)
     CHECK_EQ(serial_link_can_state(&s, t0 + 501408u), CO_CAN_ACTIVE);
     CHECK_EQ(FEED("can bus-off\r", &f), 0);
     CHECK_EQ(serial_link_can_state(&s, 0), CO_CAN_BUSOFF);
+    CHECK_EQ(FEED("t0002010A\r", &f), 0); /* bus-off: no frame received */
     CHECK_EQ(serial_link_can_state(&s, 1408), CO_CAN_ACTIVE);
+    CHECK_EQ(FEED("t0002010A\r", &f), 1); /* back on the bus */
     static const char *const bad[] = {"can bus-off 61", "can bus-off -1", "can passive 1",
                                       "can nothing", "can", "can bus-off 1 2"};
     for (unsigned i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
