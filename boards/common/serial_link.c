@@ -16,6 +16,18 @@ void serial_link_init(serial_link_t *s, const product_t *p)
     }
 }
 
+void serial_link_sample(serial_link_t *s, const product_t *p, int32_t values[],
+                        uint32_t *faults)
+{
+    if (s->prod != p) {
+        serial_link_init(s, p);
+    }
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
+        values[i] = s->values[i];
+    }
+    *faults = s->faults;
+}
+
 /* ---- output --------------------------------------------------------------- */
 
 /* Printable ASCII only: an answer echoes parts of a rejected line, and a

@@ -59,6 +59,13 @@ typedef struct serial_link {
 /* Start with the product's initial input values, no fault, error active. */
 void serial_link_init(serial_link_t *s, const product_t *p);
 
+/* What a board's board_sensor() returns: the true inputs and faults the
+ * line set for product p (its initial values until a `set` line). The
+ * first call, made before the node starts (mcu_main.c), starts the link
+ * for p, so that a board needs no product at board_init(). */
+void serial_link_sample(serial_link_t *s, const product_t *p, int32_t values[],
+                        uint32_t *faults);
+
 /* Feed one received character. Returns true when it completed a received
  * frame line, which is then in *f. An input line is applied and answered
  * through put(). */

@@ -163,17 +163,10 @@ void board_leds(bool green, bool red)
     (void)red; /* no LEDs on the virt machine */
 }
 
-/* The true inputs as the serial line set them (the product's initial
- * values until a `set` line). */
+/* The true inputs as the serial line set them (serial_link_sample). */
 void board_sensor(const product_t *p, int32_t values[], uint32_t *faults)
 {
-    if (link.prod != p) {
-        serial_link_init(&link, p);
-    }
-    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
-        values[i] = link.values[i];
-    }
-    *faults = link.faults;
+    serial_link_sample(&link, p, values, faults);
 }
 
 /* ---- flash EEPROM ---------------------------------------------------------- */

@@ -241,8 +241,31 @@ static void test_can_state_and_bitrate(void)
     }
 }
 
+/* What board_sensor() returns: the product's initial values until a
+ * `set`; the first sample starts the link for its product. */
+static void test_sample(void)
+{
+    serial_link_t t = {0};
+    int32_t v[PRODUCT_MAX_INPUTS];
+    uint32_t faults = 99;
+    serial_link_sample(&t, &gsh_a, v, &faults);
+    CHECK(t.prod == &gsh_a);
+    CHECK_EQ(v[0], gsh_a.inputs[0].initial);
+    CHECK_EQ(faults, 0);
+    co_frame_t f;
+    for (const char *c = "fault tilt-element on\r"; *c != '\0'; c++) {
+        CHECK(!serial_link_rx(&t, *c, &f, put));
+    }
+    serial_link_sample(&t, &gsh_a, v, &faults);
+    CHECK_EQ(faults, 2u);
+    serial_link_sample(&t, &jd2xxx, v, &faults); /* another product: started anew */
+    CHECK_EQ(faults, 0);
+    CHECK_EQ(v[2], jd2xxx.inputs[2].initial);
+}
+
 int main(void)
 {
+    RUN(test_sample);
     RUN(test_frames_in);
     RUN(test_frames_out);
     RUN(test_set);
