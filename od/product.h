@@ -16,8 +16,6 @@
 #define PRODUCT_MAX_NODES 2u
 /* Largest number of simulated inputs ("x", "y", ...). */
 #define PRODUCT_MAX_INPUTS 4u
-/* Bytes of the largest product instance; checked by each product. */
-#define PRODUCT_INST_MAX 4096u
 
 typedef struct product product_t;
 

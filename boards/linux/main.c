@@ -30,6 +30,7 @@
 #include "leds.h"
 #include "port.h"
 #include "product.h"
+#include "product_registry.h"
 #include "sim.h"
 
 static void usage(FILE *f)
@@ -450,7 +451,7 @@ int main(int argc, char **argv)
     }
 
     /* The instance: on this stack frame, alive until main returns. */
-    _Alignas(max_align_t) unsigned char mem[PRODUCT_INST_MAX];
+    _Alignas(max_align_t) unsigned char mem[sizeof(product_any_t)];
     if (a.prod->inst_size > sizeof(mem)) {
         return start_failure(logf, 1, "product instance too large");
     }

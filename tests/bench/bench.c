@@ -31,6 +31,7 @@
 #include "dst.h"
 #include "jd.h"
 #include "pf.h"
+#include "product_registry.h"
 
 static co_frame_t last;
 static unsigned long sent;
@@ -72,7 +73,7 @@ bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
     return true;
 }
 
-static _Alignas(8) unsigned char mem[PRODUCT_INST_MAX];
+static _Alignas(8) unsigned char mem[sizeof(product_any_t)];
 
 static co_node_t *boot(const product_t *p)
 {

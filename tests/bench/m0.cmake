@@ -2,7 +2,7 @@
 # their instructions under qemu-system-arm): tests/bench/bench.c, one image
 # per operation, each linked with the stack and its product family built
 # as that product's MCU image is (boards/CMakeLists.txt: the product's fixed
-# node config and table sizes from boards/products.cmake, no object names,
+# node config and table sizes from od/<family>/family.cmake, no object names,
 # no simulated faults; -Os, LTO, Thumb-1 from cmake/arm-none-eabi.cmake;
 # boards/common/libc_min.c and aeabi_div.c), started and ended like the
 # qemu unit tests (co_bare_io: startup.c, semihosting). Included by
@@ -27,18 +27,18 @@ foreach(entry ${CO_BENCH_OPS})
   list(GET f 2 cfg)
   set(lib co_bench_fw_${cfg})
   if(NOT TARGET ${lib})
-    # The family of the config, by the header products.cmake names for it.
-    set(header)
+    # The family of the config, as its declaration names it (od/<family>/family.cmake).
+    set(fam)
     foreach(c ${CO_MCU_FIXED_CFGS})
       separate_arguments(cf UNIX_COMMAND "${c}")
       list(GET cf 0 c0)
       if(c0 STREQUAL cfg)
-        list(GET cf 1 header)
+        list(GET cf 1 fam)
       endif()
     endforeach()
-    list(TRANSFORM CO_FAMILY_${header} PREPEND ${CMAKE_SOURCE_DIR}/ OUTPUT_VARIABLE family)
-    add_library(${lib} STATIC ${CO_STACK_SOURCES} ${CMAKE_SOURCE_DIR}/od/products.c ${family})
-    target_include_directories(${lib} PUBLIC ${CMAKE_SOURCE_DIR}/include ${CMAKE_SOURCE_DIR}/od)
+    add_library(${lib} STATIC ${CO_STACK_SOURCES} ${CMAKE_SOURCE_DIR}/od/bitrates.c
+      ${CO_FAMILY_SOURCES_${fam}})
+    target_include_directories(${lib} PUBLIC ${CMAKE_SOURCE_DIR}/include ${CO_PRODUCT_INCLUDES})
     target_compile_options(${lib} PRIVATE ${CO_BARE_FLAGS})
     target_compile_definitions(${lib} PUBLIC CO_OD_NO_NAMES CO_NO_SIM_INPUT
       CO_FIXED_CFG=${cfg} ${CO_MCU_SIZES_${cfg}})

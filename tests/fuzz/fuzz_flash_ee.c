@@ -42,6 +42,7 @@
 #include "fuzz_format.h"
 #include "fuzz_input.h"
 #include "product.h"
+#include "product_registry.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -153,7 +154,7 @@ static flash_ee_t g_fe = {.ops = &sim_ops, .ctx = NULL};
 /* ---- the device ------------------------------------------------------------ */
 
 typedef struct dev {
-    _Alignas(max_align_t) unsigned char mem[PRODUCT_INST_MAX];
+    _Alignas(max_align_t) unsigned char mem[sizeof(product_any_t)];
     co_node_t *nodes[PRODUCT_MAX_NODES];
     unsigned nnodes;
     uint32_t now;

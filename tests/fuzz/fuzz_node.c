@@ -61,6 +61,7 @@
 #include "fuzz_format.h"
 #include "fuzz_input.h"
 #include "product.h"
+#include "product_registry.h"
 #include "sdo_internal.h"
 
 /* libFuzzer's entry points. */
@@ -120,7 +121,7 @@ typedef struct watch {
 } watch_t;
 
 struct dev {
-    _Alignas(max_align_t) unsigned char mem[PRODUCT_INST_MAX];
+    _Alignas(max_align_t) unsigned char mem[sizeof(product_any_t)];
     const product_t *prod;
     co_node_t *nodes[PRODUCT_MAX_NODES];
     unsigned nnodes;

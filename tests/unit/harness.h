@@ -13,6 +13,7 @@
 
 #include "co_node.h"
 #include "product.h"
+#include "product_registry.h"
 
 #ifdef HARNESS_BARE
 #include "bare_io.h" /* printf and friends over semihosting (tests/qemu) */
@@ -44,7 +45,7 @@ extern int h_checks;
 /*
  * Runs one test function and reports it ("ok", "FAIL").
  * A build of one fixed node config (CO_FIXED_CFG with its table sizes, as
- * an MCU image: boards/products.cmake) runs its family's tests: a test
+ * an MCU image: od/<family>/family.cmake) runs its family's tests: a test
  * that boots a product of another config ends at that boot (h_boot jumps
  * back into h_run) and is reported "n/a" with the product; what it checked
  * before counts. h_finish() fails a build where no test applied.
@@ -79,9 +80,9 @@ extern unsigned h_tx_high_water;
 #ifndef FAKE_NVM_SIZE
 #define FAKE_NVM_SIZE 2048u
 #endif
-#ifndef H_INST_MAX
-#define H_INST_MAX PRODUCT_INST_MAX /* instance bytes of a device under test */
-#endif
+/* Instance bytes of a device under test: the largest family's instance
+ * (the union of every family's instance type, from their declarations). */
+#define H_INST_MAX sizeof(product_any_t)
 
 typedef struct fake_port {
     co_frame_t tx[FAKE_TX_MAX]; /* ring of sent frames, index = count % FAKE_TX_MAX */

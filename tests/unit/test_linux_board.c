@@ -317,7 +317,7 @@ static void test_eeprom_corrupt_untouched(void)
     }
     write_file(path, junk, sizeof(junk));
     log_start();
-    _Alignas(max_align_t) unsigned char inst[PRODUCT_INST_MAX];
+    _Alignas(max_align_t) unsigned char inst[sizeof(product_any_t)];
     uint8_t mem[CO_STORE_NVM_SIZE];
     lp_nvm_t n;
     char err[600];
@@ -413,7 +413,7 @@ static void test_sim_bus_off(void)
     int sv[2];
     CHECK(socketpair(AF_UNIX, SOCK_DGRAM | SOCK_NONBLOCK, 0, sv) == 0);
     log_start();
-    _Alignas(max_align_t) unsigned char inst[PRODUCT_INST_MAX];
+    _Alignas(max_align_t) unsigned char inst[sizeof(product_any_t)];
     uint8_t mem[CO_STORE_NVM_SIZE];
     lp_nvm_t n;
     char err[600];

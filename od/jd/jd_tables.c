@@ -136,7 +136,6 @@ static const co_od_t jd2_od = {.entries = jd2_entries, .count = sizeof(jd2_entri
 static const co_od_t jd1_od = {.entries = jd1_entries, .count = sizeof(jd1_entries) / sizeof(jd1_entries[0])};
 
 _Static_assert(sizeof(jd_para_t) <= CO_STORE_MAX_DATA, "PARA set must fit one store slot");
-_Static_assert(sizeof(jd_dev_t) <= PRODUCT_INST_MAX, "instance must fit PRODUCT_INST_MAX");
 
 /* CiA 305 bit-timing indices 0-4, 6, 7 (not 5 = reserved, not 8 = 10k) (R46). */
 #define JD_LSS_BITRATES 0x00DFu

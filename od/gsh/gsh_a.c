@@ -73,7 +73,6 @@ static const co_od_t ch1_od = {.entries = ch1_entries, .count = sizeof(ch1_entri
 static const co_od_t ch2_od = {.entries = ch2_entries, .count = sizeof(ch2_entries) / sizeof(ch2_entries[0])};
 
 _Static_assert(sizeof(gsh_para_t) <= CO_STORE_MAX_DATA, "PARA set must fit one store slot");
-_Static_assert(sizeof(gsh_dev_t) <= PRODUCT_INST_MAX, "instance must fit PRODUCT_INST_MAX");
 
 #define GSH_CFG(odp, id)                                                             \
     {.od = (odp), .ops = &gsh_ops, .led = NULL,                                        \

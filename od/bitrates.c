@@ -1,5 +1,5 @@
 /*
- * products.c - bit-rate code tables shared by the products.
+ * bitrates.c - the bit-rate code tables of the manuals, shared by the products.
  */
 #include "product.h"
 

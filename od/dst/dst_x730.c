@@ -83,7 +83,6 @@ static const co_od_t x730_od = {
 
 _Static_assert(sizeof(dst_para_t) <= CO_STORE_MAX_DATA, "PARA set must fit one store slot");
 _Static_assert(sizeof(co_lss_para_t) <= CO_STORE_MAX_DATA, "LSS set must fit one store slot");
-_Static_assert(sizeof(dst_dev_t) <= PRODUCT_INST_MAX, "instance must fit PRODUCT_INST_MAX");
 
 const co_node_cfg_t dst_x730_cfg = {
     .od = &x730_od,

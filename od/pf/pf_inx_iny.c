@@ -82,7 +82,6 @@ static const co_od_t inx_od = {.entries = inx_entries, .count = sizeof(inx_entri
 static const co_od_t iny_od = {.entries = iny_entries, .count = sizeof(iny_entries) / sizeof(iny_entries[0])};
 
 _Static_assert(sizeof(pf_para_t) <= CO_STORE_MAX_DATA, "PARA set must fit one store slot");
-_Static_assert(sizeof(pf_dev_t) <= PRODUCT_INST_MAX, "instance must fit PRODUCT_INST_MAX");
 
 static const co_service_t *const pf_services[] = {&co_guard_service, &co_rtr_service, NULL};
 
