@@ -54,6 +54,24 @@ typedef enum co_can_state {
 typedef uint32_t __attribute__((may_alias)) co_word_t;
 #endif
 
+/*
+ * Programming errors: a caller breaking a function's documented contract
+ * (an index past a table, a size switch out of range is an #error instead).
+ * CO_CHECK(cond) is cond, for an if that leaves the function the way its
+ * header documents for the invalid argument (nothing done, or an error
+ * result): defined behaviour in every build, no crash in an image. Where the
+ * build defines CO_ASSERT_HOOK (the unit tests, the fuzzers) a false cond
+ * also calls co_assert_failed(), which the test harness counts as a failed
+ * check unless the test expects it (tests/unit/harness.h, h_expect_assert).
+ *     if (!CO_CHECK(n < CO_TPDO_MAX)) { return CO_E_PARAM; }
+ */
+#ifdef CO_ASSERT_HOOK
+void co_assert_failed(const char *cond, const char *file, int line);
+#define CO_CHECK(cond) ((cond) ? true : (co_assert_failed(#cond, __FILE__, __LINE__), false))
+#else
+#define CO_CHECK(cond) ((cond) ? true : false)
+#endif
+
 /* "No deadline" returned by poll functions. */
 #define CO_NEVER UINT32_MAX
 

@@ -63,6 +63,14 @@ void h_own_boot(void);
 extern int h_tests;
 extern int h_failed_tests;
 
+/*
+ * The stack's CO_CHECK (co_common.h) reports a broken contract through
+ * co_assert_failed(): a failed check, unless the test announced it with
+ * h_expect_assert(n) (then it counts down; h_asserts counts every report).
+ */
+void h_expect_assert(unsigned n);
+extern unsigned h_asserts;
+
 /* Prints "N passed, M failed" and returns the exit status. */
 int h_finish(void);
 /* Most sent frames ever left unread at once (printed by h_finish). */

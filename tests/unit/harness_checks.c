@@ -73,6 +73,26 @@ void h_run(void (*fn)(void), const char *name)
     }
 }
 
+unsigned h_asserts;
+static unsigned asserts_expected;
+
+void h_expect_assert(unsigned n)
+{
+    asserts_expected = n;
+}
+
+void co_assert_failed(const char *cond, const char *file, int line)
+{
+    h_asserts++;
+    if (asserts_expected > 0u) {
+        asserts_expected--;
+        return;
+    }
+    h_checks++;
+    h_failures++;
+    fprintf(stderr, "%s:%d: stack contract broken: %s\n", file, line, cond);
+}
+
 int h_finish(void)
 {
     printf("%d checks, at most %u sent frames unread\n", h_checks, h_tx_high_water);
