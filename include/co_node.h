@@ -6,8 +6,8 @@
  *     co_node_start(&node, now());
  *     for (;;) {
  *         wait for a frame or for the delay co_node_poll() returned;
- *         co_node_poll(&node, now());          // stamps node->now
- *         while (frame received) co_node_receive(&node, &frame);
+ *         while (frame received) co_node_receive(&node, &frame, now());
+ *         co_node_poll(&node, now());          // timers, and what frames left to do
  *     }
  * Not reentrant for one node; separate nodes are independent. Never call
  * from an interrupt: a receive interrupt queues frames, the loop feeds them.
@@ -125,7 +125,7 @@ struct co_node {
     void *app;                  /* product context for its hooks */
     void *ram[CO_CLS_COUNT];    /* the class structs, owned by the caller */
     uint32_t nvm_base;          /* where this node's records start in NVM */
-    uint32_t now;               /* time of the latest co_node_poll() */
+    uint32_t now;               /* time of the latest co_node_poll() or co_node_receive() */
     uint32_t due;               /* not dirty: no service needs to run before this time */
     uint32_t tx_dropped;        /* frames the board could not queue */
     co_sync_t sync;
@@ -189,8 +189,16 @@ static inline void co_node_request_reset(co_node_t *node, co_reset_t kind)
 /* Reset node or communication now (what the NMT commands do). */
 void co_node_reset(co_node_t *node, co_reset_t kind);
 
-/* One received frame. */
-void co_node_receive(co_node_t *node, const co_frame_t *f);
+/*
+ * One received frame f (copied from where it is needed; the caller keeps
+ * f), at time now (us, the clock co_node_poll() gets): the time stamp of
+ * what the frame starts (a guard request's life time, a heartbeat
+ * consumer's timeout, an LSS switch delay). Answers go out through
+ * co_port_can_send() before it returns; what the frame leaves to do (a
+ * reset it asked for, a TPDO event) runs at the next co_node_poll(), which
+ * is due at once. Frames the node does not serve are ignored.
+ */
+void co_node_receive(co_node_t *node, const co_frame_t *f, uint32_t now);
 
 /*
  * Run timers; returns the delay (us) until the next call is needed. When

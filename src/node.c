@@ -135,23 +135,29 @@ static bool services_receive(co_node_t *node, const co_frame_t *f, bool always)
     return false;
 }
 
-void co_node_receive(co_node_t *node, const co_frame_t *f)
+void co_node_receive(co_node_t *node, const co_frame_t *f, uint32_t now)
 {
+    node->now = now;
     co_node_wake(node);
     /* The frame a slave gets most, straight to its server: no other
      * service may use an SDO CAN-ID (restricted, CiA 301 7.3.5). */
     if (f->id == 0x600u + node->node_id && node->nmt.state != CO_NMT_INIT) {
-        (void)co_sdo_receive(node, f);
+        co_sdo_receive(node, f);
+        return;
+    }
+    /* An SDO request was served above: nothing else is on its CAN-ID.
+     * NMT and SYNC next, the frames a slave gets most after SDO: their
+     * CAN-IDs (0, a SYNC COB-ID that is never restricted) are no LSS
+     * frame's (0x7E5), so they go before the services that run in every
+     * state (SYNC on the JD2: 20 instructions less). */
+    bool init = node->nmt.state == CO_NMT_INIT;
+    if (!init && (co_nmt_receive(node, f) || co_sync_receive(node, f))) {
         return;
     }
     if (services_receive(node, f, true)) {
         return; /* LSS works in every state, and without a node-ID */
     }
-    if (node->nmt.state == CO_NMT_INIT) {
-        return;
-    }
-    if (co_nmt_receive(node, f) || co_sync_receive(node, f) || co_sdo_receive(node, f) ||
-        services_receive(node, f, false)) {
+    if (init || services_receive(node, f, false)) {
         return;
     }
     /* Anything else (other nodes' traffic, RTRs nobody serves) is ignored. */

@@ -542,7 +542,6 @@ int main(int argc, char **argv)
                 }
             } else if (src < a.nnodes) {
                 co_frame_t f;
-                co_node_poll(a.nodes[src], t);
                 /* At most 64 frames, then the timers again: a flooded bus
                  * must not starve the heartbeat (the rest stay queued in
                  * the socket; epoll reports them at once). */
@@ -552,7 +551,7 @@ int main(int argc, char **argv)
                         break;
                     }
                     if (rr == 1) {
-                        co_node_receive(a.nodes[src], &f);
+                        co_node_receive(a.nodes[src], &f, t);
                     }
                 }
                 sync_can_state(&a, src);

@@ -218,7 +218,7 @@ static void deliver(dev_t *d, const co_frame_t *f)
 {
     for (unsigned k = 0; k < d->nnodes; k++) {
         (void)co_node_poll(d->nodes[k], d->now);
-        co_node_receive(d->nodes[k], f);
+        co_node_receive(d->nodes[k], f, d->now);
         (void)co_node_poll(d->nodes[k], d->now); /* a reset it asked for (the JD's save-reset) */
     }
 }

@@ -468,7 +468,7 @@ static void deliver(dev_t *d, const co_frame_t *f)
         w->in_guard_rtr = f->rtr && has_id(n) && f->id == 0x700u + n->node_id;
         w->sdo_count = 0;
         const co_od_entry_t *written = expedited_write(n, f);
-        co_node_receive(n, f);
+        co_node_receive(n, f, now32(d));
         if (written != NULL) {
             check_read_back(d, k, written, f);
         }

@@ -167,7 +167,7 @@ void h_rx_frame(h_dev_t *d, const co_frame_t *f)
 {
     for (unsigned i = 0; i < d->nnodes; i++) {
         co_node_poll(d->nodes[i], d->now);
-        co_node_receive(d->nodes[i], f);
+        co_node_receive(d->nodes[i], f, d->now);
         co_node_poll(d->nodes[i], d->now);
     }
 }

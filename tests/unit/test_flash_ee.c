@@ -136,7 +136,7 @@ static uint32_t sdo(const char *hex)
 {
     co_frame_t f = {.id = 0x67F, .dlc = 8};
     h_hex(hex, f.data, 8);
-    co_node_receive(node, &f);
+    co_node_receive(node, &f, 0);
     return last_tx.data[0] == 0x80u ? co_get_u32(&last_tx.data[4]) : 0u;
 }
 

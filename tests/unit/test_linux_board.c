@@ -434,7 +434,7 @@ static void test_sim_bus_off(void)
     CHECK(read_frames(sv[1], f, 64) >= 1); /* boot-up */
     /* 0x1017 := 10 ms heartbeat over SDO */
     co_frame_t req = {.id = 0x600u + node->node_id, .dlc = 8, .data = {0x2B, 0x17, 0x10, 0, 10, 0}};
-    co_node_receive(node, &req);
+    co_node_receive(node, &req, t);
     co_node_poll(node, t);
     CHECK_EQ(read_frames(sv[1], f, 64), 1);
     CHECK_EQ(f[0].data[0], 0x60);

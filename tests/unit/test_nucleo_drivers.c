@@ -701,7 +701,7 @@ static uint8_t sdo_over_bus(co_node_t *node, const char *req, uint32_t *v)
     h_hex(req, in.data, 8);
     co_frame_t f;
     CHECK(receive_one(&in, &f));
-    co_node_receive(node, &f);
+    co_node_receive(node, &f, board_now_us());
     stm_can_frame_t out;
     if (!stm_can_bus_take(&out) || out.id != 0x580u + node->node_id) {
         CHECK(!"no SDO response on the bus");
