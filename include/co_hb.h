@@ -18,6 +18,13 @@ typedef struct co_hb {
 /* Re-read 0x1017 and restart the period (call after a write or a reset). */
 void co_hb_reconfig(co_node_t *node);
 
+/*
+ * The heartbeat period in use (ms, 0x1017 as last applied; 0: no
+ * heartbeat). Node guarding asks it: while the heartbeat runs, guard
+ * requests go unanswered (CiA 301: one error-control protocol at a time).
+ */
+uint16_t co_hb_period_ms(const co_node_t *node);
+
 /* Send the boot-up message (0x700 + node-ID, one byte 0x00). */
 void co_hb_bootup(co_node_t *node);
 

@@ -11,6 +11,20 @@
  *     }
  * Not reentrant for one node; separate nodes are independent. Never call
  * from an interrupt: a receive interrupt queues frames, the loop feeds them.
+ *
+ * Layering of src/ (no include or call cycle but through this object):
+ *   node        owns every module's state; dispatches frames, polls, resets
+ *     -> nmt, sdo, sync, tpdo, hb, emcy, store, the optional services
+ *        (guard, hbc, lss, rtr): the protocol modules
+ *          -> od (the dictionary), filter, led, common: the leaves
+ * A protocol module reaches another only downwards (sync -> tpdo at a
+ * SYNC, nmt -> tpdo at a state change, store -> emcy for 6300h, lss ->
+ * store, guard asks hb through co_hb_period_ms()), and everything may call
+ * back into the node (co_node_send, co_node_entry, co_node_reset, the NMT
+ * state in node->nmt). The dictionary calls no protocol module: a write
+ * hook of a product table (co_store_save_hook, co_tpdo_write_hook, ...) is
+ * named by the table, not by od.c, and a product's autosave is
+ * co_node_write()'s, not co_od_write()'s.
  */
 #ifndef CO_NODE_H
 #define CO_NODE_H
@@ -236,6 +250,17 @@ const char *co_led_pattern_name(co_led_pattern_t p);
  * LED levels at time now; *next_us receives the delay until either changes.
  */
 void co_node_leds(co_node_t *node, uint32_t now, bool *green, bool *red, uint32_t *next_us);
+
+/*
+ * Write len bytes (little-endian) to entry e of the node's dictionary as an
+ * SDO download does: co_od_write() (access, length, limits, write hook),
+ * then, where the product stores every change (cfg->autosave), a save of
+ * the entry's class (co_store_save()) at once. Returns co_od_write()'s
+ * result, or the save's (CO_E_STORE, CO_E_HW) when the value was taken
+ * but could not be stored. The SDO server writes through it, so that the
+ * dictionary never calls the store (see the layering above).
+ */
+co_res_t co_node_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len);
 
 /* Convenience: look up an entry in the node's dictionary (NULL if absent). */
 const co_od_entry_t *co_node_entry(const co_node_t *node, uint16_t index, uint8_t sub);

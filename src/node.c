@@ -38,6 +38,15 @@ bool co_node_tx_drop(co_node_t *node)
     return false;
 }
 
+co_res_t co_node_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len)
+{
+    co_res_t r = co_od_write(node, e, buf, len);
+    if (r == CO_OK && co_cfg(node)->autosave && (e->cls == CO_CLS_PARA || e->cls == CO_CLS_LSS)) {
+        r = co_store_save(node, (co_cls_t)e->cls); /* the product stores every change */
+    }
+    return r;
+}
+
 /* A restore, and the check of a record's values (co_store.h). */
 static void restore(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)
 {

@@ -114,7 +114,7 @@ static void download_expedited(co_node_t *node, const uint8_t *d)
     /* Size not indicated (0x22): the object's own size, at most 4. */
     uint32_t len = (d[0] & 0x01u) != 0u ? 4u - ((d[0] >> 2) & 0x03u)
                                          : co_min_u32(co_od_size(e), 4u);
-    co_res_t r = co_od_write(node, e, &d[4], len);
+    co_res_t r = co_node_write(node, e, &d[4], len);
     if (r != CO_OK) {
         co_sdo_abort(node, d, r);
     } else {

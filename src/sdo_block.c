@@ -98,7 +98,7 @@ static void block_download_end(co_node_t *node, const uint8_t *d)
         co_sdo_abort(node, mux, CO_E_CRC);
         return;
     }
-    co_res_t r = co_od_write(node, sdo->e, sdo->buf, len);
+    co_res_t r = co_node_write(node, sdo->e, sdo->buf, len);
     if (r != CO_OK) {
         co_sdo_abort(node, mux, r);
         return;

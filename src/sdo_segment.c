@@ -56,7 +56,7 @@ static void download_segment(co_node_t *node, const uint8_t *d, const uint8_t mu
         co_sdo_abort(node, mux, CO_E_LEN_LOW);
         return;
     }
-    co_res_t r = co_od_write(node, sdo->e, sdo->buf, sdo->pos);
+    co_res_t r = co_node_write(node, sdo->e, sdo->buf, sdo->pos);
     if (r != CO_OK) {
         co_sdo_abort(node, mux, r);
         return;
