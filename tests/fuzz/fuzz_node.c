@@ -278,12 +278,6 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
     return !p->tx_full;
 }
 
-uint32_t co_port_nvm_size(void *port)
-{
-    (void)port;
-    return NVM_SIZE;
-}
-
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     port_t *p = port;
