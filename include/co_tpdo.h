@@ -53,7 +53,16 @@ typedef struct co_tpdo {
     _Alignas(4) uint8_t last[8]; /* word aligned: copied in words (tpdo.c) */
 } co_tpdo_t;
 
-/* Re-read parameters and mapping of TPDO n (0-based) from the dictionary. */
+/*
+ * Re-read the communication parameters (0x1800 + n) and the mapping
+ * (0x1A00 + n) of TPDO n (0-based) from the dictionary: the stack calls it
+ * at every reset and from the write hooks below; a product calls it after
+ * changing those values itself. A TPDO whose parameters are missing or
+ * whose mapping is unusable stays invalid (sends nothing). While
+ * operational, its timers restart now. n must be below CO_TPDO_MAX: a
+ * larger n is a broken contract (CO_CHECK, co_common.h) and changes
+ * nothing.
+ */
 void co_tpdo_reconfig(co_node_t *node, unsigned n);
 
 /* Start (entering operational) or stop every TPDO. */

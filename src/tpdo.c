@@ -69,6 +69,9 @@ static co_res_t resolve_map(co_node_t *node, uint32_t m, const co_od_entry_t **e
 
 void co_tpdo_reconfig(co_node_t *node, unsigned n)
 {
+    if (!CO_CHECK(n < CO_TPDO_MAX)) {
+        return; /* no such TPDO in this build: nothing changes */
+    }
     co_tpdo_t *t = &node->tpdo[n];
     memset(t, 0, sizeof(*t));
     uint16_t comm = (uint16_t)(0x1800u + n);

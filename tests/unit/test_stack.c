@@ -531,6 +531,34 @@ static void test_tpdo_sync_and_bad_mapping(void)
     SDO(d, "40 05 10 00 00 00 00 00", "43 05 10 00 81 00 00 00");
 }
 
+/* co_tpdo_reconfig() of a TPDO this build has no room for (a product's
+ * index past CO_TPDO_MAX): a broken contract, reported by CO_CHECK, and
+ * nothing written (before the check it cleared the bytes after tpdo[]). */
+static void test_tpdo_reconfig_out_of_range(void)
+{
+    boot();
+    h_rx(d, 0x000, "01 10");
+    SDO(d, "2F 00 18 02 01 00 00 00", "60 00 18 02 00 00 00 00"); /* TPDO1 at every SYNC */
+    h_drain(d);
+    co_node_t *n = d->nodes[0];
+    static co_node_t before;
+    memcpy(&before, n, sizeof(before));
+    unsigned seen = h_asserts;
+    h_expect_assert(2);
+    co_tpdo_reconfig(n, CO_TPDO_MAX);
+    co_tpdo_reconfig(n, 0xFFFFFFFFu);
+    CHECK_EQ(h_asserts, seen + 2u);
+    CHECK(memcmp(&before, n, sizeof(before)) == 0);
+    /* TPDOs there are: no report; TPDO1 still sends at a SYNC. */
+    co_tpdo_reconfig(n, 0);
+    co_tpdo_reconfig(n, CO_TPDO_MAX - 1u);
+    CHECK_EQ(h_asserts, seen + 2u);
+    h_drain(d);
+    h_rx(d, 0x080, "");
+    const co_frame_t *f = h_next(d);
+    CHECK(f != NULL && f->id == 0x190);
+}
+
 static void test_emcy(void)
 {
     boot();
@@ -1015,6 +1043,7 @@ int main(void)
     RUN(test_heartbeat_timing);
     RUN(test_tpdo_event_and_inhibit);
     RUN(test_tpdo_sync_and_bad_mapping);
+    RUN(test_tpdo_reconfig_out_of_range);
     RUN(test_emcy);
     RUN(test_tx_full_is_counted);
     RUN(test_two_nodes_one_process);
