@@ -126,7 +126,6 @@ struct co_node {
     uint8_t bitrate;            /* active bit-rate code (the product's table) */
     uint8_t can_state;          /* co_can_state_t */
     bool autostart;             /* set by the reset op: go operational after boot-up */
-    bool pdo_msb_first;         /* PDO values big-endian (DST 0x5001 = 0) */
     uint8_t reset_request;      /* co_reset_t to perform at the next poll (0: none) */
     bool dirty;                 /* something happened since the last full poll */
     bool due_never;             /* the last full poll found no deadline at all */

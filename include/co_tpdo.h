@@ -50,6 +50,8 @@ typedef struct co_tpdo {
     uint8_t map_drop[CO_PDO_MAP_MAX]; /* 32 - bits of each: the high bits not sent */
     uint8_t len;           /* mapped bytes */
     uint8_t dlc;           /* of its frames: len, or 8 where the product pads */
+    bool msb_first;        /* mapped values big-endian (the product's choice, DST 0x5001 = 0):
+                            * co_tpdo_set_msb_first(); kept by co_tpdo_reconfig() */
     _Alignas(4) uint8_t last[8]; /* word aligned: copied in words (tpdo.c) */
 } co_tpdo_t;
 
@@ -64,6 +66,17 @@ typedef struct co_tpdo {
  * nothing.
  */
 void co_tpdo_reconfig(co_node_t *node, unsigned n);
+
+/*
+ * The byte order of TPDO n's mapped values: little-endian as CiA 301 has
+ * it (false, the default after co_node_init()), or each value big-endian
+ * (true: the DST's 0x5001 "PDO coding" = 0). A property of the TPDO, kept
+ * across co_tpdo_reconfig() and resets: the product sets it, typically
+ * from its reset hook and the write hook of its own object. n must be
+ * below CO_TPDO_MAX: a larger n is a broken contract (CO_CHECK) and
+ * changes nothing.
+ */
+void co_tpdo_set_msb_first(co_node_t *node, unsigned n, bool msb_first);
 
 /* Start (entering operational) or stop every TPDO. */
 void co_tpdo_start(co_node_t *node);

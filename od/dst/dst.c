@@ -85,7 +85,7 @@ co_res_t dst_write_bitrate(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 co_res_t dst_write_coding(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
     co_res_t r = co_od_store(n, e, v);
-    n->pdo_msb_first = dev_of(n)->para.pdo_coding == 0u;
+    co_tpdo_set_msb_first(n, 0, dev_of(n)->para.pdo_coding == 0u); /* TPDO1, its only one */
     return r;
 }
 
@@ -147,7 +147,7 @@ static void dst_reset(co_node_t *n, co_reset_t kind)
     d->vol.id[0] = d->vol.id[1] = n->node_id;
     d->vol.br[0] = d->vol.br[1] = d->lss.bitrate;
     /* Big-endian PDOs only where 0x5001 exists and says so (the X710 has none). */
-    n->pdo_msb_first = co_node_entry(n, 0x5001, 0) != NULL && d->para.pdo_coding == 0u;
+    co_tpdo_set_msb_first(n, 0, co_node_entry(n, 0x5001, 0) != NULL && d->para.pdo_coding == 0u);
     n->autostart = d->para.autostart == 1u; /* B-11: after any reset */
     apply_filter(d);
     /* Errors are re-evaluated and re-reported after every boot-up. */
