@@ -1,6 +1,37 @@
 /*
  * co_node.h - the node object: one CANopen slave, all of its state.
  *
+ * The contract between a product (od/), a board (boards/) and the stack.
+ * co_node_t is visible so that its owner can allocate it (no heap); its
+ * fields are the stack's. A product or a board reads and changes a node
+ * only through the functions below and the modules' headers:
+ *  - Ownership. The caller owns the node, the config (const, shared by
+ *    every node of a product), the class RAM structs and the board and
+ *    product contexts; all of them outlive the node. The stack holds
+ *    pointers to them and never frees anything.
+ *  - Read, at any time (static inline, free): co_node_app(),
+ *    co_node_id(), co_node_bitrate(), co_node_nmt_state(),
+ *    co_node_can_state(), co_node_tx_dropped(), co_node_store_status();
+ *    dictionary values through co_node_entry() and co_od_get();
+ *    co_store_limit_reached(); co_od_checking() in a write hook.
+ *  - Change, from the product's reset hook only (co_node_ops_t.reset):
+ *    the node-ID (co_node_set_id), the bit-rate code (co_node_set_bitrate)
+ *    and the automatic start (co_node_set_autostart). Elsewhere they are a
+ *    broken contract (CO_CHECK, co_common.h) and change nothing.
+ *  - Change, from any hook, the product's poll or its sample function:
+ *    its own dictionary values (co_od_store() in a write hook), the byte
+ *    order of a TPDO (co_tpdo_set_msb_first), TPDO events
+ *    (co_tpdo_event), the NMT state (co_nmt_enter), errors (co_emcy_*),
+ *    the store (co_store_save, co_store_mark_corrupt,
+ *    co_store_report_emcy), a reset after the current answer
+ *    (co_node_request_reset), and co_node_wake() after a new sample.
+ *  - A board calls co_node_init/start/receive/poll, co_node_set_can_state
+ *    and co_node_leds, and provides co_port.h.
+ *  - Invalid arguments: an index or a value outside what a function's
+ *    comment allows is a programming error, checked with CO_CHECK (no
+ *    crash, nothing changed, reported in the unit tests). Results that a
+ *    master causes are co_res_t (SDO abort codes), never a CO_CHECK.
+ *
  * Typical main loop (see boards/linux/main.c):
  *     co_node_init(&node, &cfg, port, app, ram);
  *     co_node_start(&node, now());
@@ -119,6 +150,8 @@ typedef struct co_node_cfg {
     const uint16_t *kbps;       /* kbit/s of each bit-rate code (16 codes; 0: unused), or NULL */
 } co_node_cfg_t;
 
+/* The node's state. Its fields are the stack's: the accessors below and
+ * the modules' functions are the product's and the board's way in. */
 struct co_node {
     /* Bytes first: on a Cortex-M0 a byte field is one load only within the
      * first 32 bytes of the struct (words: 128), so the hot ones go here. */
@@ -190,6 +223,94 @@ static inline void co_node_wake(co_node_t *node)
 static inline bool co_od_checking(const co_node_t *node)
 {
     return node->od_checking;
+}
+
+/* ---- The product's and the board's view of the node (the contract above).
+ * Static inline: each is the one load or store it replaces, free in an
+ * image. */
+
+/* The product context given to co_node_init() (the product's instance). */
+static inline void *co_node_app(const co_node_t *node)
+{
+    return node->app;
+}
+
+/* The active node-ID: 1..127, or CO_LSS_UNCONFIGURED (0xFF: none yet, LSS). */
+static inline uint8_t co_node_id(const co_node_t *node)
+{
+    return node->node_id;
+}
+
+/* The active bit-rate code (the product's table, co_node_cfg_t.kbps). */
+static inline uint8_t co_node_bitrate(const co_node_t *node)
+{
+    return node->bitrate;
+}
+
+/* The NMT state (CO_NMT_INIT while a reset runs). */
+static inline co_nmt_state_t co_node_nmt_state(const co_node_t *node)
+{
+    return (co_nmt_state_t)node->nmt.state;
+}
+
+/* The CAN controller's state as the board last reported it. */
+static inline co_can_state_t co_node_can_state(const co_node_t *node)
+{
+    return (co_can_state_t)node->can_state;
+}
+
+/* Frames the board could not queue or that fell due while bus-off. */
+static inline uint32_t co_node_tx_dropped(const co_node_t *node)
+{
+    return node->tx_dropped;
+}
+
+/*
+ * What the last restore of class cls (CO_CLS_PARA, CO_CLS_LSS) found, as
+ * updated since (co_store.h: a full save makes a corrupt set sound again).
+ * Another cls: a broken contract (CO_CHECK), CO_STORE_BLANK.
+ */
+static inline co_store_status_t co_node_store_status(const co_node_t *node, co_cls_t cls)
+{
+    if (!CO_CHECK(cls == CO_CLS_PARA || cls == CO_CLS_LSS)) {
+        return CO_STORE_BLANK;
+    }
+    return (co_store_status_t)node->store.status[cls];
+}
+
+/* The node-ID, bit rate and automatic start are set by the stack at every
+ * reset (from the LSS set, else the config's defaults; autostart off) and
+ * then by the product's reset hook, if it has one: only there may a
+ * product change them (the NMT state is CO_NMT_INIT then). Anywhere else
+ * a call is a broken contract (CO_CHECK) and changes nothing. */
+
+/* Node-ID id (1..127, or CO_LSS_UNCONFIGURED) from the next boot-up on:
+ * a product that keeps it in its own object (the JD's 3000h). Another id:
+ * a broken contract (CO_CHECK), nothing changes. */
+static inline void co_node_set_id(co_node_t *node, uint8_t id)
+{
+    if (CO_CHECK(node->nmt.state == CO_NMT_INIT) &&
+        CO_CHECK((id >= 1u && id <= 127u) || id == CO_LSS_UNCONFIGURED)) {
+        node->node_id = id;
+    }
+}
+
+/* Bit-rate code (0..15, the product's table) activated by this reset: the
+ * board is asked for its rate when the reset ends (co_port_can_bitrate).
+ * Another code: a broken contract (CO_CHECK), nothing changes. */
+static inline void co_node_set_bitrate(co_node_t *node, uint8_t code)
+{
+    if (CO_CHECK(node->nmt.state == CO_NMT_INIT) && CO_CHECK(code <= 15u)) {
+        node->bitrate = code;
+    }
+}
+
+/* Go operational by itself after this boot-up (the DST's 0x5000, ...). */
+static inline void co_node_set_autostart(co_node_t *node, bool on)
+{
+    if (CO_CHECK(node->nmt.state == CO_NMT_INIT)) {
+        node->autostart = on;
+    }
 }
 
 /* Reset at the next poll, after the answer to the current request went out. */
