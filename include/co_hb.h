@@ -1,5 +1,8 @@
 /*
  * co_hb.h - heartbeat producer (0x1017) and boot-up message.
+ *
+ * State: co_hb_t in the node. Frames go out through co_node_send(); one
+ * the board cannot queue is counted and not repeated.
  */
 #ifndef CO_HB_H
 #define CO_HB_H
@@ -28,6 +31,10 @@ uint16_t co_hb_period_ms(const co_node_t *node);
 /* Send the boot-up message (0x700 + node-ID, one byte 0x00). */
 void co_hb_bootup(co_node_t *node);
 
+/* Send the heartbeat (0x700 + node-ID, the NMT state) when its period
+ * ran out, one period after the last (no burst after a late poll). Returns
+ * the delay (us) until the next one, CO_NEVER while 0x1017 is 0 or the
+ * node initialises. */
 uint32_t co_hb_poll(co_node_t *node, uint32_t now);
 
 /*

@@ -40,6 +40,10 @@ typedef struct co_lss {
     uint32_t switch_at;  /* (us) */
 } co_lss_t;
 
+/* Reset communication (co_service_t.reset): back to the waiting state, no
+ * selective switch, identification or Fastscan in progress, a configured
+ * bit timing forgotten; a configured node-ID stays pending (co_node_reset
+ * applies it). */
 void co_lss_init(co_node_t *node);
 
 /* Handle a frame on 0x7E5. Returns true if it was one. Works in every NMT

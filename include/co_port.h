@@ -47,7 +47,14 @@ bool co_port_can_bitrate(void *port, uint16_t kbps);
  * read, and every save is refused with 0x06060000. The check would have cost the DST X730 image
  * flash it does not have to spare.
  */
+/* Copy len bytes of the EEPROM from addr into buf (the caller's, len
+ * bytes). False: a hardware failure or a byte beyond the EEPROM; buf's
+ * contents are then undefined. */
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len);
+/* Write len bytes of buf (read only during the call) to the EEPROM at
+ * addr; durable when it returns true. False: a hardware failure or a byte
+ * beyond the EEPROM (what the bytes hold then is undefined: the store's
+ * records survive it, co_store.h). */
 bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len);
 
 #endif /* CO_PORT_H */

@@ -4,6 +4,13 @@
  * when the client wants it; one block carries any object, the
  * protocol-switch threshold is not used),
  * toggle and sequence checks, timeout, abort codes from co_res_t.
+ *
+ * State: co_sdo_t in the node, one transfer at a time (a new initiate
+ * replaces an unfinished one); the buffer of segmented and block downloads
+ * is its buf[CO_SDO_BUF]. The server reads and writes the dictionary
+ * (co_od_read, co_node_write) and answers through co_node_send(); every
+ * failure a client causes is answered with the abort code of its co_res_t
+ * (co_common.h), never a crash. Not reentrant; main loop only.
  */
 #ifndef CO_SDO_H
 #define CO_SDO_H

@@ -15,6 +15,8 @@ typedef struct co_sync {
     uint32_t count; /* SYNCs received in operational, for diagnostics */
 } co_sync_t;
 
+/* Re-read the SYNC COB-ID from 0x1005 (0x080 where the dictionary has
+ * none): at every reset and after a write of 0x1005. */
 void co_sync_reconfig(co_node_t *node);
 
 /* Write hook for 0x1005: store and use the new COB-ID at once. */

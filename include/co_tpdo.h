@@ -18,6 +18,15 @@
  *            sent once when it ends.
  * A remote request on the COB-ID (bit 30 of sub 1 clear) sends any valid
  * TPDO in operational.
+ *
+ * State: co_tpdo_t in the node, CO_TPDO_MAX of them; the mapped entries
+ * point into the product's const table. Frames go out through
+ * co_node_send(): one the board cannot queue is counted and lost. A
+ * TPDO number n a product passes must be below CO_TPDO_MAX: beyond it
+ * co_tpdo_reconfig and co_tpdo_set_msb_first are a broken contract
+ * (CO_CHECK) and change nothing; co_tpdo_event and co_tpdo_changed ignore
+ * it (false). Values a master writes are judged by the write hooks below,
+ * which answer SDO abort codes.
  */
 #ifndef CO_TPDO_H
 #define CO_TPDO_H
@@ -78,8 +87,11 @@ void co_tpdo_reconfig(co_node_t *node, unsigned n);
  */
 void co_tpdo_set_msb_first(co_node_t *node, unsigned n, bool msb_first);
 
-/* Start (entering operational) or stop every TPDO. */
+/* Entering operational: every TPDO starts afresh (SYNC count 0, no data
+ * sent yet, the event timer's first send at the next poll). */
 void co_tpdo_start(co_node_t *node);
+/* Leaving operational or resetting: event timers and pending events of
+ * every TPDO stop; nothing is sent until co_tpdo_start(). */
 void co_tpdo_stop(co_node_t *node);
 
 /* One SYNC received in operational. */
