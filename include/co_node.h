@@ -32,8 +32,8 @@
  *    crash, nothing changed, reported in the unit tests). Results that a
  *    master causes are co_res_t (SDO abort codes), never a CO_CHECK.
  *
- * Typical main loop (see boards/linux/main.c):
- *     co_node_init(&node, &cfg, port, app, ram);
+ * Typical main loop (boards/common/mcu_main.c, boards/linux/main.c):
+ *     co_node_init(&node, &cfg, port, app, ram, nvm_base);
  *     co_node_start(&node, now());
  *     for (;;) {
  *         wait for a frame or for the delay co_node_poll() returned;
@@ -47,7 +47,9 @@
  *   node        owns every module's state; dispatches frames, polls, resets
  *     -> nmt, sdo, sync, tpdo, hb, emcy, store, the optional services
  *        (guard, hbc, lss, rtr): the protocol modules
- *          -> od (the dictionary), filter, led, common: the leaves
+ *          -> od (the dictionary), common: the leaves
+ *   incl (CiA 410), filter, led: libraries the products (led: the node)
+ *   call, calling no other module but filter
  * A protocol module reaches another only downwards (sync -> tpdo at a
  * SYNC, nmt -> tpdo at a state change, store -> emcy for 6300h, lss ->
  * store, guard asks hb through co_hb_period_ms()), and everything may call
