@@ -559,6 +559,33 @@ static void test_tpdo_reconfig_out_of_range(void)
     CHECK(f != NULL && f->id == 0x190);
 }
 
+/* The contract's setters (co_node.h): node-ID, bit rate and automatic
+ * start only from the reset hook; a TPDO's byte order and a store status
+ * only for what exists. Anything else: a CO_CHECK report, nothing changed. */
+static void test_contract_broken_changes_nothing(void)
+{
+    boot();
+    co_node_t *n = d->nodes[0];
+    static co_node_t before;
+    memcpy(&before, n, sizeof(before));
+    unsigned seen = h_asserts;
+    h_expect_assert(6);
+    co_node_set_id(n, 0x20);        /* pre-operational: not in a reset */
+    co_node_set_bitrate(n, 1);
+    co_node_set_autostart(n, true);
+    co_tpdo_set_msb_first(n, CO_TPDO_MAX, true);
+    CHECK_EQ(co_node_store_status(n, CO_CLS_VOL), CO_STORE_BLANK);
+    CHECK_EQ(co_node_store_status(n, CO_CLS_COUNT), CO_STORE_BLANK);
+    CHECK_EQ(h_asserts, seen + 6u);
+    CHECK(memcmp(&before, n, sizeof(before)) == 0);
+    CHECK_EQ(co_node_id(n), 0x10);
+    CHECK_EQ(co_node_nmt_state(n), CO_NMT_PREOP);
+    /* What exists: no report. */
+    CHECK_EQ(co_node_store_status(n, CO_CLS_PARA), CO_STORE_BLANK); /* a fresh EEPROM */
+    co_tpdo_set_msb_first(n, CO_TPDO_MAX - 1u, false);
+    CHECK_EQ(h_asserts, seen + 6u);
+}
+
 static void test_emcy(void)
 {
     boot();
@@ -1044,6 +1071,7 @@ int main(void)
     RUN(test_tpdo_event_and_inhibit);
     RUN(test_tpdo_sync_and_bad_mapping);
     RUN(test_tpdo_reconfig_out_of_range);
+    RUN(test_contract_broken_changes_nothing);
     RUN(test_emcy);
     RUN(test_tx_full_is_counted);
     RUN(test_two_nodes_one_process);
