@@ -201,14 +201,19 @@ extern const co_node_cfg_t CO_FIXED_CFG;
 #endif
 
 /*
- * Prepare a node; nothing is sent. cfg, port, app and the ram structs are
- * owned by the caller and must outlive the node. ram has CO_CLS_COUNT
- * entries (NULL where cfg->ram_size is 0).
+ * Prepare a node; nothing is sent, the board is not called. cfg, port, app
+ * and the ram structs are owned by the caller and must outlive the node;
+ * ram (copied) has CO_CLS_COUNT entries, NULL where cfg->ram_size is 0.
+ * nvm_base: where the node's records start in the board's EEPROM (each
+ * node of a device its own CO_STORE_NVM_SIZE bytes). Cannot fail.
  */
 void co_node_init(co_node_t *node, const co_node_cfg_t *cfg, void *port, void *app,
                   void *const ram[CO_CLS_COUNT], uint32_t nvm_base);
 
-/* Power-on: reset node (load the store, boot-up, pre-operational). */
+/* Power-on at time now: reset node (restore the stored sets, ask the
+ * board for the bit rate, boot-up, pre-operational or, with autostart,
+ * operational). A stored set that cannot be used is reported, never
+ * fatal: co_node_store_status(). */
 void co_node_start(co_node_t *node, uint32_t now);
 
 /*
@@ -322,7 +327,9 @@ static inline void co_node_request_reset(co_node_t *node, co_reset_t kind)
     co_node_wake(node);
 }
 
-/* Reset node or communication now (what the NMT commands do). */
+/* Reset node or communication now (what the NMT commands do): the
+ * product's reset hook runs, the boot-up is sent. From a write hook use
+ * co_node_request_reset() instead, so that the answer goes out first. */
 void co_node_reset(co_node_t *node, co_reset_t kind);
 
 /*
@@ -359,7 +366,10 @@ static inline bool co_node_send(co_node_t *node, const co_frame_t *f)
     return co_node_tx_drop(node);
 }
 
-/* The board's view of the CAN controller (LEDs, diagnostics). */
+/* The board's view of the CAN controller (LEDs, diagnostics): call it
+ * from the main loop when it changes (no-op when unchanged); while
+ * CO_CAN_BUSOFF the node sends nothing. The product's can_state hook
+ * runs. */
 void co_node_set_can_state(co_node_t *node, co_can_state_t s);
 
 /* The patterns the two LEDs show now (CiA 303-3 mapping, product hook). */

@@ -1,6 +1,8 @@
 /*
  * co_sync.h - SYNC consumer (CiA 301 7.2.5). The COB-ID is 0x1005 when the
- * dictionary has it, 0x080 otherwise.
+ * dictionary has it, 0x080 otherwise. State: co_sync_t in the node. A SYNC
+ * in operational drives the synchronous TPDOs (co_tpdo_sync); elsewhere,
+ * or with more than one data byte, it is consumed and does nothing.
  */
 #ifndef CO_SYNC_H
 #define CO_SYNC_H
