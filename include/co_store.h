@@ -100,7 +100,9 @@ co_res_t co_store_save_group(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_
  * A value of the restored set of cls that only the product can judge (the
  * DST's bit-rate code, kept without a dictionary entry) failed: the product
  * set it to its default; the set is reported as corrupt, like one whose
- * values fail co_od_validate(), until the next full save.
+ * values fail co_od_validate(), until the next full save. cls must be
+ * CO_CLS_PARA or CO_CLS_LSS: another is a broken contract (CO_CHECK) and
+ * changes nothing.
  */
 void co_store_mark_corrupt(co_node_t *node, co_cls_t cls);
 
