@@ -23,10 +23,10 @@
  * point into the product's const table. Frames go out through
  * co_node_send(): one the board cannot queue is counted and lost. A
  * TPDO number n a product passes must be below CO_TPDO_MAX: beyond it
- * co_tpdo_reconfig and co_tpdo_set_msb_first are a broken contract
- * (CO_CHECK) and change nothing; co_tpdo_event and co_tpdo_changed ignore
- * it (false). Values a master writes are judged by the write hooks below,
- * which answer SDO abort codes.
+ * co_tpdo_reconfig, co_tpdo_set_msb_first, co_tpdo_event and
+ * co_tpdo_changed take it as a broken contract (CO_CHECK): nothing changes,
+ * co_tpdo_changed answers false. Values a master writes are judged by the
+ * write hooks below, which answer SDO abort codes.
  */
 #ifndef CO_TPDO_H
 #define CO_TPDO_H

@@ -391,7 +391,7 @@ bool co_tpdo_rtr(co_node_t *node, const co_frame_t *f)
 
 bool co_tpdo_changed(co_node_t *node, unsigned n)
 {
-    if (n >= CO_TPDO_MAX) {
+    if (!CO_CHECK(n < CO_TPDO_MAX)) {
         return false;
     }
     co_tpdo_t *t = &node->tpdo[n];
@@ -405,7 +405,7 @@ bool co_tpdo_changed(co_node_t *node, unsigned n)
 
 void co_tpdo_event(co_node_t *node, unsigned n)
 {
-    if (n >= CO_TPDO_MAX) {
+    if (!CO_CHECK(n < CO_TPDO_MAX)) {
         return;
     }
     co_tpdo_t *t = &node->tpdo[n];

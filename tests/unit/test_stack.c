@@ -790,7 +790,10 @@ static void test_tpdo_events_and_inhibit(void)
     CHECK(h_next(d) != NULL);
     EXPECT_NONE(d); /* the two events went out as one */
     CHECK(d->now - t0 >= 100000);
-    co_tpdo_event(d->node, 5); /* no such TPDO: ignored */
+    unsigned seen = h_asserts;
+    h_expect_assert(1);
+    co_tpdo_event(d->node, 5); /* no such TPDO: ignored (a broken contract, CO_CHECK) */
+    CHECK_EQ(h_asserts, seen + 1u);
 }
 
 /*
