@@ -182,12 +182,6 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
     return true;
 }
 
-uint32_t co_port_nvm_size(void *port)
-{
-    (void)port;
-    return flash_ee_size(&g_fe);
-}
-
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     (void)port;
@@ -219,7 +213,7 @@ static void deliver(dev_t *d, const co_frame_t *f)
 {
     for (unsigned k = 0; k < d->nnodes; k++) {
         (void)co_node_poll(d->nodes[k], d->now);
-        co_node_receive(d->nodes[k], f);
+        co_node_receive(d->nodes[k], f, d->now);
         (void)co_node_poll(d->nodes[k], d->now); /* a reset it asked for (the JD's save-reset) */
     }
 }

@@ -279,12 +279,6 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
     return !p->tx_full;
 }
 
-uint32_t co_port_nvm_size(void *port)
-{
-    (void)port;
-    return NVM_SIZE;
-}
-
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     port_t *p = port;
@@ -469,7 +463,7 @@ static void deliver(dev_t *d, const co_frame_t *f)
         w->in_guard_rtr = f->rtr && has_id(n) && f->id == 0x700u + n->node_id;
         w->sdo_count = 0;
         const co_od_entry_t *written = expedited_write(n, f);
-        co_node_receive(n, f);
+        co_node_receive(n, f, now32(d));
         if (written != NULL) {
             check_read_back(d, k, written, f);
         }
