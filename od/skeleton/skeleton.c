@@ -11,7 +11,7 @@
 
 static skel_dev_t *dev_of(co_node_t *n)
 {
-    return n->app;
+    return co_node_app(n);
 }
 
 /* ---- behaviour ------------------------------------------------------- */
