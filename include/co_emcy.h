@@ -32,15 +32,26 @@ enum {
     CO_ER_MANUFACTURER = 0x80,
 };
 
-/* Active errors (at least 1) and 0x1003 history depth a node has room for;
- * an MCU image may set less (boards/CMakeLists.txt). History depth 0: no
- * history is kept, and the 0x1003 hooks do not exist (a product with 0x1003
- * does not link). */
+/* Active errors and 0x1003 history depth a node has room for; an MCU image
+ * may set less (its table sizes in od/<family>/family.cmake). History depth
+ * 0: no history is kept, and the 0x1003 hooks do not exist (a product with
+ * 0x1003 does not link).
+ * CO_EMCY_ACTIVE_MAX 1..255: at least one (the table needs a member, and a
+ * product that raises an error needs a place for it), at most what the
+ * count co_emcy_t.nactive (a byte) holds.
+ * CO_EMCY_HIST_MAX 0..254: 0x1003 sub 0 is the UNSIGNED8 count of
+ * subs 1..254 (CiA 301). */
 #ifndef CO_EMCY_ACTIVE_MAX
 #define CO_EMCY_ACTIVE_MAX 8u
 #endif
+#if CO_EMCY_ACTIVE_MAX < 1 || CO_EMCY_ACTIVE_MAX > 255
+#error "CO_EMCY_ACTIVE_MAX must be 1..255 (at least one active error; counted in a byte)"
+#endif
 #ifndef CO_EMCY_HIST_MAX
 #define CO_EMCY_HIST_MAX 8u
+#endif
+#if CO_EMCY_HIST_MAX < 0 || CO_EMCY_HIST_MAX > 254
+#error "CO_EMCY_HIST_MAX must be 0..254 (CiA 301: 0x1003 subs 1..254; 0 keeps no history)"
 #endif
 
 typedef struct co_emcy {

@@ -27,6 +27,15 @@
 #define CO_STORE_MAX_DATA (CO_STORE_SLOT - CO_STORE_HDR - 4u)
 /* NVM bytes one node needs (2 classes x 2 slots). */
 #define CO_STORE_NVM_SIZE (4u * CO_STORE_SLOT)
+/* Fixed sizes, not switches; what a change must keep: the header's 20
+ * bytes (store.c writes magic .. class at its bytes 0..19), an even header
+ * and slot (the flash EEPROM programs half-words from a slot's start,
+ * flash_ee.h), room for data and the CRC, and a slot in the 1 KiB page of
+ * the smallest flash (STM32F042: one slot a page). */
+#if CO_STORE_HDR < 20 || CO_STORE_HDR % 2 != 0 || CO_STORE_SLOT % 2 != 0 || \
+    CO_STORE_SLOT < CO_STORE_HDR + 4 + 2 || CO_STORE_SLOT > 1024
+#error "CO_STORE_HDR must be even and >= 20, CO_STORE_SLOT even, above header + CRC, <= 1024"
+#endif
 
 /* "save" and "load" signatures (CiA 301). */
 #define CO_SIG_SAVE 0x65766173u

@@ -26,9 +26,15 @@
 #include "co_od.h"
 
 /* TPDOs a node has room for (0x1800 + n for n below it). An MCU image of
- * one product may set fewer (boards/CMakeLists.txt, CO_MCU_SIZES_*). */
+ * one product may set fewer (its table sizes in od/<family>/family.cmake).
+ * 1..512: at least one (the table needs a member; every product has a
+ * TPDO), at most CiA 301's 512 (0x1800..0x19FF, the 9 bits of the index
+ * that tpdo.c takes as the number). */
 #ifndef CO_TPDO_MAX
 #define CO_TPDO_MAX 2u
+#endif
+#if CO_TPDO_MAX < 1 || CO_TPDO_MAX > 512
+#error "CO_TPDO_MAX must be 1..512 (CiA 301: TPDOs 0x1800..0x19FF; at least one)"
 #endif
 #define CO_PDO_MAP_MAX 8u
 
