@@ -80,9 +80,9 @@ static void usage(FILE *f)
     }
 }
 
-/* A wrong command line: one line with the cause, exit status 2. */
-static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int usage_error(const char *fmt, ...)
+/* A wrong command line: one line with the cause on stderr. */
+static void usage_print(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static void usage_print(const char *fmt, ...)
 {
     char msg[512];
     va_list ap;
@@ -90,8 +90,12 @@ static int usage_error(const char *fmt, ...)
     vsnprintf(msg, sizeof(msg), fmt, ap);
     va_end(ap);
     fprintf(stderr, "canopen-sensor: %s (see --help)\n", msg);
-    return 2;
 }
+
+/* usage_print(), then exit status 2: a macro, so that the status is seen
+ * where it is returned (clang's analyzer does not follow a variadic call,
+ * and would take a wrong command line for one that goes on). */
+#define USAGE_ERROR(...) ((void)usage_print(__VA_ARGS__), 2)
 
 /* A failure at start: one line on stderr, and in the log when it is a file. */
 static int start_failure(bool log_file, int rc, const char *msg)
@@ -304,7 +308,7 @@ static int split_ifaces(options_t *o)
     const product_t *prod = o->prod;
     const char *iface = o->iface;
     if (snprintf(o->ifbuf, sizeof(o->ifbuf), "%s", iface) >= (int)sizeof(o->ifbuf)) {
-        return usage_error("--iface %s: too long", iface);
+        return USAGE_ERROR("--iface %s: too long", iface);
     }
     unsigned nif = 0;
     for (char *s = o->ifbuf, *comma;; s = comma + 1) {
@@ -313,13 +317,13 @@ static int split_ifaces(options_t *o)
             *comma = '\0';
         }
         if (s[0] == '\0' || strlen(s) >= IFNAMSIZ) {
-            return usage_error("--iface %s: '%s' is not an interface name", iface, s);
+            return USAGE_ERROR("--iface %s: '%s' is not an interface name", iface, s);
         }
         if (nif == prod->nodes) {
             return prod->nodes == 1u
-                       ? usage_error("%s has one node: give one interface, not '%s'", prod->id,
+                       ? USAGE_ERROR("%s has one node: give one interface, not '%s'", prod->id,
                                      iface)
-                       : usage_error("%s has %u nodes: give one interface, or one per node "
+                       : USAGE_ERROR("%s has %u nodes: give one interface, or one per node "
                                      "(A,B), not '%s'", prod->id, prod->nodes, iface);
         }
         o->ifn[nif++] = s;
@@ -371,13 +375,13 @@ static int parse_options(int argc, char **argv, options_t *o)
         case 'g':
         case 'r':
             if (parse_int(optarg, c == 'g' ? &o->led_green : &o->led_red) != 0) {
-                return usage_error("bad GPIO line '%s'", optarg);
+                return USAGE_ERROR("bad GPIO line '%s'", optarg);
             }
             o->led_line_opt = c == 'g' ? "--led-green" : "--led-red";
             break;
         case 'o':
             if (strcmp(optarg, "quit") != 0 && strcmp(optarg, "run") != 0) {
-                return usage_error("--on-eof takes quit or run, not '%s'", optarg);
+                return USAGE_ERROR("--on-eof takes quit or run, not '%s'", optarg);
             }
             o->quit_on_eof = strcmp(optarg, "quit") == 0;
             break;
@@ -393,32 +397,32 @@ static int parse_options(int argc, char **argv, options_t *o)
             usage(stdout);
             return 0;
         case ':':
-            return usage_error("option %s needs a value", argv[optind - 1]);
+            return USAGE_ERROR("option %s needs a value", argv[optind - 1]);
         default:
-            return usage_error("unknown option '%s'", argv[optind - 1]);
+            return USAGE_ERROR("unknown option '%s'", argv[optind - 1]);
         }
     }
     if (optind != argc) {
-        return usage_error("unexpected argument '%s'", argv[optind]);
+        return USAGE_ERROR("unexpected argument '%s'", argv[optind]);
     }
     if (product == NULL) {
-        return usage_error("--product is missing");
+        return USAGE_ERROR("--product is missing");
     }
     o->prod = product_find(product);
     if (o->prod == NULL) {
-        return usage_error("unknown product '%s' (see --list-products)", product);
+        return USAGE_ERROR("unknown product '%s' (see --list-products)", product);
     }
     if (o->eds) {
         return GO_ON;
     }
     if (o->iface == NULL) {
-        return usage_error("--iface is missing");
+        return USAGE_ERROR("--iface is missing");
     }
     if (o->led_line_opt != NULL && o->led_chip == NULL) {
-        return usage_error("%s needs --led-chip", o->led_line_opt);
+        return USAGE_ERROR("%s needs --led-chip", o->led_line_opt);
     }
     if (o->led_chip != NULL && o->led_green == o->led_red) {
-        return usage_error("--led-green and --led-red are the same line (%d)", o->led_green);
+        return USAGE_ERROR("--led-green and --led-red are the same line (%d)", o->led_green);
     }
     return split_ifaces(o);
 }
@@ -445,7 +449,7 @@ static int set_up(app_t *a, const options_t *o)
     if (o->log_path != NULL) {
         FILE *lf = fopen(o->log_path, "a");
         if (lf == NULL) {
-            return usage_error("--log %s: %s", o->log_path, strerror(errno));
+            return USAGE_ERROR("--log %s: %s", o->log_path, strerror(errno));
         }
         lp_log_open(lf);
     }

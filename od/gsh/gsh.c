@@ -76,9 +76,10 @@ void gsh_create(const product_t *p, void *mem, void *const ports[], co_node_t *n
 {
     gsh_dev_t *d = mem;
     memset(d, 0, sizeof(*d));
-    d->nchan = p->nodes;
     static const co_node_cfg_t *const cfgs[2] = {&gsh_ch1_cfg, &gsh_ch2_cfg};
-    for (unsigned i = 0; i < d->nchan; i++) {
+    unsigned nchan = CO_CHECK(p->nodes <= 2u) ? p->nodes : 2u; /* cfgs[]: two at most */
+    d->nchan = nchan;
+    for (unsigned i = 0; i < nchan; i++) {
         gsh_chan_t *c = &d->ch[i];
         c->channel = (uint8_t)(i + 1u);
         c->incl_para.resolution = 100; /* 0x6800: 0.1 deg */
