@@ -12,7 +12,6 @@ typedef struct co_node co_node_t;
 
 typedef struct co_sync {
     uint16_t cob_id;
-    uint32_t count; /* SYNCs received in operational, for diagnostics */
 } co_sync_t;
 
 void co_sync_reconfig(co_node_t *node);

@@ -40,7 +40,6 @@ bool co_sync_receive(co_node_t *node, const co_frame_t *f)
     }
     /* CiA 301: a SYNC has no data, or a one-byte counter. */
     if (f->dlc <= 1u && node->nmt.state == CO_NMT_OPERATIONAL) {
-        node->sync.count++;
         co_tpdo_sync(node);
     }
     return true;

@@ -591,7 +591,6 @@ static bool commit(lp_nvm_t *n, uint32_t addr, const void *buf, uint32_t len)
         close(dfd);
     }
     memcpy(n->mem + addr, buf, len);
-    n->writes++;
     return true;
 }
 

@@ -236,7 +236,6 @@ void dst_create(const product_t *p, void *mem, void *const ports[], co_node_t *n
     dst_dev_t *d = mem;
     const dst_variant_t *v = p->variant;
     memset(d, 0, sizeof(*d));
-    d->v = v;
     co_incl_init(&d->incl, &d->para.incl, v->axes, v->limit_mdeg, v->wrap);
     void *const ram[CO_CLS_COUNT] = {NULL, &d->vol, &d->para, &d->lss};
     co_node_init(&d->node, v->cfg, ports[0], d, ram, 0);

@@ -52,7 +52,6 @@ typedef struct dst_dev {
     uint8_t reported; /* 0x4001 as last sent by EMCY */
     bool sensor_fault;
     uint8_t filter_active;
-    const dst_variant_t *v;
     dst_para_t para;
     dst_vol_t vol;
     co_lss_para_t lss;

@@ -81,7 +81,6 @@ void gsh_create(const product_t *p, void *mem, void *const ports[], co_node_t *n
     d->nchan = nchan;
     for (unsigned i = 0; i < nchan; i++) {
         gsh_chan_t *c = &d->ch[i];
-        c->channel = (uint8_t)(i + 1u);
         c->incl_para.resolution = 100; /* 0x6800: 0.1 deg */
         /* Channel 2 counts backwards: A2 = (3600 - A1) mod 3600. */
         c->incl_para.op[0] = (uint8_t)(i == 0u ? 0u : CO_INCL_OP_INVERT);
