@@ -129,7 +129,8 @@ uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len);
  * cfg->save_includes_lss and it changed);
  * "load" requests defaults for PARA and LSS (unless the product keeps
  * LSS, cfg->load_keeps_lss) at the next reset. Wrong
- * signature: CO_E_STORE. Both call the node's on_store op afterwards.
+ * signature: CO_E_STORE. Both call the node's stored op afterwards
+ * (co_node_ops_t.stored).
  */
 co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 co_res_t co_store_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);

@@ -1,5 +1,5 @@
 /*
- * product_list.c - the product registry (the Linux program and the tests;
+ * registry.c - the product registry (the Linux program and the tests;
  * an MCU image links one product only, so it leaves this file out).
  */
 #include <string.h>

@@ -1,5 +1,5 @@
 /*
- * hb_consumer.c - heartbeat consumer. See co_hbc.h.
+ * hbc.c - heartbeat consumer. See co_hbc.h.
  */
 #include "co_hbc.h"
 

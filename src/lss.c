@@ -1,5 +1,5 @@
 /*
- * lss_slave.c - LSS slave. See co_lss.h.
+ * lss.c - LSS slave. See co_lss.h.
  */
 #include "co_lss.h"
 

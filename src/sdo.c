@@ -1,5 +1,5 @@
 /*
- * sdo_server.c - SDO server: expedited transfer, the dispatch to the
+ * sdo.c - SDO server: expedited transfer, the dispatch to the
  * optional segmented (sdo_segment.c) and block (sdo_block.c) protocols,
  * their timeout. See co_sdo.h.
  */

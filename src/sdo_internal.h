@@ -1,5 +1,5 @@
 /*
- * sdo_internal.h - what the SDO server (sdo_server.c) shares with its
+ * sdo_internal.h - what the SDO server (sdo.c) shares with its
  * optional block transfer (sdo_block.c). Not part of the public API.
  */
 #ifndef SDO_INTERNAL_H

@@ -1,5 +1,5 @@
 /*
- * param_store.c - parameter store on the board's EEPROM emulation.
+ * store.c - parameter store on the board's EEPROM emulation.
  * See co_store.h for the record format and the power-cut argument.
  */
 #include "co_store.h"

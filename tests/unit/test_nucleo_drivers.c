@@ -28,7 +28,7 @@
 void can_irq_handler(void);
 void systick_handler(void);
 
-/* Every rate of the products' bit-rate tables (od/products.c) and CiA 301's 10 kbit/s. */
+/* Every rate of the products' bit-rate tables (od/bitrates.c) and CiA 301's 10 kbit/s. */
 static const uint16_t product_rates[] = {10, 20, 50, 100, 125, 250, 500, 800, 1000};
 
 #define EE_BASE 0x08006000u
