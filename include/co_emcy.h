@@ -96,14 +96,14 @@ bool co_emcy_active(const co_node_t *node, uint16_t code);
 void co_emcy_can_state(co_node_t *node, co_can_state_t old_state);
 
 /* Read hook for 0x1001 (error register from the error table). */
-co_res_t co_emcy_register_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
+co_res_t co_emcy_read_register(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
 /* Hooks for 0x1003: sub 0 count (write 0 clears), sub n the n-th newest. */
 #if CO_EMCY_HIST_MAX > 0
-co_res_t co_emcy_hist_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
-co_res_t co_emcy_hist_write(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_emcy_read_hist(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
+co_res_t co_emcy_write_hist(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 #endif
 /* Write hook for 0x1014: CiA 301 rules (bits 30..11 zero, CAN-ID changes
  * only while bit 31 is set). */
-co_res_t co_emcy_cobid_write(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_emcy_write_cobid(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 #endif /* CO_EMCY_H */

@@ -40,7 +40,7 @@ typedef struct co_lss {
     uint32_t switch_at;  /* (us) */
 } co_lss_t;
 
-void co_lss_init(co_node_t *node);
+void co_lss_reset(co_node_t *node);
 
 /* Handle a frame on 0x7E5. Returns true if it was one. Works in every NMT
  * state, and while the node has no node-ID. */

@@ -132,10 +132,10 @@ uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len);
  * signature: CO_E_STORE. Both call the node's stored op afterwards
  * (co_node_ops_t.stored).
  */
-co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
-co_res_t co_store_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_store_write_save(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_store_write_load(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 /* The same for sub 2..4: one CiA 301 group (co_store_save_group). */
-co_res_t co_store_group_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
-co_res_t co_store_group_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_store_write_group_save(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_store_write_group_load(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 #endif /* CO_STORE_H */

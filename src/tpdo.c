@@ -114,7 +114,7 @@ static unsigned tpdo_number(const co_od_entry_t *e)
     return (unsigned)(e->index & 0x1FFu);
 }
 
-co_res_t co_tpdo_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+co_res_t co_tpdo_write_comm(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     if (e->sub == 2u && value > TYPE_SYNC_MAX && value < TYPE_RTR_SYNC) {
         return CO_E_VAL; /* reserved transmission types */
@@ -126,7 +126,7 @@ co_res_t co_tpdo_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
     return r;
 }
 
-co_res_t co_tpdo_cobid_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+co_res_t co_tpdo_write_cobid(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     /* Bit 30 is "no RTR"; an invalid COB-ID may name any CAN-ID (0x80000000). */
     co_res_t c = co_cobid_check(value, true, true);
@@ -139,10 +139,10 @@ co_res_t co_tpdo_cobid_write_hook(co_node_t *node, const co_od_entry_t *e, uint3
     if (cur_valid && (value & 0x80000000u) == 0u && (value & 0x7FFu) != (cur & 0x7FFu)) {
         return CO_E_VAL; /* the CAN-ID changes only while the PDO is invalid */
     }
-    return co_tpdo_write_hook(node, e, value);
+    return co_tpdo_write_comm(node, e, value);
 }
 
-co_res_t co_tpdo_map_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+co_res_t co_tpdo_write_map(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     unsigned n = (unsigned)(e->index & 0x1FFu);
     uint16_t comm = (uint16_t)(0x1800u + n);
@@ -341,7 +341,7 @@ void co_tpdo_sync(co_node_t *node)
     }
 }
 
-bool co_tpdo_rtr(co_node_t *node, const co_frame_t *f)
+bool co_tpdo_receive_rtr(co_node_t *node, const co_frame_t *f)
 {
     if (!f->rtr) {
         return false;
@@ -436,4 +436,4 @@ uint32_t co_tpdo_poll(co_node_t *node, uint32_t now)
     return next;
 }
 
-const co_service_t co_rtr_service = {.receive = co_tpdo_rtr};
+const co_service_t co_rtr_service = {.receive = co_tpdo_receive_rtr};

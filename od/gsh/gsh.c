@@ -25,7 +25,7 @@ co_res_t gsh_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     if (v >= 1u && v <= 3u) {
         return CO_E_VAL_LOW; /* 4..65535 ms (L404); 0 = off (C-14) */
     }
-    return co_tpdo_write_hook(n, e, v);
+    return co_tpdo_write_comm(n, e, v);
 }
 
 co_res_t gsh_read_position(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
