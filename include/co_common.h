@@ -40,7 +40,7 @@ typedef enum co_can_state {
 } co_can_state_t;
 
 /* Keep a function out of its callers: its locals then share the stack with
- * its siblings' instead of adding to the caller's frame (param_store.c). */
+ * its siblings' instead of adding to the caller's frame (store.c). */
 #if defined(__GNUC__)
 #define CO_NOINLINE __attribute__((noinline))
 #else

@@ -39,15 +39,26 @@ enum {
     CO_ER_MANUFACTURER = 0x80,
 };
 
-/* Active errors (at least 1) and 0x1003 history depth a node has room for;
- * an MCU image may set less (boards/CMakeLists.txt). History depth 0: no
- * history is kept, and the 0x1003 hooks do not exist (a product with 0x1003
- * does not link). */
+/* Active errors and 0x1003 history depth a node has room for; an MCU image
+ * may set less (its table sizes in od/<family>/family.cmake). History depth
+ * 0: no history is kept, and the 0x1003 hooks do not exist (a product with
+ * 0x1003 does not link).
+ * CO_EMCY_ACTIVE_MAX 1..255: at least one (the table needs a member, and a
+ * product that raises an error needs a place for it), at most what the
+ * count co_emcy_t.nactive (a byte) holds.
+ * CO_EMCY_HIST_MAX 0..254: 0x1003 sub 0 is the UNSIGNED8 count of
+ * subs 1..254 (CiA 301). */
 #ifndef CO_EMCY_ACTIVE_MAX
 #define CO_EMCY_ACTIVE_MAX 8u
 #endif
+#if CO_EMCY_ACTIVE_MAX < 1 || CO_EMCY_ACTIVE_MAX > 255
+#error "CO_EMCY_ACTIVE_MAX must be 1..255 (at least one active error; counted in a byte)"
+#endif
 #ifndef CO_EMCY_HIST_MAX
 #define CO_EMCY_HIST_MAX 8u
+#endif
+#if CO_EMCY_HIST_MAX < 0 || CO_EMCY_HIST_MAX > 254
+#error "CO_EMCY_HIST_MAX must be 0..254 (CiA 301: 0x1003 subs 1..254; 0 keeps no history)"
 #endif
 
 typedef struct co_emcy {
@@ -92,18 +103,18 @@ bool co_emcy_active(const co_node_t *node, uint16_t code);
 void co_emcy_can_state(co_node_t *node, co_can_state_t old_state);
 
 /* Read hook for 0x1001 (error register from the error table). */
-co_res_t co_emcy_register_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
+co_res_t co_emcy_read_register(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
 #if CO_EMCY_HIST_MAX > 0
 /* Read hook for 0x1003 (pre-defined error field): sub 0 the number of
  * entries, sub n the n-th newest (code | additional information << 16);
  * a sub-index beyond the entries held reads CO_E_NO_DATA (0x08000024). */
-co_res_t co_emcy_hist_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
+co_res_t co_emcy_read_hist(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
 /* Write hook for 0x1003 sub 0: 0 clears the history; any other value is
  * CO_E_VAL (0x06090030, CiA 301), another sub-index CO_E_RO. */
-co_res_t co_emcy_hist_write(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_emcy_write_hist(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 #endif
 /* Write hook for 0x1014: CiA 301 rules (bits 30..11 zero, CAN-ID changes
  * only while bit 31 is set). */
-co_res_t co_emcy_cobid_write(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_emcy_write_cobid(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 #endif /* CO_EMCY_H */

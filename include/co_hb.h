@@ -41,6 +41,6 @@ uint32_t co_hb_poll(co_node_t *node, uint32_t now);
  * Standard write hook for 0x1017: stores the value and restarts the period.
  * Products with extra rules (the DST's "1..19 not accepted") validate first.
  */
-co_res_t co_hb_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_hb_write_time(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 #endif /* CO_HB_H */

@@ -25,7 +25,7 @@ typedef struct co_hbc {
 } co_hbc_t;
 
 /* Re-read 0x1016 sub 1 (after a reset or a write). */
-void co_hbc_reconfig(co_node_t *node);
+void co_hbc_reset(co_node_t *node);
 
 /* A frame on 0x700 + the monitored node-ID. Returns true if consumed. */
 bool co_hbc_receive(co_node_t *node, const co_frame_t *f);
@@ -36,6 +36,6 @@ bool co_hbc_receive(co_node_t *node, const co_frame_t *f);
 uint32_t co_hbc_poll(co_node_t *node, uint32_t now);
 
 /* Write hook for 0x1016 sub n: reserved bits 31..24 must be 0. */
-co_res_t co_hbc_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_hbc_write_time(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 #endif /* CO_HBC_H */

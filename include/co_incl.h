@@ -41,10 +41,14 @@ typedef struct co_incl_para {
 } co_incl_para_t;
 
 /* Circular outputs (0 .. one turn - 1 LSB, the P+F and GSH-A mode). An MCU
- * image of a product without them sets 0 (boards/CMakeLists.txt): the mode's
- * code is left out, and a product that sets incl.circular does not build. */
+ * image of a product without them sets 0 (od/<family>/family.cmake): the
+ * mode's code is left out, and a product that sets incl.circular does not
+ * build. 0 or 1: a switch, tested with #if. */
 #ifndef CO_INCL_CIRCULAR
 #define CO_INCL_CIRCULAR 1
+#endif
+#if CO_INCL_CIRCULAR != 0 && CO_INCL_CIRCULAR != 1
+#error "CO_INCL_CIRCULAR must be 0 or 1 (circular outputs left out or built in)"
 #endif
 
 typedef struct co_incl {

@@ -47,7 +47,7 @@ typedef struct co_lss {
  * selective switch, identification or Fastscan in progress, a configured
  * bit timing forgotten; a configured node-ID stays pending (co_node_reset
  * applies it). */
-void co_lss_init(co_node_t *node);
+void co_lss_reset(co_node_t *node);
 
 /* Handle a frame on 0x7E5. Returns true if it was one. Works in every NMT
  * state, and while the node has no node-ID. */

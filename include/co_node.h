@@ -55,7 +55,7 @@
  * store, guard asks hb through co_hb_period_ms()), and everything may call
  * back into the node (co_node_send, co_node_entry, co_node_reset, the NMT
  * state in node->nmt). The dictionary calls no protocol module: a write
- * hook of a product table (co_store_save_hook, co_tpdo_write_hook, ...) is
+ * hook of a product table (co_store_write_save, co_tpdo_write_comm, ...) is
  * named by the table, not by od.c, and a product's autosave is
  * co_node_write()'s, not co_od_write()'s.
  */

@@ -74,6 +74,16 @@ typedef enum co_cls {
  * repetition (re-reading a configuration from RAM is one; a preset that
  * computes an offset from the measurement is not). Read hook: computes
  * the value of a numeric entry.
+ *
+ * How hooks are named, everywhere (stack and products):
+ *  - a dictionary hook is <module>_write_<object> or <module>_read_<object>:
+ *    the access, then the object it serves (co_tpdo_write_map for 0x1A00,
+ *    co_hb_write_time for 0x1017, co_emcy_read_hist, dst_read_slope);
+ *  - a function that implements a field of co_node_ops_t or co_service_t
+ *    is <module>_<field>, a qualifier after it where the module has two
+ *    (dst_reset, jd_lss_store, co_guard_poll, co_hbc_reset,
+ *    co_tpdo_receive_rtr), and a product_t's are <family>_create and
+ *    <family>_sample.
  */
 typedef co_res_t (*co_od_write_fn)(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 typedef co_res_t (*co_od_read_fn)(co_node_t *node, const co_od_entry_t *e, uint32_t *value);

@@ -21,9 +21,17 @@
 typedef struct co_node co_node_t;
 
 /* Largest object a segmented or block download can write, or a block
- * upload can read (bytes); the RAM cost of the SDO server is about this. */
+ * upload can read (bytes); the RAM cost of the SDO server is about this.
+ * An MCU image may set less (its table sizes in od/<family>/family.cmake).
+ * 4..889: at least an expedited transfer's 4 bytes (a product that offers
+ * expedited SDO only, the DST, needs no more), at most one block: 127
+ * segments of 7 bytes (CiA 301's largest blksize; sdo_block.c sends a
+ * buffer as one block of (CO_SDO_BUF + 6) / 7 segments). */
 #ifndef CO_SDO_BUF
-#define CO_SDO_BUF 64u /* an MCU image may set less (boards/CMakeLists.txt) */
+#define CO_SDO_BUF 64u
+#endif
+#if CO_SDO_BUF < 4 || CO_SDO_BUF > 889
+#error "CO_SDO_BUF must be 4..889 (an expedited transfer's 4 bytes .. one block of 127 x 7 bytes)"
 #endif
 /* Default SDO timeout between segments (CiA 301 leaves it to the device). */
 #define CO_SDO_TIMEOUT_US 1000000u

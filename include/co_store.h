@@ -38,6 +38,15 @@
 #define CO_STORE_MAX_DATA (CO_STORE_SLOT - CO_STORE_HDR - 4u)
 /* NVM bytes one node needs (2 classes x 2 slots). */
 #define CO_STORE_NVM_SIZE (4u * CO_STORE_SLOT)
+/* Fixed sizes, not switches; what a change must keep: the header's 20
+ * bytes (store.c writes magic .. class at its bytes 0..19), an even header
+ * and slot (the flash EEPROM programs half-words from a slot's start,
+ * flash_ee.h), room for data and the CRC, and a slot in the 1 KiB page of
+ * the smallest flash (STM32F042: one slot a page). */
+#if CO_STORE_HDR < 20 || CO_STORE_HDR % 2 != 0 || CO_STORE_SLOT % 2 != 0 || \
+    CO_STORE_SLOT < CO_STORE_HDR + 4 + 2 || CO_STORE_SLOT > 1024
+#error "CO_STORE_HDR must be even and >= 20, CO_STORE_SLOT even, above header + CRC, <= 1024"
+#endif
 
 /* "save" and "load" signatures (CiA 301). */
 #define CO_SIG_SAVE 0x65766173u
@@ -134,21 +143,21 @@ uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len);
  * where cfg->save_includes_lss and it changed; results of co_store_save().
  * On success the product's stored hook (co_node_ops_t.stored) runs.
  */
-co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_store_write_save(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 /*
  * Write hook for 0x1011 sub 1 "restore default parameters": value must be
  * "load" (CO_SIG_LOAD), else CO_E_STORE. Makes the next restore of PARA
  * (and of LSS, unless cfg->load_keeps_lss) use defaults: the values in use
  * stay until the next reset. Then the stored hook, as for "save".
  */
-co_res_t co_store_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_store_write_load(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 /* Write hook for 0x1010 sub 2..4: "save" of one CiA 301 group
  * (co_store_save_group; LSS too where cfg->save_includes_lss). Another
  * signature, or another sub-index: CO_E_STORE. */
-co_res_t co_store_group_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_store_write_group_save(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 /* Write hook for 0x1011 sub 2..4: "load" of one group: its entries are
  * stored as their defaults, the others keep their stored values. Same
  * errors as the group save. */
-co_res_t co_store_group_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_store_write_group_load(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 #endif /* CO_STORE_H */

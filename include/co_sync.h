@@ -14,7 +14,6 @@ typedef struct co_node co_node_t;
 
 typedef struct co_sync {
     uint16_t cob_id;
-    uint32_t count; /* SYNCs received in operational, for diagnostics */
 } co_sync_t;
 
 /* Re-read the SYNC COB-ID from 0x1005 (0x080 where the dictionary has
@@ -22,7 +21,7 @@ typedef struct co_sync {
 void co_sync_reconfig(co_node_t *node);
 
 /* Write hook for 0x1005: store and use the new COB-ID at once. */
-co_res_t co_sync_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_sync_write_cobid(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 /* Returns true if f was a SYNC; drives the synchronous TPDOs. */
 bool co_sync_receive(co_node_t *node, const co_frame_t *f);

@@ -35,9 +35,15 @@
 #include "co_od.h"
 
 /* TPDOs a node has room for (0x1800 + n for n below it). An MCU image of
- * one product may set fewer (boards/CMakeLists.txt, CO_MCU_SIZES_*). */
+ * one product may set fewer (its table sizes in od/<family>/family.cmake).
+ * 1..512: at least one (the table needs a member; every product has a
+ * TPDO), at most CiA 301's 512 (0x1800..0x19FF, the 9 bits of the index
+ * that tpdo.c takes as the number). */
 #ifndef CO_TPDO_MAX
 #define CO_TPDO_MAX 2u
+#endif
+#if CO_TPDO_MAX < 1 || CO_TPDO_MAX > 512
+#error "CO_TPDO_MAX must be 1..512 (CiA 301: TPDOs 0x1800..0x19FF; at least one)"
 #endif
 #define CO_PDO_MAP_MAX 8u
 
@@ -98,7 +104,7 @@ void co_tpdo_stop(co_node_t *node);
 void co_tpdo_sync(co_node_t *node);
 
 /* A remote frame: sends the TPDO it asks for. Returns true if it was one. */
-bool co_tpdo_rtr(co_node_t *node, const co_frame_t *f);
+bool co_tpdo_receive_rtr(co_node_t *node, const co_frame_t *f);
 
 /*
  * An application event for TPDO n (new value, change of state): types
@@ -122,14 +128,14 @@ void co_tpdo_build(co_node_t *node, unsigned n, co_frame_t *f);
  * Write hook for 0x1800.. sub-entries: store, then reconfigure. Checks
  * only what every product shares: transmission types 241..251 are invalid.
  */
-co_res_t co_tpdo_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_tpdo_write_comm(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 /*
  * Stricter write hook for a writable COB-ID (sub 1), CiA 301: bits 29 and
  * 11..28 zero, the CAN-ID changes only while the PDO is invalid (bit 31),
  * and a valid one not to a restricted CAN-ID. Abort 0x06090030 otherwise.
  */
-co_res_t co_tpdo_cobid_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_tpdo_write_cobid(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 /*
  * Write hook for a writable mapping (0x1A00 + n), CiA 301 dynamic mapping:
@@ -138,6 +144,6 @@ co_res_t co_tpdo_cobid_write_hook(co_node_t *node, const co_od_entry_t *e, uint3
  * while sub 0 is 0 (0x06010000), naming an existing (0x06020000) mappable
  * (0x06040041) object.
  */
-co_res_t co_tpdo_map_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+co_res_t co_tpdo_write_map(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 #endif /* CO_TPDO_H */

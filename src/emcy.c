@@ -100,7 +100,7 @@ bool co_emcy_error(co_node_t *node, uint16_t code, uint8_t er_bits, bool active,
     return true;
 }
 
-co_res_t co_emcy_register_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value)
+co_res_t co_emcy_read_register(co_node_t *node, const co_od_entry_t *e, uint32_t *value)
 {
     (void)e;
     *value = co_emcy_register(node);
@@ -108,7 +108,7 @@ co_res_t co_emcy_register_read(co_node_t *node, const co_od_entry_t *e, uint32_t
 }
 
 #if CO_EMCY_HIST_MAX > 0
-co_res_t co_emcy_hist_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value)
+co_res_t co_emcy_read_hist(co_node_t *node, const co_od_entry_t *e, uint32_t *value)
 {
     const co_emcy_t *em = &node->emcy;
     if (e->sub == 0u) {
@@ -127,7 +127,7 @@ co_res_t co_emcy_hist_read(co_node_t *node, const co_od_entry_t *e, uint32_t *va
     return CO_OK;
 }
 
-co_res_t co_emcy_hist_write(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+co_res_t co_emcy_write_hist(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     if (e->sub != 0u) {
         return CO_E_RO;
@@ -140,7 +140,7 @@ co_res_t co_emcy_hist_write(co_node_t *node, const co_od_entry_t *e, uint32_t va
 }
 #endif
 
-co_res_t co_emcy_cobid_write(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+co_res_t co_emcy_write_cobid(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     /* Bits 30 and 29 zero, an 11-bit CAN-ID that is not restricted while
      * the EMCY is valid (CiA 301 7.3.5, 7.5.2.21). */

@@ -1,11 +1,11 @@
 /*
- * hb_consumer.c - heartbeat consumer. See co_hbc.h.
+ * hbc.c - heartbeat consumer. See co_hbc.h.
  */
 #include "co_hbc.h"
 
 #include "co_node.h"
 
-void co_hbc_reconfig(co_node_t *node)
+void co_hbc_reset(co_node_t *node)
 {
     co_hbc_t *c = &node->hbc;
     uint32_t v = 0;
@@ -23,14 +23,14 @@ void co_hbc_reconfig(co_node_t *node)
     c->lost = false;
 }
 
-co_res_t co_hbc_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+co_res_t co_hbc_write_time(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     if ((value & 0xFF000000u) != 0u || ((value >> 16) & 0xFFu) > 127u) {
         return CO_E_VAL;
     }
     co_res_t r = co_od_store(node, e, value);
     if (r == CO_OK) {
-        co_hbc_reconfig(node);
+        co_hbc_reset(node);
     }
     return r;
 }
@@ -76,4 +76,4 @@ uint32_t co_hbc_poll(co_node_t *node, uint32_t now)
 }
 
 const co_service_t co_hbc_service = {.receive = co_hbc_receive, .poll = co_hbc_poll,
-                                     .reset = co_hbc_reconfig};
+                                     .reset = co_hbc_reset};

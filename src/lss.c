@@ -1,5 +1,5 @@
 /*
- * lss_slave.c - LSS slave. See co_lss.h.
+ * lss.c - LSS slave. See co_lss.h.
  */
 #include "co_lss.h"
 
@@ -34,7 +34,7 @@ enum {
 /* kbit/s of each CiA 305 bit-timing index (5: reserved; 9: auto, none). */
 static const uint16_t lss_kbps[16] = {1000, 800, 500, 250, 125, 0, 50, 20, 10};
 
-void co_lss_init(co_node_t *node)
+void co_lss_reset(co_node_t *node)
 {
     co_lss_t *l = &node->lss;
     uint8_t keep = l->pending_id;
@@ -273,4 +273,4 @@ static uint32_t co_lss_poll(co_node_t *node, uint32_t now)
 }
 
 const co_service_t co_lss_service = {.receive = co_lss_receive, .poll = co_lss_poll,
-                                     .reset = co_lss_init, .always = true};
+                                     .reset = co_lss_reset, .always = true};

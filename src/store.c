@@ -1,5 +1,5 @@
 /*
- * param_store.c - parameter store on the board's EEPROM emulation.
+ * store.c - parameter store on the board's EEPROM emulation.
  * See co_store.h for the record format and the power-cut argument.
  */
 #include "co_store.h"
@@ -433,7 +433,7 @@ static co_res_t group_op(co_node_t *node, uint8_t sub, bool defaults)
     return r;
 }
 
-co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+co_res_t co_store_write_save(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     (void)e;
     if (value != CO_SIG_SAVE) {
@@ -452,7 +452,7 @@ co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t va
     return r;
 }
 
-co_res_t co_store_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+co_res_t co_store_write_load(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     (void)e;
     if (value != CO_SIG_LOAD) {
@@ -482,12 +482,12 @@ static co_res_t group_hook(co_node_t *node, const co_od_entry_t *e, uint32_t val
     return r;
 }
 
-co_res_t co_store_group_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+co_res_t co_store_write_group_save(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     return group_hook(node, e, value, CO_SIG_SAVE, false);
 }
 
-co_res_t co_store_group_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+co_res_t co_store_write_group_load(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     return group_hook(node, e, value, CO_SIG_LOAD, true);
 }

@@ -16,7 +16,7 @@ void co_sync_reconfig(co_node_t *node)
     node->sync.cob_id = (uint16_t)(cob & 0x7FFu);
 }
 
-co_res_t co_sync_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
+co_res_t co_sync_write_cobid(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     /* 11-bit IDs only; bit 30 (this node generates SYNC) refused: no
      * product produces SYNC (the specs: 0x06090030); bit 31 means nothing
@@ -40,7 +40,6 @@ bool co_sync_receive(co_node_t *node, const co_frame_t *f)
     }
     /* CiA 301: a SYNC has no data, or a one-byte counter. */
     if (f->dlc <= 1u && node->nmt.state == CO_NMT_OPERATIONAL) {
-        node->sync.count++;
         co_tpdo_sync(node);
     }
     return true;

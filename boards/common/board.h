@@ -9,7 +9,9 @@
 #include "co_common.h"
 #include "product.h"
 
-/* Clocks, pins, timer, CAN at the product's bit-rate code; returns false on a fault. */
+/* Clocks, pins, timer, the CAN controller's clock and receive interrupt;
+ * returns false on a fault. The bit rate comes later: the node's start
+ * asks for it (co_port_can_bitrate -> board_can_bitrate). */
 bool board_init(void);
 /* Bring the CAN controller to a bit rate (kbit/s); false if it cannot. */
 bool board_can_bitrate(uint16_t kbps);

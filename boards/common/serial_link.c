@@ -38,7 +38,7 @@ void serial_link_sample(serial_link_t *s, const product_t *p, int32_t values[],
 static void put_str(serial_put_fn put, const char *t)
 {
     for (; *t != '\0'; t++) {
-        put((*t >= ' ' && *t <= '~') || *t == '\r' ? *t : '?'); /* '\r': ours, ends a line */
+        put((char)((*t >= ' ' && *t <= '~') || *t == '\r' ? *t : '?')); /* '\r': ours, ends a line */
     }
 }
 
@@ -311,7 +311,8 @@ static void input_line(serial_link_t *s, serial_put_fn put)
     bool ok;
     if (cmd == NULL) {
         return; /* blank: nothing to answer */
-    } else if (equal(cmd, "set")) {
+    }
+    if (equal(cmd, "set")) {
         ok = cmd_set(s, &t, put);
     } else if (equal(cmd, "fault")) {
         ok = cmd_fault(s, &t, put);

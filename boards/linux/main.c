@@ -80,9 +80,9 @@ static void usage(FILE *f)
     }
 }
 
-/* A wrong command line: one line with the cause, exit status 2. */
-static int usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
-static int usage_error(const char *fmt, ...)
+/* A wrong command line: one line with the cause on stderr. */
+static void usage_print(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static void usage_print(const char *fmt, ...)
 {
     char msg[512];
     va_list ap;
@@ -90,8 +90,12 @@ static int usage_error(const char *fmt, ...)
     vsnprintf(msg, sizeof(msg), fmt, ap);
     va_end(ap);
     fprintf(stderr, "canopen-sensor: %s (see --help)\n", msg);
-    return 2;
 }
+
+/* usage_print(), then exit status 2: a macro, so that the status is seen
+ * where it is returned (clang's analyzer does not follow a variadic call,
+ * and would take a wrong command line for one that goes on). */
+#define USAGE_ERROR(...) ((void)usage_print(__VA_ARGS__), 2)
 
 /* A failure at start: one line on stderr, and in the log when it is a file. */
 static int start_failure(bool log_file, int rc, const char *msg)
@@ -124,6 +128,10 @@ static int parse_int(const char *s, int *out)
 /* Rejected input lines: at most this many logged a second, the rest counted. */
 #define IN_REJECT_LINES 5u
 
+/* epoll's tags: a node's socket is tagged with the node's index. */
+#define EV_SIGNAL 100u
+#define EV_STDIN 101u
+
 typedef struct app {
     const product_t *prod;
     unsigned nnodes;
@@ -135,6 +143,15 @@ typedef struct app {
     bool quit_on_eof;
     lp_rate_t in_rate;
     unsigned long in_held; /* rejected lines not logged yet */
+    /* Set up by set_up(), used by the loop: */
+    int sfd;               /* signalfd: SIGINT, SIGTERM, SIGHUP */
+    int ep;                /* epoll over sfd, stdin and the CAN sockets */
+    bool stdin_file;       /* stdin cannot be polled: read a block a pass */
+    uint32_t next_sample;  /* when the product samples its inputs next */
+    lp_nvm_t nvm;
+    uint8_t nvm_mem[PRODUCT_MAX_NODES * CO_STORE_NVM_SIZE];
+    /* The instance: in main's frame (app_t lives there), alive until main returns. */
+    _Alignas(max_align_t) unsigned char inst[sizeof(product_any_t)];
 } app_t;
 
 /* The node sees the CAN state its port shows (link, error frames, simulator). */
@@ -263,17 +280,72 @@ static void log_store_status(app_t *a, const lp_nvm_t *nvm)
     }
 }
 
-int main(int argc, char **argv)
+/* The command line, as parse_options() leaves it. */
+typedef struct options {
+    const product_t *prod;
+    const char *iface;
+    const char *nvm_path;
+    const char *log_path;
+    const char *led_chip;
+    const char *led_line_opt; /* the last --led-green/--led-red given, or NULL */
+    int led_green;
+    int led_red;
+    bool eds;
+    bool quit_on_eof;
+    /* --iface split at its commas: one interface per node (the first one
+     * for every node when one is given); ifn[] points into ifbuf. */
+    char ifbuf[PRODUCT_MAX_NODES * IFNAMSIZ + 8];
+    const char *ifn[PRODUCT_MAX_NODES];
+} options_t;
+
+/* Not an exit status: go on (parse_options, set_up). */
+#define GO_ON (-1)
+
+/* --iface: one interface for all nodes, or one per node ("A,B"). Returns
+ * GO_ON or the exit status of a wrong command line. */
+static int split_ifaces(options_t *o)
 {
+    const product_t *prod = o->prod;
+    const char *iface = o->iface;
+    if (snprintf(o->ifbuf, sizeof(o->ifbuf), "%s", iface) >= (int)sizeof(o->ifbuf)) {
+        return USAGE_ERROR("--iface %s: too long", iface);
+    }
+    unsigned nif = 0;
+    for (char *s = o->ifbuf, *comma;; s = comma + 1) {
+        comma = strchr(s, ',');
+        if (comma != NULL) {
+            *comma = '\0';
+        }
+        if (s[0] == '\0' || strlen(s) >= IFNAMSIZ) {
+            return USAGE_ERROR("--iface %s: '%s' is not an interface name", iface, s);
+        }
+        if (nif == prod->nodes) {
+            return prod->nodes == 1u
+                       ? USAGE_ERROR("%s has one node: give one interface, not '%s'", prod->id,
+                                     iface)
+                       : USAGE_ERROR("%s has %u nodes: give one interface, or one per node "
+                                     "(A,B), not '%s'", prod->id, prod->nodes, iface);
+        }
+        o->ifn[nif++] = s;
+        if (comma == NULL) {
+            break;
+        }
+    }
+    for (unsigned i = nif; i < prod->nodes; i++) {
+        o->ifn[i] = o->ifn[0];
+    }
+    return GO_ON;
+}
+
+/* The command line into *o, checked: returns GO_ON, 0 after --help or
+ * --list-products (printed), or 2 for a wrong command line (one line on
+ * stderr). With --eds only the product is checked. Nothing is opened. */
+static int parse_options(int argc, char **argv, options_t *o)
+{
+    memset(o, 0, sizeof(*o));
     const char *product = NULL;
-    const char *iface = NULL;
-    const char *nvm_path = NULL;
-    const char *log_path = NULL;
-    const char *led_chip = NULL;
-    const char *led_line_opt = NULL;
-    int led_green = 0;
-    int led_red = 1;
-    bool eds = false;
+    o->led_green = 0;
+    o->led_red = 1;
     /* --on-eof quit by default: standard input is the sensor's tie to whoever
      * started it. A CI job whose parent exits or dies closes the pipe, and
      * the sensor leaves the bus instead of running on as an orphan; Ctrl-D
@@ -282,7 +354,7 @@ int main(int argc, char **argv)
      * and would kill a sensor a script starts in the background on purpose.
      * --on-eof run is for input that ends at once (/dev/null, a daemon, a
      * file of commands, tools/vcan-run). */
-    bool quit_on_eof = true;
+    o->quit_on_eof = true;
     static const struct option opts[] = {
         {"product", required_argument, NULL, 'p'}, {"iface", required_argument, NULL, 'i'},
         {"nvm", required_argument, NULL, 'n'},     {"log", required_argument, NULL, 'l'},
@@ -296,25 +368,25 @@ int main(int argc, char **argv)
     while ((c = getopt_long(argc, argv, ":", opts, NULL)) != -1) {
         switch (c) {
         case 'p': product = optarg; break;
-        case 'i': iface = optarg; break;
-        case 'n': nvm_path = optarg; break;
-        case 'l': log_path = optarg; break;
-        case 'c': led_chip = optarg; break;
+        case 'i': o->iface = optarg; break;
+        case 'n': o->nvm_path = optarg; break;
+        case 'l': o->log_path = optarg; break;
+        case 'c': o->led_chip = optarg; break;
         case 'g':
         case 'r':
-            if (parse_int(optarg, c == 'g' ? &led_green : &led_red) != 0) {
-                return usage_error("bad GPIO line '%s'", optarg);
+            if (parse_int(optarg, c == 'g' ? &o->led_green : &o->led_red) != 0) {
+                return USAGE_ERROR("bad GPIO line '%s'", optarg);
             }
-            led_line_opt = c == 'g' ? "--led-green" : "--led-red";
+            o->led_line_opt = c == 'g' ? "--led-green" : "--led-red";
             break;
         case 'o':
             if (strcmp(optarg, "quit") != 0 && strcmp(optarg, "run") != 0) {
-                return usage_error("--on-eof takes quit or run, not '%s'", optarg);
+                return USAGE_ERROR("--on-eof takes quit or run, not '%s'", optarg);
             }
-            quit_on_eof = strcmp(optarg, "quit") == 0;
+            o->quit_on_eof = strcmp(optarg, "quit") == 0;
             break;
         case 'E':
-            eds = true;
+            o->eds = true;
             break;
         case 'L':
             for (size_t i = 0; product_list[i] != NULL; i++) {
@@ -325,100 +397,80 @@ int main(int argc, char **argv)
             usage(stdout);
             return 0;
         case ':':
-            return usage_error("option %s needs a value", argv[optind - 1]);
+            return USAGE_ERROR("option %s needs a value", argv[optind - 1]);
         default:
-            return usage_error("unknown option '%s'", argv[optind - 1]);
+            return USAGE_ERROR("unknown option '%s'", argv[optind - 1]);
         }
     }
     if (optind != argc) {
-        return usage_error("unexpected argument '%s'", argv[optind]);
+        return USAGE_ERROR("unexpected argument '%s'", argv[optind]);
     }
     if (product == NULL) {
-        return usage_error("--product is missing");
+        return USAGE_ERROR("--product is missing");
     }
-    const product_t *prod = product_find(product);
-    if (prod == NULL) {
-        return usage_error("unknown product '%s' (see --list-products)", product);
+    o->prod = product_find(product);
+    if (o->prod == NULL) {
+        return USAGE_ERROR("unknown product '%s' (see --list-products)", product);
     }
-    if (eds) {
-        if (eds_write(stdout, prod) != 0) {
-            fprintf(stderr, "canopen-sensor: %s: EDS overrides that apply to no entry\n", prod->id);
-            return 1;
-        }
-        return fflush(stdout) == 0 ? 0 : 1;
+    if (o->eds) {
+        return GO_ON;
     }
-    if (iface == NULL) {
-        return usage_error("--iface is missing");
+    if (o->iface == NULL) {
+        return USAGE_ERROR("--iface is missing");
     }
-    if (led_line_opt != NULL && led_chip == NULL) {
-        return usage_error("%s needs --led-chip", led_line_opt);
+    if (o->led_line_opt != NULL && o->led_chip == NULL) {
+        return USAGE_ERROR("%s needs --led-chip", o->led_line_opt);
     }
-    if (led_chip != NULL && led_green == led_red) {
-        return usage_error("--led-green and --led-red are the same line (%d)", led_green);
+    if (o->led_chip != NULL && o->led_green == o->led_red) {
+        return USAGE_ERROR("--led-green and --led-red are the same line (%d)", o->led_green);
     }
+    return split_ifaces(o);
+}
 
-    /* Interfaces: one for all nodes, or one per node ("A,B"). */
-    char ifbuf[PRODUCT_MAX_NODES * IFNAMSIZ + 8];
-    if (snprintf(ifbuf, sizeof(ifbuf), "%s", iface) >= (int)sizeof(ifbuf)) {
-        return usage_error("--iface %s: too long", iface);
+/* --eds: the product's EDS on stdout; returns the exit status. */
+static int print_eds(const product_t *prod)
+{
+    if (eds_write(stdout, prod) != 0) {
+        fprintf(stderr, "canopen-sensor: %s: EDS overrides that apply to no entry\n", prod->id);
+        return 1;
     }
-    const char *ifn[PRODUCT_MAX_NODES];
-    unsigned nif = 0;
-    for (char *s = ifbuf, *comma;; s = comma + 1) {
-        comma = strchr(s, ',');
-        if (comma != NULL) {
-            *comma = '\0';
-        }
-        if (s[0] == '\0' || strlen(s) >= IFNAMSIZ) {
-            return usage_error("--iface %s: '%s' is not an interface name", iface, s);
-        }
-        if (nif == prod->nodes) {
-            return prod->nodes == 1u
-                       ? usage_error("%s has one node: give one interface, not '%s'", prod->id,
-                                     iface)
-                       : usage_error("%s has %u nodes: give one interface, or one per node "
-                                     "(A,B), not '%s'", prod->id, prod->nodes, iface);
-        }
-        ifn[nif++] = s;
-        if (comma == NULL) {
-            break;
-        }
-    }
-    for (unsigned i = nif; i < prod->nodes; i++) {
-        ifn[i] = ifn[0];
-    }
+    return fflush(stdout) == 0 ? 0 : 1;
+}
 
-    app_t a;
-    memset(&a, 0, sizeof(a));
-    a.prod = prod;
-    a.quit_on_eof = quit_on_eof;
-    if (log_path != NULL) {
-        FILE *lf = fopen(log_path, "a");
+/* Everything the loop needs, in the order a failure must be reported:
+ * the log, the EEPROM file, the CAN sockets and LEDs, the signals and
+ * epoll, then the instance, its first sample and the nodes' start.
+ * Returns GO_ON, or the exit status of a failure at start (reported). */
+static int set_up(app_t *a, const options_t *o)
+{
+    memset(a, 0, sizeof(*a));
+    a->prod = o->prod;
+    a->quit_on_eof = o->quit_on_eof;
+    if (o->log_path != NULL) {
+        FILE *lf = fopen(o->log_path, "a");
         if (lf == NULL) {
-            return usage_error("--log %s: %s", log_path, strerror(errno));
+            return USAGE_ERROR("--log %s: %s", o->log_path, strerror(errno));
         }
         lp_log_open(lf);
     }
-    bool logf = log_path != NULL;
-    a.nnodes = a.prod->nodes;
-    sim_init(&a.sim, a.prod);
+    bool logf = o->log_path != NULL;
+    a->nnodes = a->prod->nodes;
+    sim_init(&a->sim, a->prod);
 
     char err[600];
-    uint8_t nvm_mem[PRODUCT_MAX_NODES * CO_STORE_NVM_SIZE];
-    lp_nvm_t nvm;
-    int r = lp_nvm_open(&nvm, nvm_path, nvm_mem, (uint32_t)(a.nnodes * CO_STORE_NVM_SIZE), err,
-                        sizeof(err));
+    int r = lp_nvm_open(&a->nvm, o->nvm_path, a->nvm_mem,
+                        (uint32_t)(a->nnodes * CO_STORE_NVM_SIZE), err, sizeof(err));
     if (r != 0) {
         return start_failure(logf, r == -2 ? 2 : 1, err);
     }
     uint32_t t = now_us();
     void *ports[PRODUCT_MAX_NODES];
-    for (unsigned i = 0; i < a.nnodes; i++) {
-        if (lp_open(&a.ports[i], ifn[i], i, &nvm, t, err, sizeof(err)) != 0) {
+    for (unsigned i = 0; i < a->nnodes; i++) {
+        if (lp_open(&a->ports[i], o->ifn[i], i, &a->nvm, t, err, sizeof(err)) != 0) {
             return start_failure(logf, 1, err);
         }
-        ports[i] = &a.ports[i];
-        if (leds_open(&a.leds[i], i == 0 ? led_chip : NULL, led_green, led_red, err,
+        ports[i] = &a->ports[i];
+        if (leds_open(&a->leds[i], i == 0 ? o->led_chip : NULL, o->led_green, o->led_red, err,
                       sizeof(err)) != 0) {
             return start_failure(logf, 1, err);
         }
@@ -431,146 +483,186 @@ int main(int argc, char **argv)
     sigaddset(&sigs, SIGHUP);
     sigprocmask(SIG_BLOCK, &sigs, NULL);
     signal(SIGPIPE, SIG_IGN);
-    int sfd = signalfd(-1, &sigs, SFD_CLOEXEC | SFD_NONBLOCK);
-    int ep = epoll_create1(EPOLL_CLOEXEC);
-    if (sfd < 0 || ep < 0) {
+    a->sfd = signalfd(-1, &sigs, SFD_CLOEXEC | SFD_NONBLOCK);
+    a->ep = epoll_create1(EPOLL_CLOEXEC);
+    if (a->sfd < 0 || a->ep < 0) {
         snprintf(err, sizeof(err), "epoll/signalfd: %s", strerror(errno));
         return start_failure(logf, 1, err);
     }
     struct epoll_event ev = {.events = EPOLLIN};
-    ev.data.u32 = 100;
-    epoll_ctl(ep, EPOLL_CTL_ADD, sfd, &ev);
-    ev.data.u32 = 101;
+    ev.data.u32 = EV_SIGNAL;
+    epoll_ctl(a->ep, EPOLL_CTL_ADD, a->sfd, &ev);
+    ev.data.u32 = EV_STDIN;
     /* A pipe or terminal is polled; a regular file or /dev/null cannot be
      * (EPERM): it never blocks, and is read a block at a time in the loop. */
-    bool stdin_polled = epoll_ctl(ep, EPOLL_CTL_ADD, STDIN_FILENO, &ev) == 0;
+    bool stdin_polled = epoll_ctl(a->ep, EPOLL_CTL_ADD, STDIN_FILENO, &ev) == 0;
     int stdin_errno = stdin_polled ? 0 : errno;
-    for (unsigned i = 0; i < a.nnodes; i++) {
+    for (unsigned i = 0; i < a->nnodes; i++) {
         ev.data.u32 = i;
-        epoll_ctl(ep, EPOLL_CTL_ADD, a.ports[i].fd, &ev);
+        epoll_ctl(a->ep, EPOLL_CTL_ADD, a->ports[i].fd, &ev);
     }
 
-    /* The instance: on this stack frame, alive until main returns. */
-    _Alignas(max_align_t) unsigned char mem[sizeof(product_any_t)];
-    if (a.prod->inst_size > sizeof(mem)) {
+    if (a->prod->inst_size > sizeof(a->inst)) {
         return start_failure(logf, 1, "product instance too large");
     }
-    a.prod->create(a.prod, mem, ports, a.nodes);
-    a.prod->sample(mem, a.sim.values, a.sim.faults);
+    a->prod->create(a->prod, a->inst, ports, a->nodes);
+    a->prod->sample(a->inst, a->sim.values, a->sim.faults);
     t = now_us();
-    for (unsigned i = 0; i < a.nnodes; i++) {
-        co_node_start(a.nodes[i], t);
+    for (unsigned i = 0; i < a->nnodes; i++) {
+        co_node_start(a->nodes[i], t);
         lp_log("node %u: %s, node-ID 0x%02X on %s, bit-rate code %u = %u kbit/s (vcan ignores it)",
-               i, a.prod->id, co_node_id(a.nodes[i]), ifn[i], co_node_bitrate(a.nodes[i]),
-               product_kbps(a.prod, co_node_bitrate(a.nodes[i])));
+               i, a->prod->id, co_node_id(a->nodes[i]), o->ifn[i], co_node_bitrate(a->nodes[i]),
+               product_kbps(a->prod, co_node_bitrate(a->nodes[i])));
     }
-    log_store_status(&a, &nvm);
+    log_store_status(a, &a->nvm);
     /* A regular file or a device never blocks: read one block a pass of the
-     * loop below, at most one a millisecond, so that the nodes run and
-     * signals are heard however long (/dev/zero: endless) it is. */
-    bool stdin_file = !stdin_polled && stdin_errno == EPERM;
+     * loop, at most one a millisecond, so that the nodes run and signals
+     * are heard however long (/dev/zero: endless) it is. */
+    a->stdin_file = !stdin_polled && stdin_errno == EPERM;
     if (!stdin_polled) {
-        if (stdin_file) {
+        if (a->stdin_file) {
             lp_log("standard input is a file or device: read a block a millisecond");
         } else {
             lp_log("standard input cannot be polled (%s)", strerror(stdin_errno));
-            end_of_input(&a);
+            end_of_input(a);
         }
     }
-    uint32_t next_sample = t + CO_FILTER_PERIOD_US;
-    int rc = 0;
+    a->next_sample = t + CO_FILTER_PERIOD_US;
+    return GO_ON;
+}
 
-    while (!a.sim.quit) {
-        t = now_us();
-        if (!co_time_before(t, next_sample)) {
-            a.prod->sample(mem, a.sim.values, a.sim.faults);
-            next_sample += CO_FILTER_PERIOD_US;
-            if (!co_time_before(t, next_sample)) {
-                next_sample = t + CO_FILTER_PERIOD_US; /* we slept too long: no burst */
+/* One pass over the nodes at time t: ports, CAN state, the node's timers,
+ * LEDs, the transmit queue. Returns the delay until one of them needs the
+ * next pass; *backlog tells that a port kept frames the kernel refused. */
+static uint32_t poll_nodes(app_t *a, uint32_t t, uint32_t wait, bool *backlog)
+{
+    for (unsigned i = 0; i < a->nnodes; i++) {
+        wait = co_min_u32(wait, lp_poll(&a->ports[i], t));
+        sync_can_state(a, i);
+        wait = co_min_u32(wait, co_node_poll(a->nodes[i], t));
+        bool g;
+        bool rd;
+        uint32_t led_next;
+        co_led_pattern_t gp;
+        co_led_pattern_t rp;
+        co_node_leds(a->nodes[i], t, &g, &rd, &led_next);
+        co_node_led_patterns(a->nodes[i], &gp, &rp);
+        leds_set(&a->leds[i], i, g, rd, gp, rp);
+        wait = co_min_u32(wait, led_next);
+        *backlog |= lp_flush(&a->ports[i]) > 0u;
+        sync_can_state(a, i); /* a write may have found the link gone */
+    }
+    return wait;
+}
+
+/* What epoll reported for src (EV_SIGNAL, EV_STDIN, or a node's socket). */
+static void handle_event(app_t *a, uint32_t src, uint32_t t)
+{
+    if (src == EV_SIGNAL) {
+        struct signalfd_siginfo si;
+        if (read(a->sfd, &si, sizeof(si)) == (ssize_t)sizeof(si)) {
+            lp_log("signal %u (%s): stopping", si.ssi_signo, strsignal((int)si.ssi_signo));
+            a->sim.quit = true;
+        }
+    } else if (src == EV_STDIN) {
+        if (!read_stdin(a)) {
+            epoll_ctl(a->ep, EPOLL_CTL_DEL, STDIN_FILENO, NULL);
+        }
+    } else if (src < a->nnodes) {
+        co_frame_t f;
+        /* At most 64 frames, then the timers again: a flooded bus
+         * must not starve the heartbeat (the rest stay queued in
+         * the socket; epoll reports them at once). */
+        for (int m = 0; m < 64; m++) {
+            int rr = lp_read(&a->ports[src], &f, t);
+            if (rr == 0) {
+                break;
+            }
+            if (rr == 1) {
+                co_node_receive(a->nodes[src], &f, t);
             }
         }
-        uint32_t wait = co_time_until(t, next_sample);
-        bool backlog = false;
-        for (unsigned i = 0; i < a.nnodes; i++) {
-            wait = co_min_u32(wait, lp_poll(&a.ports[i], t));
-            sync_can_state(&a, i);
-            wait = co_min_u32(wait, co_node_poll(a.nodes[i], t));
-            bool g;
-            bool rd;
-            uint32_t led_next;
-            co_led_pattern_t gp;
-            co_led_pattern_t rp;
-            co_node_leds(a.nodes[i], t, &g, &rd, &led_next);
-            co_node_led_patterns(a.nodes[i], &gp, &rp);
-            leds_set(&a.leds[i], i, g, rd, gp, rp);
-            wait = co_min_u32(wait, led_next);
-            backlog |= lp_flush(&a.ports[i]) > 0u;
-            sync_can_state(&a, i); /* a write may have found the link gone */
+        sync_can_state(a, src);
+    }
+}
+
+/* The event loop, until quit (a command, the end of input, a signal).
+ * Returns 0, or 1 when epoll fails. */
+static int run(app_t *a)
+{
+    while (!a->sim.quit) {
+        uint32_t t = now_us();
+        if (!co_time_before(t, a->next_sample)) {
+            a->prod->sample(a->inst, a->sim.values, a->sim.faults);
+            a->next_sample += CO_FILTER_PERIOD_US;
+            if (!co_time_before(t, a->next_sample)) {
+                a->next_sample = t + CO_FILTER_PERIOD_US; /* we slept too long: no burst */
+            }
         }
-        log_states(&a);
-        log_held_input(&a, t);
-        if (a.in_held != 0u) {
-            wait = co_min_u32(wait, lp_rate_wait(&a.in_rate, t));
+        bool backlog = false;
+        uint32_t wait = poll_nodes(a, t, co_time_until(t, a->next_sample), &backlog);
+        log_states(a);
+        log_held_input(a, t);
+        if (a->in_held != 0u) {
+            wait = co_min_u32(wait, lp_rate_wait(&a->in_rate, t));
         }
         if (backlog) {
             wait = co_min_u32(wait, 1000u); /* retry the kernel's full queue soon */
         }
-        if (stdin_file && !a.sim.quit) {
-            stdin_file = read_stdin(&a);
-            wait = stdin_file ? co_min_u32(wait, 1000u) : wait;
+        if (a->stdin_file && !a->sim.quit) {
+            a->stdin_file = read_stdin(a);
+            wait = a->stdin_file ? co_min_u32(wait, 1000u) : wait;
         }
         struct epoll_event evs[8];
         int timeout_ms = (int)((wait + 999u) / 1000u);
-        int n = epoll_wait(ep, evs, 8, timeout_ms);
+        int n = epoll_wait(a->ep, evs, 8, timeout_ms);
         if (n < 0 && errno != EINTR) {
             lp_log("error: epoll_wait: %s", strerror(errno));
-            rc = 1;
-            break;
+            return 1;
         }
         t = now_us();
         for (int k = 0; k < n; k++) {
-            uint32_t src = evs[k].data.u32;
-            if (src == 100u) {
-                struct signalfd_siginfo si;
-                if (read(sfd, &si, sizeof(si)) == (ssize_t)sizeof(si)) {
-                    lp_log("signal %u (%s): stopping", si.ssi_signo, strsignal((int)si.ssi_signo));
-                    a.sim.quit = true;
-                }
-            } else if (src == 101u) {
-                if (!read_stdin(&a)) {
-                    epoll_ctl(ep, EPOLL_CTL_DEL, STDIN_FILENO, NULL);
-                }
-            } else if (src < a.nnodes) {
-                co_frame_t f;
-                /* At most 64 frames, then the timers again: a flooded bus
-                 * must not starve the heartbeat (the rest stay queued in
-                 * the socket; epoll reports them at once). */
-                for (int m = 0; m < 64; m++) {
-                    int rr = lp_read(&a.ports[src], &f, t);
-                    if (rr == 0) {
-                        break;
-                    }
-                    if (rr == 1) {
-                        co_node_receive(a.nodes[src], &f, t);
-                    }
-                }
-                sync_can_state(&a, src);
-            }
+            handle_event(a, evs[k].data.u32, t);
         }
     }
-    for (unsigned i = 0; i < a.nnodes; i++) {
-        lp_port_t *p = &a.ports[i];
+    return 0;
+}
+
+/* After the loop: send what is queued, LEDs off, the counts in the log. */
+static void shut_down(app_t *a)
+{
+    for (unsigned i = 0; i < a->nnodes; i++) {
+        lp_port_t *p = &a->ports[i];
         lp_flush(p);
-        leds_close(&a.leds[i], i); /* both LEDs off */
+        leds_close(&a->leds[i], i); /* both LEDs off */
         lp_report_drops(p);
         lp_log("node %u: %lu frames received, %lu dropped by the kernel (receive queue full)", i,
                p->rx_frames, p->rx_dropped);
-        if (co_node_tx_dropped(a.nodes[i]) != 0u) {
+        if (co_node_tx_dropped(a->nodes[i]) != 0u) {
             lp_log("node %u: %u frames could not be sent (%lu while off the bus)", i,
-                   co_node_tx_dropped(a.nodes[i]), p->tx_off);
+                   co_node_tx_dropped(a->nodes[i]), p->tx_off);
         }
         lp_close(p);
     }
     lp_log("stopped");
+}
+
+int main(int argc, char **argv)
+{
+    options_t o;
+    int rc = parse_options(argc, argv, &o);
+    if (rc != GO_ON) {
+        return rc;
+    }
+    if (o.eds) {
+        return print_eds(o.prod);
+    }
+    app_t a;
+    rc = set_up(&a, &o);
+    if (rc != GO_ON) {
+        return rc;
+    }
+    rc = run(&a);
+    shut_down(&a);
     return rc;
 }

@@ -42,7 +42,6 @@ typedef struct lp_nvm {
     uint8_t *mem;      /* mirror of the file, size bytes (caller's storage); always
                         * what the file holds (a write that fails changes neither) */
     uint32_t size;
-    unsigned writes;   /* file commits, for diagnostics */
 } lp_nvm_t;
 
 /* A rate limit for one kind of log line: a window of LP_RATE_US from the

@@ -21,7 +21,7 @@ co_res_t dst_write_hb(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     if (v >= 1u && v <= 19u) {
         return CO_E_VAL; /* manual: "From 1 - 19 NOT ACCEPTED" */
     }
-    return co_hb_write_hook(n, e, v);
+    return co_hb_write_time(n, e, v);
 }
 
 co_res_t dst_write_emcy_cobid(co_node_t *n, const co_od_entry_t *e, uint32_t v)
@@ -40,7 +40,7 @@ co_res_t dst_write_tx_type(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     if (!((v >= 1u && v <= 240u) || v == 254u)) {
         return CO_E_VAL;
     }
-    return co_tpdo_write_hook(n, e, v);
+    return co_tpdo_write_comm(n, e, v);
 }
 
 co_res_t dst_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v)
@@ -48,7 +48,7 @@ co_res_t dst_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     if (v >= 1u && v <= 3u) {
         return CO_E_VAL; /* 0 = inactive, 4..65535 ms (C-17) */
     }
-    return co_tpdo_write_hook(n, e, v);
+    return co_tpdo_write_comm(n, e, v);
 }
 
 /* Node-ID / bit rate: a value is committed when both copies agree; the
@@ -238,7 +238,6 @@ void dst_create(const product_t *p, void *mem, void *const ports[], co_node_t *n
     dst_dev_t *d = mem;
     const dst_variant_t *v = p->variant;
     memset(d, 0, sizeof(*d));
-    d->v = v;
     co_incl_init(&d->incl, &d->para.incl, v->axes, v->limit_mdeg, v->wrap);
     void *const ram[CO_CLS_COUNT] = {NULL, &d->vol, &d->para, &d->lss};
     co_node_init(&d->node, v->cfg, ports[0], d, ram, 0);

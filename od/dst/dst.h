@@ -52,7 +52,6 @@ typedef struct dst_dev {
     uint8_t reported; /* 0x4001 as last sent by EMCY */
     bool sensor_fault;
     uint8_t filter_active;
-    const dst_variant_t *v;
     dst_para_t para;
     dst_vol_t vol;
     co_lss_para_t lss;
@@ -98,7 +97,8 @@ extern const product_t dst_x710_xy10, dst_x710_xy15, dst_x710_xy20, dst_x710_xy3
 /* A product of the family: symbol, ID, description, variant, input names, config. */
 #define DST_PRODUCT(sym, idstr, text, var, ins, cfgp)                                           \
     const product_t sym = {.id = PRODUCT_TEXT(idstr), .summary = PRODUCT_TEXT(text),            \
-                           .inputs = ins, .faults = {PRODUCT_FAULT("sensor"), NULL, NULL, NULL}, \
+                           .inputs = ins, /* NOLINT(bugprone-macro-parentheses): a {...} list */ \
+                           .faults = {PRODUCT_FAULT("sensor"), NULL, NULL, NULL},               \
                            .nodes = 1, .inst_size = sizeof(dst_dev_t), .create = dst_create,    \
                            .sample = dst_sample, .variant = &(var), .cfg = (cfgp),              \
                            .vendor = PRODUCT_TEXT("Danfoss A/S"), .bitrates = DST_BITRATES,     \

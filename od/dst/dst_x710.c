@@ -24,10 +24,10 @@ static const co_od_entry_t x710_entries[] = {
     {.index = 0x1009, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, CO_NAME("Manufacturer hardware version")},
     {.index = 0x100A, .sub = 0, CO_TYPE_STR("1.10"), .attr = CONST, CO_NAME("Manufacturer software version")},
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Store parameters")},
-    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, CO_EXT(.write = co_store_save_hook), CO_NAME("Save all parameters")},
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, CO_EXT(.write = co_store_write_save), CO_NAME("Save all parameters")},
     {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Restore default parameters")},
     /* rw, reads 1 = "restores on command" (C-5, C-36). */
-    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_load_hook), CO_NAME("Restore all default parameters")},
+    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_load), CO_NAME("Restore all default parameters")},
     {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, CO_EXT(.write = dst_write_emcy_cobid), CO_NAME("COB-ID EMCY")},
     /* 0 or 20..65535 ms; 1..19 "NOT ACCEPTED". */
     {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, CO_EXT(.write = dst_write_hb), CO_NAME("Producer heartbeat time")},
@@ -44,7 +44,7 @@ static const co_od_entry_t x710_entries[] = {
     {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x180, CO_NAME("COB-ID TPDO1")},
     {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RW, PARA(tx_type), .def = 254, CO_EXT(.write = dst_write_tx_type), CO_NAME("Transmission type")},
     /* Main table: rw, default 4, 4..65535, unit 1 ms (C-19; Example 3 says ro 0). */
-    {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit_ms), .def = 4, CO_EXT(.min = 4, .max = 65535, .write = co_tpdo_write_hook), CO_NAME("Inhibit time")},
+    {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit_ms), .def = 4, CO_EXT(.min = 4, .max = 65535, .write = co_tpdo_write_comm), CO_NAME("Inhibit time")},
     /* 0 = inactive, 4..65535 ms; default 100 = 0x64 (C-16, C-17). */
     {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 100, CO_EXT(.write = dst_write_event), CO_NAME("Event timer")},
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("TPDO1 mapping parameter")},

@@ -23,10 +23,10 @@ static const co_od_entry_t x730_entries[] = {
     {.index = 0x1009, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, CO_NAME("Manufacturer hardware version")},
     {.index = 0x100A, .sub = 0, CO_TYPE_STR("1.24"), .attr = CONST, CO_NAME("Manufacturer software version")},
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Store parameters")},
-    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, CO_EXT(.write = co_store_save_hook), CO_NAME("Save all parameters")},
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, CO_EXT(.write = co_store_write_save), CO_NAME("Save all parameters")},
     {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Restore default parameters")},
     /* rw, reads 1 = "restores on command" (C-5, C-36). */
-    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_load_hook), CO_NAME("Restore all default parameters")},
+    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_load), CO_NAME("Restore all default parameters")},
     {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, CO_EXT(.write = dst_write_emcy_cobid), CO_NAME("COB-ID EMCY")},
     /* 0 or 20..65535 ms; 1..19 "NOT ACCEPTED". */
     {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, CO_EXT(.write = dst_write_hb), CO_NAME("Producer heartbeat time")},

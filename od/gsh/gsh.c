@@ -25,7 +25,7 @@ co_res_t gsh_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     if (v >= 1u && v <= 3u) {
         return CO_E_VAL_LOW; /* 4..65535 ms (L404); 0 = off (C-14) */
     }
-    return co_tpdo_write_hook(n, e, v);
+    return co_tpdo_write_comm(n, e, v);
 }
 
 co_res_t gsh_read_position(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
@@ -76,11 +76,11 @@ void gsh_create(const product_t *p, void *mem, void *const ports[], co_node_t *n
 {
     gsh_dev_t *d = mem;
     memset(d, 0, sizeof(*d));
-    d->nchan = p->nodes;
     static const co_node_cfg_t *const cfgs[2] = {&gsh_ch1_cfg, &gsh_ch2_cfg};
-    for (unsigned i = 0; i < d->nchan; i++) {
+    unsigned nchan = CO_CHECK(p->nodes <= 2u) ? p->nodes : 2u; /* cfgs[]: two at most */
+    d->nchan = nchan;
+    for (unsigned i = 0; i < nchan; i++) {
         gsh_chan_t *c = &d->ch[i];
-        c->channel = (uint8_t)(i + 1u);
         c->incl_para.resolution = 100; /* 0x6800: 0.1 deg */
         /* Channel 2 counts backwards: A2 = (3600 - A1) mod 3600. */
         c->incl_para.op[0] = (uint8_t)(i == 0u ? 0u : CO_INCL_OP_INVERT);

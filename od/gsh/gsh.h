@@ -45,7 +45,6 @@ typedef struct gsh_chan {
     co_lss_para_t lss;       /* 0x3000 bit rate, 0x3001 node-ID */
     co_incl_para_t incl_para; /* fixed: 0.1 deg, channel 2 counts backwards */
     co_incl_t incl;
-    uint8_t channel;         /* 1 or 2 */
     uint16_t position_mm;    /* 0x6004 */
     uint16_t alarms;
     uint8_t counter;         /* PDO byte 7 */

@@ -19,19 +19,19 @@
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = 0xFFFF0196u, CO_NAME("Device type")}, \
     /* "Always 0", even with alarms in the PDO. */ \
     {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, .def = 0, CO_NAME("Error register")}, \
-    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = RW, PARA(sync_cobid), .def = 0x80, CO_EXT(.write = co_sync_write_hook), CO_NAME("COB-ID SYNC")}, \
+    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = RW, PARA(sync_cobid), .def = 0x80, CO_EXT(.write = co_sync_write_cobid), CO_NAME("COB-ID SYNC")}, \
     {.index = 0x1008, .sub = 0, CO_TYPE_STR("GSHA"), .attr = CONST, CO_NAME("Manufacturer device name")}, \
     /* "1.xx", format Maj.MinMin: the unit's own values are not known (C-31). */ \
     {.index = 0x1009, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, CO_NAME("Manufacturer hardware version")}, \
     {.index = 0x100A, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, CO_NAME("Manufacturer software version")}, \
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Store parameters")}, \
     /* wo as the manual says (C-08); subs 2-4 per CiA 301 (C-07). */ \
-    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, CO_EXT(.write = co_store_save_hook), CO_NAME("Save all parameters")}, \
-    {.index = 0x1010, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_save_hook), CO_NAME("Save communication parameters")}, \
-    {.index = 0x1010, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_save_hook), CO_NAME("Save application parameters")}, \
-    {.index = 0x1010, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_save_hook), CO_NAME("Save manufacturer parameters")}, \
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, CO_EXT(.write = co_store_write_save), CO_NAME("Save all parameters")}, \
+    {.index = 0x1010, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_save), CO_NAME("Save communication parameters")}, \
+    {.index = 0x1010, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_save), CO_NAME("Save application parameters")}, \
+    {.index = 0x1010, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_save), CO_NAME("Save manufacturer parameters")}, \
     /* No 0x1011 (C-09). Heartbeat 0x1017 is not in the table but described (C-10). */ \
-    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, CO_EXT(.write = co_hb_write_hook), CO_NAME("Producer heartbeat time")}, \
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, CO_EXT(.write = co_hb_write_time), CO_NAME("Producer heartbeat time")}, \
     {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Identity object")}, \
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x00000093u, CO_NAME("Vendor-ID")}, \
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x00000067u, CO_NAME("Product code")}, \

@@ -280,7 +280,7 @@ co_res_t jd_write_inhibit(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     if ((c & 0x80000000u) == 0u) {
         return CO_E_VAL; /* only while the PDO is invalid (R21) */
     }
-    return co_tpdo_write_hook(n, e, v);
+    return co_tpdo_write_comm(n, e, v);
 }
 
 co_res_t jd_write_save_reset(co_node_t *n, const co_od_entry_t *e, uint32_t v)

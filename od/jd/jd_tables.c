@@ -16,44 +16,44 @@
  * writable only while invalid, the shared event timer, dynamic mapping. */
 #define JD_TPDO(n, cobdef, inhdef)                                                                           \
     {.index = 0x1800 + (n), .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, CO_NAME("TPDO communication parameter")}, \
-    {.index = 0x1800 + (n), .sub = 1, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(cob[n]), .def = (cobdef), CO_EXT(.write = co_tpdo_cobid_write_hook), CO_NAME("COB-ID")}, \
-    {.index = 0x1800 + (n), .sub = 2, CO_TYPE_U8, .attr = RW, PARA(type[n]), .def = 1, CO_EXT(.write = co_tpdo_write_hook), CO_NAME("Transmission type")}, \
+    {.index = 0x1800 + (n), .sub = 1, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(cob[n]), .def = (cobdef), CO_EXT(.write = co_tpdo_write_cobid), CO_NAME("COB-ID")}, \
+    {.index = 0x1800 + (n), .sub = 2, CO_TYPE_U8, .attr = RW, PARA(type[n]), .def = 1, CO_EXT(.write = co_tpdo_write_comm), CO_NAME("Transmission type")}, \
     {.index = 0x1800 + (n), .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit[n]), .def = (inhdef), CO_EXT(.write = jd_write_inhibit), CO_NAME("Inhibit time")}, \
     {.index = 0x1800 + (n), .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 10, CO_EXT(.write = jd_write_event), CO_NAME("Event timer")}
 
 #define JD_MAP(n, count, m2)                                                                                 \
-    {.index = 0x1A00 + (n), .sub = 0, CO_TYPE_U8, .attr = RW, PARA(map_count[n]), .def = (count), CO_EXT(.write = co_tpdo_map_write_hook), CO_NAME("TPDO mapping parameter")}, \
-    {.index = 0x1A00 + (n), .sub = 1, CO_TYPE_U32, .attr = RW, PARA(map[n][0]), .def = 0x60100010u, CO_EXT(.write = co_tpdo_map_write_hook), CO_NAME("1st mapped object")}, \
-    {.index = 0x1A00 + (n), .sub = 2, CO_TYPE_U32, .attr = RW, PARA(map[n][1]), .def = (m2), CO_EXT(.write = co_tpdo_map_write_hook), CO_NAME("2nd mapped object")}
+    {.index = 0x1A00 + (n), .sub = 0, CO_TYPE_U8, .attr = RW, PARA(map_count[n]), .def = (count), CO_EXT(.write = co_tpdo_write_map), CO_NAME("TPDO mapping parameter")}, \
+    {.index = 0x1A00 + (n), .sub = 1, CO_TYPE_U32, .attr = RW, PARA(map[n][0]), .def = 0x60100010u, CO_EXT(.write = co_tpdo_write_map), CO_NAME("1st mapped object")}, \
+    {.index = 0x1A00 + (n), .sub = 2, CO_TYPE_U32, .attr = RW, PARA(map[n][1]), .def = (m2), CO_EXT(.write = co_tpdo_write_map), CO_NAME("2nd mapped object")}
 
 /* 0x1000 .. 0x1018, the same on both models but for the device type and name. */
 #define JD_COMM(devtype, devname)                                                                            \
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = (devtype), CO_NAME("Device type")},       \
-    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, CO_EXT(.read = co_emcy_register_read), CO_NAME("Error register")}, \
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, CO_EXT(.read = co_emcy_read_register), CO_NAME("Error register")}, \
     /* Depth 1: only sub 1 is documented (C41). */ \
-    {.index = 0x1003, .sub = 0, CO_TYPE_U8, .attr = RW, CO_EXT(.write = co_emcy_hist_write, .read = co_emcy_hist_read), CO_NAME("Pre-defined error field")}, \
-    {.index = 0x1003, .sub = 1, CO_TYPE_U32, .attr = RO, CO_EXT(.read = co_emcy_hist_read), CO_NAME("Most recent error")}, \
-    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = RW, PARA(sync_cobid), .def = 0x80, CO_EXT(.write = co_sync_write_hook), CO_NAME("COB-ID SYNC")}, \
+    {.index = 0x1003, .sub = 0, CO_TYPE_U8, .attr = RW, CO_EXT(.write = co_emcy_write_hist, .read = co_emcy_read_hist), CO_NAME("Pre-defined error field")}, \
+    {.index = 0x1003, .sub = 1, CO_TYPE_U32, .attr = RO, CO_EXT(.read = co_emcy_read_hist), CO_NAME("Most recent error")}, \
+    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = RW, PARA(sync_cobid), .def = 0x80, CO_EXT(.write = co_sync_write_cobid), CO_NAME("COB-ID SYNC")}, \
     {.index = 0x1008, .sub = 0, CO_TYPE_STR(devname), .attr = CONST, CO_NAME("Manufacturer device name")}, /* (?) */ \
     {.index = 0x1009, .sub = 0, CO_TYPE_STR("HW 1.0"), .attr = CONST, CO_NAME("Manufacturer hardware version")}, /* (?) */ \
     {.index = 0x100A, .sub = 0, CO_TYPE_STR("FW 1.0"), .attr = CONST, CO_NAME("Manufacturer software version")}, /* (?) */ \
     {.index = 0x100C, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(guard_ms), .def = 0, CO_NAME("Guard time")}, \
     {.index = 0x100D, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(life_factor), .def = 0, CO_NAME("Life time factor")}, \
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Store parameters")}, \
-    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_save_hook), CO_NAME("Save all parameters")}, \
-    {.index = 0x1010, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_save_hook), CO_NAME("Save communication parameters")}, \
-    {.index = 0x1010, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_save_hook), CO_NAME("Save application parameters")}, \
-    {.index = 0x1010, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_save_hook), CO_NAME("Save manufacturer parameters")}, \
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_save), CO_NAME("Save all parameters")}, \
+    {.index = 0x1010, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_save), CO_NAME("Save communication parameters")}, \
+    {.index = 0x1010, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_save), CO_NAME("Save application parameters")}, \
+    {.index = 0x1010, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_save), CO_NAME("Save manufacturer parameters")}, \
     {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Restore default parameters")}, \
-    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_load_hook), CO_NAME("Restore all parameters")}, \
-    {.index = 0x1011, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_load_hook), CO_NAME("Restore communication parameters")}, \
-    {.index = 0x1011, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_load_hook), CO_NAME("Restore application parameters")}, \
-    {.index = 0x1011, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_group_load_hook), CO_NAME("Restore manufacturer parameters")}, \
+    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_load), CO_NAME("Restore all parameters")}, \
+    {.index = 0x1011, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_load), CO_NAME("Restore communication parameters")}, \
+    {.index = 0x1011, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_load), CO_NAME("Restore application parameters")}, \
+    {.index = 0x1011, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_load), CO_NAME("Restore manufacturer parameters")}, \
     /* UNSIGNED32, rw, 0x80 + node-ID (C2). */ \
-    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, CO_EXT(.write = co_emcy_cobid_write), CO_NAME("COB-ID EMCY")}, \
+    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, CO_EXT(.write = co_emcy_write_cobid), CO_NAME("COB-ID EMCY")}, \
     {.index = 0x1016, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Consumer heartbeat time")}, \
-    {.index = 0x1016, .sub = 1, CO_TYPE_U32, .attr = RW, PARA(hb_consumer), .def = 0, CO_EXT(.write = co_hbc_write_hook), CO_NAME("Consumer heartbeat time 1")}, \
-    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, CO_EXT(.write = co_hb_write_hook), CO_NAME("Producer heartbeat time")}, \
+    {.index = 0x1016, .sub = 1, CO_TYPE_U32, .attr = RW, PARA(hb_consumer), .def = 0, CO_EXT(.write = co_hbc_write_time), CO_NAME("Consumer heartbeat time 1")}, \
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, CO_EXT(.write = co_hb_write_time), CO_NAME("Producer heartbeat time")}, \
     {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Identity object")}, \
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x0069666Du, CO_NAME("Vendor-ID")}, /* "ifm" */ \
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Product code")}, /* "0x0 (JDxxxx)" (?) */ \

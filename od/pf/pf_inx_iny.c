@@ -19,31 +19,31 @@
 /* The entries both models have, up to 0x1800. */
 #define PF_COMMON_1000_TO_1800(devtype, devname)                                                          \
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = (devtype), CO_NAME("Device type")}, \
-    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, CO_EXT(.read = co_emcy_register_read), CO_NAME("Error register")}, \
-    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = RW, PARA(sync_cobid), .def = 0x80, CO_EXT(.write = co_sync_write_hook), CO_NAME("COB-ID SYNC")}, /* [301] G13 */ \
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, CO_EXT(.read = co_emcy_read_register), CO_NAME("Error register")}, \
+    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = RW, PARA(sync_cobid), .def = 0x80, CO_EXT(.write = co_sync_write_cobid), CO_NAME("COB-ID SYNC")}, /* [301] G13 */ \
     {.index = 0x1008, .sub = 0, CO_TYPE_STR(devname), .attr = CONST, CO_NAME("Manufacturer device name")}, /* [inf] the type code, L8-9 */ \
     {.index = 0x100C, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(guard_ms), .def = 0, CO_NAME("Guard time")}, /* default [301] */ \
     {.index = 0x100D, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(life_factor), .def = 0, CO_NAME("Life time factor")}, /* default [301] */ \
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Store parameters")}, /* [301] */ \
     /* Reads 3: saves on command and autonomously (G2). */ \
-    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 3, CO_EXT(.write = co_store_save_hook), CO_NAME("Save all parameters")}, \
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 3, CO_EXT(.write = co_store_write_save), CO_NAME("Save all parameters")}, \
     {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Restore default parameters")}, /* [301] */ \
-    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_load_hook), CO_NAME("Restore all default parameters")}, \
-    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, CO_EXT(.write = co_emcy_cobid_write), CO_NAME("COB-ID EMCY")}, \
+    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_load), CO_NAME("Restore all default parameters")}, \
+    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, CO_EXT(.write = co_emcy_write_cobid), CO_NAME("COB-ID EMCY")}, \
     /* UNSIGNED16 though the manual says "32-bit" (C5). */ \
-    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, CO_EXT(.write = co_hb_write_hook), CO_NAME("Producer heartbeat time")}, \
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, CO_EXT(.write = co_hb_write_time), CO_NAME("Producer heartbeat time")}, \
     {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Identity object")}, \
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Vendor-ID")}, /* [ph] */ \
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Product code")}, /* [ph] */ \
     {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Revision number")}, /* [ph] */ \
     {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Serial number")}, /* [ph] */ \
     {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, CO_NAME("TPDO1 communication parameter")}, \
-    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(tpdo_cobid), .def = 0x180, CO_EXT(.write = co_tpdo_cobid_write_hook), CO_NAME("COB-ID TPDO1")}, \
+    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(tpdo_cobid), .def = 0x180, CO_EXT(.write = co_tpdo_write_cobid), CO_NAME("COB-ID TPDO1")}, \
     /* Default 1: synchronous, CiA 410 (G1); 0, 1..240, 252..255 accepted (C10). */ \
-    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RW, PARA(tx_type), .def = 1, CO_EXT(.write = co_tpdo_write_hook), CO_NAME("Transmission type")}, \
+    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RW, PARA(tx_type), .def = 1, CO_EXT(.write = co_tpdo_write_comm), CO_NAME("Transmission type")}, \
     /* 100 us units; writable while the PDO is valid (C11). */ \
-    {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit), .def = 0, CO_EXT(.write = co_tpdo_write_hook), CO_NAME("Inhibit time")}, /* default [301] */ \
-    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 0, CO_EXT(.write = co_tpdo_write_hook), CO_NAME("Event timer")} /* [301] G18 */
+    {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit), .def = 0, CO_EXT(.write = co_tpdo_write_comm), CO_NAME("Inhibit time")}, /* default [301] */ \
+    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 0, CO_EXT(.write = co_tpdo_write_comm), CO_NAME("Event timer")} /* [301] G18 */
 
 /* Per axis: CiA 410 slope objects in 0.1 deg, full turn. */
 #define PF_AXIS(base, ax, nm)                                                                           \
@@ -62,17 +62,17 @@
 
 static const co_od_entry_t inx_entries[] = {
     PF_COMMON_1000_TO_1800(0x0000019Au /* high word [ph] */, "INX360D-F99-B16-V15"),
-    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(map_count), .def = 1, CO_EXT(.write = co_tpdo_map_write_hook), CO_NAME("TPDO1 mapping parameter")}, /* [inf] G3 */
-    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = RW, PARA(map[0]), .def = 0x60100010u, CO_EXT(.write = co_tpdo_map_write_hook), CO_NAME("1st mapped object")}, /* [inf] G3 */
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(map_count), .def = 1, CO_EXT(.write = co_tpdo_write_map), CO_NAME("TPDO1 mapping parameter")}, /* [inf] G3 */
+    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = RW, PARA(map[0]), .def = 0x60100010u, CO_EXT(.write = co_tpdo_write_map), CO_NAME("1st mapped object")}, /* [inf] G3 */
     PF_2000_TO_6000,
     PF_AXIS(0x6010, 0, "long16"),
 };
 
 static const co_od_entry_t iny_entries[] = {
     PF_COMMON_1000_TO_1800(0x0000019Au /* high word [ph] */, "INY360D-F99-B16-V15"),
-    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(map_count), .def = 2, CO_EXT(.write = co_tpdo_map_write_hook), CO_NAME("TPDO1 mapping parameter")},
-    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = RW, PARA(map[0]), .def = 0x60100010u, CO_EXT(.write = co_tpdo_map_write_hook), CO_NAME("1st mapped object")}, /* [inf] L441 */
-    {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = RW, PARA(map[1]), .def = 0x60200010u, CO_EXT(.write = co_tpdo_map_write_hook), CO_NAME("2nd mapped object")}, /* [inf] L441 */
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(map_count), .def = 2, CO_EXT(.write = co_tpdo_write_map), CO_NAME("TPDO1 mapping parameter")},
+    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = RW, PARA(map[0]), .def = 0x60100010u, CO_EXT(.write = co_tpdo_write_map), CO_NAME("1st mapped object")}, /* [inf] L441 */
+    {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = RW, PARA(map[1]), .def = 0x60200010u, CO_EXT(.write = co_tpdo_write_map), CO_NAME("2nd mapped object")}, /* [inf] L441 */
     PF_2000_TO_6000,
     PF_AXIS(0x6010, 0, "long16"),
     PF_AXIS(0x6020, 1, "lateral16"),

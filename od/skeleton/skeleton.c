@@ -92,21 +92,21 @@ static void skel_sample(void *mem, const int32_t values[], uint32_t faults)
 
 static const co_od_entry_t skel_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = 0x0000019Au, CO_NAME("Device type")}, /* CiA 410 */
-    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, CO_EXT(.read = co_emcy_register_read), CO_NAME("Error register")},
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, CO_EXT(.read = co_emcy_read_register), CO_NAME("Error register")},
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Store parameters")},
-    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_save_hook), CO_NAME("Save all parameters")},
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_save), CO_NAME("Save all parameters")},
     {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Restore default parameters")},
-    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_load_hook), CO_NAME("Restore all default parameters")},
-    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, CO_EXT(.write = co_hb_write_hook), CO_NAME("Producer heartbeat time")},
+    {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_load), CO_NAME("Restore all default parameters")},
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(hb_ms), .def = 0, CO_EXT(.write = co_hb_write_time), CO_NAME("Producer heartbeat time")},
     {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Identity object")},
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Vendor-ID")}, /* the vendor's CiA ID */
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 1, CO_NAME("Product code")},
     {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x00010000u, CO_NAME("Revision number")},
     {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Serial number")},
     {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, CO_NAME("TPDO1 communication parameter")},
-    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(tpdo_cobid), .def = 0x180, CO_EXT(.write = co_tpdo_cobid_write_hook), CO_NAME("COB-ID TPDO1")},
-    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RW, PARA(tx_type), .def = 254, CO_EXT(.write = co_tpdo_write_hook), CO_NAME("Transmission type")},
-    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 0, CO_EXT(.write = co_tpdo_write_hook), CO_NAME("Event timer")},
+    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(tpdo_cobid), .def = 0x180, CO_EXT(.write = co_tpdo_write_cobid), CO_NAME("COB-ID TPDO1")},
+    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RW, PARA(tx_type), .def = 254, CO_EXT(.write = co_tpdo_write_comm), CO_NAME("Transmission type")},
+    {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 0, CO_EXT(.write = co_tpdo_write_comm), CO_NAME("Event timer")},
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("TPDO1 mapping parameter")},
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x60100010u, CO_NAME("1st mapped object")},
     {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(incl.resolution), .def = 10, CO_EXT(.write = skel_write_resolution), CO_NAME("Resolution")}, /* 0.01 deg */

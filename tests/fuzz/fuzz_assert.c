@@ -7,7 +7,9 @@
 
 #include "co_common.h"
 
-void co_assert_failed(const char *cond, const char *file, int line)
+/* Here it never returns (the unit tests' one does: co_common.h's
+ * declaration cannot say _Noreturn). */
+_Noreturn void co_assert_failed(const char *cond, const char *file, int line)
 {
     fprintf(stderr, "%s:%d: stack contract broken: %s\n", file, line, cond);
     abort();

@@ -31,6 +31,14 @@ extern int h_checks;
         }                                                                               \
     } while (0)
 
+/* A check that fails where it is reached (a path that must not be taken), saying why. */
+#define FAIL(why)                                                                       \
+    do {                                                                                \
+        h_checks++;                                                                     \
+        h_failures++;                                                                   \
+        fprintf(stderr, "%s:%d: FAIL: %s\n", __FILE__, __LINE__, why);                  \
+    } while (0)
+
 #define CHECK_EQ(a, b)                                                                  \
     do {                                                                                \
         long long a_ = (long long)(a), b_ = (long long)(b);                             \

@@ -14,4 +14,5 @@
 #define co_port_can_bitrate mcu_main_fixed_can_bitrate
 #include "co_common.h"
 bool co_port_can_bitrate(void *port, uint16_t kbps);
+int main(void); /* mcu_main_fixed: declared, for -Wmissing-prototypes */
 #include "mcu_main.c"

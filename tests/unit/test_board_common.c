@@ -73,6 +73,7 @@ static void test_libc_min(void)
 #define PRODUCT_SYM dst_x730_xy30
 #define PRODUCT_HEADER "dst.h"
 #define PRODUCT_INST_SIZE sizeof(dst_dev_t)
+int main(void); /* mcu_main_any: declared, for -Wmissing-prototypes */
 #include "mcu_main.c"
 #undef main
 

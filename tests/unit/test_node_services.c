@@ -43,20 +43,20 @@ typedef struct n_dev {
 
 #define P(f) CO_AT(CO_CLS_PARA, n_para_t, f)
 #define V(f) CO_AT(CO_CLS_VOL, n_vol_t, f)
-#define TPW CO_EXT(.write = co_tpdo_write_hook)
-#define MAPW CO_EXT(.write = co_tpdo_map_write_hook)
-#define COBW CO_EXT(.write = co_tpdo_cobid_write_hook)
+#define TPW CO_EXT(.write = co_tpdo_write_comm)
+#define MAPW CO_EXT(.write = co_tpdo_write_map)
+#define COBW CO_EXT(.write = co_tpdo_write_cobid)
 
 static const co_od_entry_t n_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x0000019Au},
-    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_register_read)},
-    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(sync_cob), .def = 0x80, CO_EXT(.write = co_sync_write_hook)},
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_read_register)},
+    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(sync_cob), .def = 0x80, CO_EXT(.write = co_sync_write_cobid)},
     {.index = 0x100C, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(guard_ms), .def = 0},
     {.index = 0x100D, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, P(life), .def = 0},
-    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, P(emcy_cob), .def = 0x80, CO_EXT(.write = co_emcy_cobid_write)},
+    {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, P(emcy_cob), .def = 0x80, CO_EXT(.write = co_emcy_write_cobid)},
     {.index = 0x1016, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
-    {.index = 0x1016, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, P(hbc), .def = 0, CO_EXT(.write = co_hbc_write_hook)},
-    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(hb), .def = 0, CO_EXT(.write = co_hb_write_hook)},
+    {.index = 0x1016, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, P(hbc), .def = 0, CO_EXT(.write = co_hbc_write_time)},
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(hb), .def = 0, CO_EXT(.write = co_hb_write_time)},
     {.index = 0x1018, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 4},
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x12345678u},
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x0000ABCDu},

@@ -28,7 +28,7 @@
 void can_irq_handler(void);
 void systick_handler(void);
 
-/* Every rate of the products' bit-rate tables (od/products.c) and CiA 301's 10 kbit/s. */
+/* Every rate of the products' bit-rate tables (od/bitrates.c) and CiA 301's 10 kbit/s. */
 static const uint16_t product_rates[] = {10, 20, 50, 100, 125, 250, 500, 800, 1000};
 
 #define EE_BASE 0x08006000u
@@ -329,7 +329,7 @@ static void test_bit_rate_accepted_or_refused(void)
             if (rate != k * 1000u || k > 1000u || sp < 750u || sp > 900u) {
                 printf("     %u kbit/s accepted: %u bit/s, sample point %u/1000\n", (unsigned)k, (unsigned)rate,
                        (unsigned)sp);
-                CHECK(!"an accepted bit rate that the controller cannot run exactly");
+                FAIL("an accepted bit rate that the controller cannot run exactly");
             }
             CHECK_EQ(stm_can_mode(), STM_CAN_NORMAL);
         } else {
@@ -706,7 +706,7 @@ static uint8_t sdo_over_bus(co_node_t *node, const char *req, uint32_t *v)
     co_node_receive(node, &f, board_now_us());
     stm_can_frame_t out;
     if (!stm_can_bus_take(&out) || out.id != 0x580u + node->node_id) {
-        CHECK(!"no SDO response on the bus");
+        FAIL("no SDO response on the bus");
         return 0;
     }
     *v = co_get_u32(&out.data[4]);

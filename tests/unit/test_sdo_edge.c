@@ -21,17 +21,17 @@ typedef struct e_dev {
 } e_dev_t;
 
 #define P(f) CO_AT(CO_CLS_PARA, e_para_t, f)
-#define HIST CO_EXT(.read = co_emcy_hist_read)
+#define HIST CO_EXT(.read = co_emcy_read_hist)
 
 static const co_od_entry_t e_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x00000191u},
-    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_register_read)},
-    {.index = 0x1003, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, CO_EXT(.write = co_emcy_hist_write, .read = co_emcy_hist_read)},
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_read_register)},
+    {.index = 0x1003, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, CO_EXT(.write = co_emcy_write_hist, .read = co_emcy_read_hist)},
     {.index = 0x1003, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, HIST},
     {.index = 0x1003, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, HIST},
     {.index = 0x1003, .sub = 3, CO_TYPE_U32, .attr = CO_A_R, HIST},
     {.index = 0x1008, .sub = 0, CO_TYPE_STR(LONG_NAME), .attr = CO_A_R | CO_A_CONST},
-    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(hb), .def = 0, CO_EXT(.write = co_hb_write_hook)},
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(hb), .def = 0, CO_EXT(.write = co_hb_write_time)},
     {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(u32), .def = 100, CO_EXT(.min = 10, .max = 1000)},
     {.index = 0x2003, .sub = 0, CO_TYPE_I8, .attr = CO_A_RW, P(i8), .def = (uint32_t)-3, CO_EXT(.min = -10, .max = 10)},
     /* A writable string: the stack stores no strings yet (co_od_write). */
@@ -242,7 +242,7 @@ static void test_history_depth(void)
     SDO(d, "40 03 10 01 00 00 00 00", "43 03 10 01 0A FF 0A 00"); /* the tenth */
     SDO(d, "40 03 10 03 00 00 00 00", "43 03 10 03 08 FF 08 00");
     SDO(d, "23 03 10 01 00 00 00 00", "80 03 10 01 02 00 01 06");
-    CHECK(co_emcy_hist_write(d->node, co_node_entry(d->node, 0x1003, 1), 0) == CO_E_RO);
+    CHECK(co_emcy_write_hist(d->node, co_node_entry(d->node, 0x1003, 1), 0) == CO_E_RO);
     SDO(d, "2F 03 10 00 00 00 00 00", "60 03 10 00 00 00 00 00");
     SDO(d, "40 03 10 00 00 00 00 00", "4F 03 10 00 00 00 00 00");
 }
