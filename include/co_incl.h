@@ -59,7 +59,7 @@ typedef struct co_incl {
     uint8_t shift;       /* active filter shift */
     bool beyond[2];      /* measured angle strictly beyond the limit */
     int32_t angle[2];    /* filtered, saturated angle (mdeg) */
-    int32_t unwrapped;   /* wrap mode: continuous input fed to the filter */
+    int32_t unwrapped[2]; /* wrap mode: each axis' continuous input to its filter */
     co_filter_t f[2];
     /* The slope outputs, computed once per sample rather than per read
      * (SDO, every PDO): valid while *p still equals seen. */

@@ -56,12 +56,13 @@ void co_incl_sample(co_incl_t *incl, const int32_t mdeg[2])
         if (incl->wrap) {
             /* Feed the filter a continuous angle so that crossing +-180
              * does not sweep the output through zero. */
+            int32_t *u = &incl->unwrapped[a];
             if (!incl->f[a].primed) {
-                incl->unwrapped = wrap180(x);
+                *u = wrap180(x);
             } else {
-                incl->unwrapped += wrap180(x - incl->unwrapped);
+                *u += wrap180(x - *u);
             }
-            int32_t y = co_filter_step(&incl->f[a], incl->unwrapped, incl->shift);
+            int32_t y = co_filter_step(&incl->f[a], *u, incl->shift);
             int32_t w = wrap180(y);
             /* Keep the filter state near the [-180, 180) window. */
             if (w != y) {
@@ -69,7 +70,7 @@ void co_incl_sample(co_incl_t *incl, const int32_t mdeg[2])
                 for (unsigned i = 0; i < CO_FILTER_STAGES; i++) {
                     incl->f[a].s[i] += d * 256;
                 }
-                incl->unwrapped += d;
+                *u += d;
             }
             incl->angle[a] = w;
             incl->beyond[a] = false;

@@ -136,6 +136,44 @@ static void test_incl_wrap(void)
     CHECK_EQ(co_incl_slope(&in, 0), -18000);
 }
 
+/* Two axes, circular outputs (0..359.9 deg), the filter on: each axis keeps
+ * its own continuous angle. With one value shared by both, the second axis
+ * was unwrapped against the first one's input (170 / -100 deg in gave
+ * 171.4 / 79.3 deg out; issue 12). */
+static void test_incl_two_axes_circular(void)
+{
+    co_incl_para_t p = {.resolution = 100, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
+    co_incl_t in;
+    co_incl_init(&in, &p, 2, 0, true);
+    in.circular = true;
+    in.shift = co_filter_shift(0); /* slow */
+    int32_t a[2] = {170000, -100000};
+    for (int i = 0; i < 2000; i++) { /* 10 s: settled whatever the filter */
+        co_incl_sample(&in, a);
+    }
+    CHECK_EQ(co_incl_slope(&in, 0), 1700);
+    CHECK_EQ(co_incl_slope(&in, 1), 2600); /* -100 deg = 260 deg */
+    /* Each axis crosses +-180 by the short way, on its own: X from 170 to
+     * -170 (190 deg), Y stays; Y's output never moves. */
+    a[0] = -170000;
+    int16_t y_lo = 32767;
+    int16_t y_hi = -32768;
+    int16_t x_far = 0; /* largest distance of X from 180 deg on the way */
+    for (int i = 0; i < 2000; i++) {
+        co_incl_sample(&in, a);
+        int16_t y = co_incl_slope(&in, 1);
+        y_lo = y < y_lo ? y : y_lo;
+        y_hi = y > y_hi ? y : y_hi;
+        int16_t dx = (int16_t)(co_incl_slope(&in, 0) - 1800);
+        dx = (int16_t)(dx < 0 ? -dx : dx);
+        x_far = dx > x_far ? dx : x_far;
+    }
+    CHECK_EQ(y_lo, 2600);
+    CHECK_EQ(y_hi, 2600);
+    CHECK(x_far <= 100); /* through 180, never back through 0 */
+    CHECK_EQ(co_incl_slope(&in, 0), 1900);
+}
+
 static void test_led_patterns(void)
 {
     const co_led_timing_t *t = &co_led_cia303;
@@ -176,6 +214,7 @@ int main(void)
     RUN(test_filter_through_the_device);
     RUN(test_incl_arithmetic);
     RUN(test_incl_wrap);
+    RUN(test_incl_two_axes_circular);
     RUN(test_led_patterns);
     return h_finish();
 }
