@@ -28,6 +28,9 @@
 #define CO_INCL_OP_INVERT 0x01u
 #define CO_INCL_OP_SCALING 0x02u
 
+/* The most axes a device has: axis arguments are below it (CO_CHECK). */
+#define CO_INCL_AXES 2u
+
 /* Stored parameters; products embed this in their PARA struct. Word
  * aligned (16 bytes, no padding): the slope cache compares it with four
  * word loads (co_incl_para_same). The products' PARA structs already had
@@ -57,23 +60,44 @@ typedef struct co_incl {
     bool fault;          /* sensor element error: outputs hold */
     int32_t limit_mdeg;  /* output stops here, error beyond it; 0: none */
     uint8_t shift;       /* active filter shift */
-    bool beyond[2];      /* measured angle strictly beyond the limit */
-    int32_t angle[2];    /* filtered, saturated angle (mdeg) */
-    int32_t unwrapped[2]; /* wrap mode: each axis' continuous input to its filter */
-    co_filter_t f[2];
+    bool beyond[CO_INCL_AXES];      /* measured angle strictly beyond the limit */
+    int32_t angle[CO_INCL_AXES];    /* filtered, saturated angle (mdeg) */
+    int32_t unwrapped[CO_INCL_AXES]; /* wrap mode: each axis' continuous input to its filter */
+    co_filter_t f[CO_INCL_AXES];
     /* The slope outputs, computed once per sample rather than per read
      * (SDO, every PDO): valid while *p still equals seen. */
-    int16_t out[2];
+    int16_t out[CO_INCL_AXES];
     co_incl_para_t seen;
 } co_incl_t;
 
-/* p is owned by the caller and must outlive incl. */
+/*
+ * Set incl up for a device of axes axes (1 or 2; CO_INCL_AXES at most)
+ * whose parameters are *p: no sample yet (outputs 0), the filter at its
+ * slow speed (set incl->shift to change it; 0 passes samples through),
+ * linear outputs (set incl->circular for circular ones). limit_mdeg: the
+ * output stops there and co_incl_beyond() reports beyond it (0: no
+ * limit); wrap: a full-turn sensor, angles wrap at +-180 deg (no limit).
+ * p is owned by the caller and must outlive incl; incl is the caller's
+ * too (no heap). Cannot fail.
+ */
 void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limit_mdeg, bool wrap);
 
-/* Feed one sensor sample (mdeg per axis; unused axes ignored). */
+/*
+ * Feed one sensor sample: mdeg[a] is axis a's angle in millidegrees
+ * (entries from incl->axes on are not read). Filters it, applies the
+ * limit or the wrap, and recomputes every slope output. While
+ * incl->fault is set the sample is ignored and the outputs hold. Not
+ * from an interrupt (it writes the state every read uses).
+ */
 void co_incl_sample(co_incl_t *incl, const int32_t mdeg[2]);
 
-/* co_incl_slope's slow path: recompute the outputs, return one. */
+/*
+ * co_incl_slope's slow path, for a parameter changed since the last
+ * sample: recompute every output with *incl->p, return axis's. An axis
+ * the device lacks (incl->axes <= axis < CO_INCL_AXES) reads 0. An axis
+ * from CO_INCL_AXES on breaks the contract: CO_CHECK fails, 0 is
+ * returned and nothing is recomputed.
+ */
 int16_t co_incl_refresh_slope(co_incl_t *incl, unsigned axis);
 
 _Static_assert(sizeof(co_incl_para_t) == 16u, "co_incl_para_t: four words, no padding");
@@ -103,10 +127,13 @@ static inline bool co_incl_para_same(const co_incl_para_t *a, const co_incl_para
 /* The slope object (0x6010 axis 0, 0x6020 axis 1) in resolution units.
  * Recomputed only when a parameter changed since the last sample:
  * parameters reach p through plain dictionary writes and the store too,
- * so compare rather than rely on every writer telling us. */
+ * so compare rather than rely on every writer telling us. An axis the
+ * device lacks (a single-axis device's 0x6020) reads 0; from
+ * CO_INCL_AXES on CO_CHECK fails too (0 all the same). */
 static inline int16_t co_incl_slope(co_incl_t *incl, unsigned axis)
 {
     if (axis >= incl->axes) {
+        (void)CO_CHECK(axis < CO_INCL_AXES); /* no code in an image */
         return 0;
     }
     if (!co_incl_para_same(&incl->seen, incl->p)) {
@@ -115,8 +142,10 @@ static inline int16_t co_incl_slope(co_incl_t *incl, unsigned axis)
     return incl->out[axis];
 }
 
-/* The same as a read hook's answer: the slope sign-extended into *v. The
- * slow path is a tail call, so the fast one needs no stack frame. */
+/* The same as a read hook's answer: the slope sign-extended into *v
+ * (always CO_OK; an axis as co_incl_slope). The slow path is a tail call,
+ * so the fast one needs no stack frame. co_incl_refresh_read is that
+ * slow path (axes as co_incl_refresh_slope; *v = 0 for any other). */
 co_res_t co_incl_refresh_read(co_incl_t *incl, unsigned axis, uint32_t *v);
 static inline co_res_t co_incl_read(co_incl_t *incl, unsigned axis, uint32_t *v)
 {
@@ -127,7 +156,7 @@ static inline co_res_t co_incl_read(co_incl_t *incl, unsigned axis, uint32_t *v)
     return co_incl_refresh_read(incl, axis, v);
 }
 
-/* Any axis beyond its limit. */
+/* Any axis beyond its limit at the last sample (never in wrap mode). */
 bool co_incl_beyond(const co_incl_t *incl);
 
 /*
@@ -138,7 +167,15 @@ bool co_incl_beyond(const co_incl_t *incl);
  */
 co_res_t co_incl_set_resolution(co_incl_t *incl, uint16_t res);
 
-/* Write the preset (0x6012/0x6022): offset = preset - s*m now. */
+/*
+ * Write the preset (0x6012/0x6022): stores it and sets the offset so that
+ * the output reads it now (linear: offset = preset - s*m, saturated to
+ * INTEGER16; circular: offset = preset - a1 - differential offset, modulo
+ * a turn). An axis the device lacks (incl->axes <= axis < CO_INCL_AXES)
+ * is stored all the same, with a measured angle of 0 (its objects exist
+ * in the shared tables). From CO_INCL_AXES on: CO_CHECK fails, nothing is
+ * written. Range checks of the value are the product's, before calling.
+ */
 void co_incl_set_preset(co_incl_t *incl, unsigned axis, int16_t preset);
 
 /* Round a / b to nearest, halves away from zero (b > 0). */

@@ -161,13 +161,21 @@ static void refresh(co_incl_t *incl)
 
 int16_t co_incl_refresh_slope(co_incl_t *incl, unsigned axis)
 {
+    if (!CO_CHECK(axis < CO_INCL_AXES)) {
+        return 0;
+    }
     refresh(incl);
-    return incl->out[axis];
+    return incl->out[axis]; /* 0 on an axis the device lacks: never computed */
 }
 
 co_res_t co_incl_refresh_read(co_incl_t *incl, unsigned axis, uint32_t *v)
 {
-    *v = axis < incl->axes ? (uint32_t)(int32_t)co_incl_refresh_slope(incl, axis) : 0u;
+    if (axis >= incl->axes) {
+        (void)CO_CHECK(axis < CO_INCL_AXES); /* no code in an image */
+        *v = 0;
+        return CO_OK;
+    }
+    *v = (uint32_t)(int32_t)co_incl_refresh_slope(incl, axis);
     return CO_OK;
 }
 
@@ -193,6 +201,9 @@ co_res_t co_incl_set_resolution(co_incl_t *incl, uint16_t res)
 
 void co_incl_set_preset(co_incl_t *incl, unsigned axis, int16_t preset)
 {
+    if (!CO_CHECK(axis < CO_INCL_AXES)) {
+        return;
+    }
 #if CO_INCL_CIRCULAR
     if (incl->circular) {
         int32_t a1 = circular_a1(incl, axis);

@@ -95,7 +95,10 @@ static void test_incl_arithmetic(void)
     /* No such axis. Through a volatile: with a constant 5, gcc's array-bounds
      * check sees the out[] access the axes test keeps it from reaching. */
     volatile unsigned no_axis = 5;
+    unsigned reports = h_asserts;
+    h_expect_assert(1); /* past CO_INCL_AXES: a broken contract, reported */
     CHECK_EQ(co_incl_slope(&in, no_axis), 0);
+    CHECK_EQ(h_asserts, reports + 1u);
     /* Same resolution: offsets kept. New one: cleared. */
     p.diff[0] = 7;
     CHECK_EQ(co_incl_set_resolution(&in, 50), CO_OK);
@@ -134,6 +137,51 @@ static void test_incl_wrap(void)
         co_incl_sample(&in, a);
     }
     CHECK_EQ(co_incl_slope(&in, 0), -18000);
+}
+
+/* An axis from the product: the device's axes read, a lateral axis a
+ * single-axis device lacks reads 0 (its objects are in the family's
+ * table), one past CO_INCL_AXES is a broken contract (CO_CHECK) that
+ * leaves everything as it was. */
+static void test_incl_axis_bounds(void)
+{
+    co_incl_para_t p = {.resolution = 10, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
+    co_incl_t in;
+    co_incl_init(&in, &p, 1, 0, false);
+    int32_t a[2] = {12340, 5000};
+    co_incl_sample(&in, a);
+    volatile unsigned lateral = 1; /* volatile: as test_incl_arithmetic */
+    volatile unsigned past = CO_INCL_AXES;
+    unsigned reports = h_asserts;
+    CHECK_EQ(co_incl_refresh_slope(&in, 0), 1234);
+    CHECK_EQ(co_incl_refresh_slope(&in, lateral), 0);
+    uint32_t v = 7;
+    CHECK_EQ(co_incl_refresh_read(&in, lateral, &v), CO_OK);
+    CHECK_EQ(v, 0);
+    co_incl_set_preset(&in, lateral, 55); /* stored, from a measured 0 */
+    CHECK_EQ(p.preset[1], 55);
+    CHECK_EQ(p.offset[1], 55);
+    CHECK_EQ(h_asserts, reports); /* none of these is a broken contract */
+
+    co_incl_para_t before = p;
+    h_expect_assert(1);
+    CHECK_EQ(co_incl_refresh_slope(&in, past), 0);
+    CHECK_EQ(h_asserts, reports + 1u);
+    h_expect_assert(1);
+    v = 7;
+    CHECK_EQ(co_incl_refresh_read(&in, past + 3u, &v), CO_OK);
+    CHECK_EQ(v, 0);
+    CHECK_EQ(h_asserts, reports + 2u);
+    h_expect_assert(1);
+    co_incl_set_preset(&in, past, 99);
+    CHECK_EQ(h_asserts, reports + 3u);
+    CHECK(memcmp(&before, &p, sizeof(p)) == 0); /* nothing written */
+    h_expect_assert(1);
+    uint32_t r = 7;
+    CHECK_EQ(co_incl_read(&in, past, &r), CO_OK);
+    CHECK_EQ(r, 0);
+    CHECK_EQ(h_asserts, reports + 4u);
+    CHECK_EQ(co_incl_slope(&in, 0), 1234); /* the device's axis as before */
 }
 
 /* Two axes, circular outputs (0..359.9 deg), the filter on: each axis keeps
@@ -214,6 +262,7 @@ int main(void)
     RUN(test_filter_through_the_device);
     RUN(test_incl_arithmetic);
     RUN(test_incl_wrap);
+    RUN(test_incl_axis_bounds);
     RUN(test_incl_two_axes_circular);
     RUN(test_led_patterns);
     return h_finish();
