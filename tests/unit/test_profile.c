@@ -139,6 +139,86 @@ static void test_incl_wrap(void)
     CHECK_EQ(co_incl_slope(&in, 0), -18000);
 }
 
+/* The arithmetic of one output, as a product with its own objects uses it
+ * (the ifm JD's 16- and 32-bit slopes): each fit of co_incl_fit_t. */
+static void test_incl_output_fits(void)
+{
+    const uint8_t sc = CO_INCL_OP_SCALING;
+    const uint8_t inv = CO_INCL_OP_INVERT;
+    co_incl_fit_t i16 = {.turn = 0, .wide = false, .centred = false};
+    co_incl_fit_t i32 = {.turn = 0, .wide = true, .centred = false};
+    /* Linear: s*m, + offsets with the scaling bit, saturated to the type. */
+    CHECK_EQ(co_incl_output(1234, 0, 100, 10, i16), 1234); /* offsets not read */
+    CHECK_EQ(co_incl_output(1234, sc, 100, 10, i16), 1344);
+    CHECK_EQ(co_incl_output(1234, sc | inv, 100, 10, i16), -1124);
+    CHECK_EQ(co_incl_output(30000, sc, 2000, 1000, i16), 32767);
+    CHECK_EQ(co_incl_output(30000, sc, 2000, 1000, i32), 33000);
+    CHECK_EQ(co_incl_output(-30000, sc, -2000, -1000, i16), -32768);
+    CHECK_EQ(co_incl_output(1, sc, INT32_MAX, INT32_MAX, i32), INT32_MAX); /* exact sum, saturated */
+    CHECK_EQ(co_incl_output(-1, sc, INT32_MIN, INT32_MIN, i32), INT32_MIN);
+    CHECK_EQ(co_incl_output(5, sc, INT32_MAX, INT32_MIN, i32), 4);
+    /* Circular: modulo the turn, 0..turn-1, whatever the offsets hold. */
+    co_incl_fit_t c = {.turn = 36000, .wide = false, .centred = false};
+    CHECK_EQ(co_incl_output(35999, 0, 0, 0, c), 35999);
+    CHECK_EQ(co_incl_output(36000, 0, 0, 0, c), 0);
+    CHECK_EQ(co_incl_output(1000, inv, 0, 0, c), 35000);
+    CHECK_EQ(co_incl_output(0, inv, 0, 0, c), 0);
+    CHECK_EQ(co_incl_output(35000, sc, 2000, -500, c), 500);
+    CHECK_EQ(co_incl_output(1000, sc, INT32_MAX, INT32_MAX, c), 24294); /* 1000 + 2 x 11647 */
+    CHECK_EQ(co_incl_output(1000, sc, INT32_MIN, 0, c), 25352); /* -2^31 mod 36000 = 24352 */
+    /* The preset's offset: preset - s*m - diff, fitted the same way. */
+    CHECK_EQ(co_incl_preset_offset(100, 1234, 0, 0, i16), -1134);
+    CHECK_EQ(co_incl_preset_offset(100, 1234, inv, 0, i16), 1334);
+    CHECK_EQ(co_incl_preset_offset(100, 1234, 0, 50, i16), -1184);
+    CHECK_EQ(co_incl_preset_offset(-32000, 2000, 0, 0, i16), -32768);
+    CHECK_EQ(co_incl_preset_offset(-32000, 2000, 0, 0, i32), -34000);
+    CHECK_EQ(co_incl_preset_offset(INT32_MIN, 1, 0, 0, i32), INT32_MIN);
+    CHECK_EQ(co_incl_preset_offset(100, 1000, 0, 0, c), 35100); /* [0, turn) */
+    co_incl_fit_t cc = {.turn = 36000, .wide = false, .centred = true};
+    CHECK_EQ(co_incl_preset_offset(100, 1000, 0, 0, cc), -900); /* (-turn/2, turn/2] */
+    CHECK_EQ(co_incl_preset_offset(18000, 0, 0, 0, cc), 18000);
+    CHECK_EQ(co_incl_preset_offset(18001, 0, 0, 0, cc), -17999);
+    CHECK_EQ(co_incl_preset_offset(100, 1000, inv, 0, cc), 1100);
+    /* The output then reads the preset (+ a differential offset left out). */
+    int32_t off = co_incl_preset_offset(100, 1000, inv, 0, cc);
+    CHECK_EQ(co_incl_output(1000, sc | inv, off, 0, cc), 100);
+    CHECK_EQ(co_incl_output(1000, sc | inv, off, 7, cc), 107);
+    off = co_incl_preset_offset(250, 1000, 0, 7, c);
+    CHECK_EQ(co_incl_output(1000, sc, off, 7, c), 250);
+    /* Angles: +-180 deg window, non-negative modulo. */
+    CHECK_EQ(co_incl_wrap180(180000), -180000);
+    CHECK_EQ(co_incl_wrap180(-180001), 179999);
+    CHECK_EQ(co_incl_wrap180(3600000 + 90000), 90000);
+    CHECK_EQ(co_incl_wrap180(-7200000 - 90000), -90000);
+    CHECK_EQ(co_incl_mod(-1, 360), 359);
+    CHECK_EQ(co_incl_mod(720, 360), 0);
+    CHECK_EQ(co_incl_mod(-1081, 360), 359);
+    CHECK_EQ(co_incl_mod(INT32_MIN, 36000), 24352);
+}
+
+/* Measured angles: divided when the resolution changes, not per read. */
+static void test_incl_meas(void)
+{
+    co_incl_meas_t c;
+    memset(&c, 0, sizeof(c));
+    int32_t raw[CO_INCL_AXES] = {12345, -12345};
+    const co_incl_meas_t *r = co_incl_meas_at(&c, raw, 0); /* no parameters yet */
+    CHECK_EQ(r->m[0], 0);
+    CHECK_EQ(r->turn, 0);
+    r = co_incl_meas_at(&c, raw, 10);
+    CHECK_EQ(r->m[0], 1235); /* half away from zero */
+    CHECK_EQ(r->m[1], -1235);
+    CHECK_EQ(r->turn, 36000);
+    raw[0] = 99999; /* the same resolution: the figures it holds */
+    CHECK_EQ(co_incl_meas_at(&c, raw, 10)->m[0], 1235);
+    CHECK_EQ(co_incl_meas_at(&c, raw, 1000)->m[0], 100);
+    CHECK_EQ(c.turn, 360);
+    co_incl_remeasure(&c, raw, 0);
+    CHECK_EQ(c.m[0], 0);
+    CHECK_EQ(c.m[1], 0);
+    CHECK_EQ(c.res, 0);
+}
+
 /* An axis from the product: the device's axes read, a lateral axis a
  * single-axis device lacks reads 0 (its objects are in the family's
  * table), one past CO_INCL_AXES is a broken contract (CO_CHECK) that
@@ -262,6 +342,8 @@ int main(void)
     RUN(test_filter_through_the_device);
     RUN(test_incl_arithmetic);
     RUN(test_incl_wrap);
+    RUN(test_incl_output_fits);
+    RUN(test_incl_meas);
     RUN(test_incl_axis_bounds);
     RUN(test_incl_two_axes_circular);
     RUN(test_led_patterns);
