@@ -67,17 +67,22 @@
 #define CO_INCL_INLINE static inline
 #endif
 
-/* Round a / b to nearest, halves away from zero (b > 0; any a). */
+/* Round a / b to nearest, halves away from zero (any a). b must be above
+ * 0: b <= 0 breaks the contract, CO_CHECK fails and the result is 0. */
 int32_t co_div_round(int32_t a, int32_t b);
 
 /* An angle in [-180000, 180000) millidegrees (any a; a few turns take one
  * pass each: no division, which an MCU image has as a helper). */
 int32_t co_incl_wrap180(int32_t a);
 
-/* Non-negative a mod m, in [0, m) (m > 0; any a). Within one m either side
- * of 0, where the terms of a circular output are, without a division. */
+/* Non-negative a mod m, in [0, m) (any a). Within one m either side of 0,
+ * where the terms of a circular output are, without a division. m must be
+ * above 0: m <= 0 breaks the contract, CO_CHECK fails and the result is 0. */
 static inline int32_t co_incl_mod(int32_t a, int32_t m)
 {
+    if (!CO_CHECK(m > 0)) {
+        return 0;
+    }
     if (a >= -m && a < m) {
         return a < 0 ? a + m : a;
     }

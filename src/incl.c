@@ -7,6 +7,9 @@
 
 int32_t co_div_round(int32_t a, int32_t b)
 {
+    if (!CO_CHECK(b > 0)) {
+        return 0;
+    }
     /* Half away from zero, in unsigned arithmetic so that no a overflows
      * (|a| <= 2^31, |a| + b/2 < 2^32). The result for INT32_MIN / 1 is
      * converted back modulo 2^32 (gcc and clang define it). */

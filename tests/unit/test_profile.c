@@ -194,6 +194,15 @@ static void test_incl_output_fits(void)
     CHECK_EQ(co_incl_mod(720, 360), 0);
     CHECK_EQ(co_incl_mod(-1081, 360), 359);
     CHECK_EQ(co_incl_mod(INT32_MIN, 36000), 24352);
+    /* A modulus or divisor of 0 or less: a broken contract, 0. Through a
+     * volatile, so that the compiler sees no constant division by 0. */
+    volatile int32_t zero = 0;
+    unsigned reports = h_asserts;
+    h_expect_assert(3);
+    CHECK_EQ(co_incl_mod(7, zero), 0);
+    CHECK_EQ(co_incl_mod(7, zero - 360), 0);
+    CHECK_EQ(co_div_round(7, zero), 0);
+    CHECK_EQ(h_asserts, reports + 3u);
 }
 
 /* Measured angles: divided when the resolution changes, not per read. */
