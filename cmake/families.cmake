@@ -109,7 +109,7 @@ macro(co_family name)
   endforeach()
 endmacro()
 
-file(GLOB co_family_files LIST_DIRECTORIES false ${CMAKE_SOURCE_DIR}/od/*/family.cmake)
+file(GLOB co_family_files LIST_DIRECTORIES false CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/od/*/family.cmake)
 list(SORT co_family_files)
 foreach(f ${co_family_files})
   include(${f})

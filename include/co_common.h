@@ -66,6 +66,10 @@ typedef uint32_t __attribute__((may_alias)) co_word_t;
  *     if (!CO_CHECK(n < CO_TPDO_MAX)) { return CO_E_PARAM; }
  */
 #ifdef CO_ASSERT_HOOK
+/* Provided by the build that defines CO_ASSERT_HOOK (the unit tests'
+ * harness, the fuzzers), never by the stack: a CO_CHECK failed, cond is its
+ * text (static), file and line where. If it returns, the check's caller
+ * leaves the way its header documents. */
 void co_assert_failed(const char *cond, const char *file, int line);
 #define CO_CHECK(cond) ((cond) ? true : (co_assert_failed(#cond, __FILE__, __LINE__), false))
 #else
@@ -87,29 +91,36 @@ static inline uint32_t co_time_until(uint32_t now, uint32_t deadline)
     return co_time_before(now, deadline) ? deadline - now : 0u;
 }
 
+/* The smaller of a and b. */
 static inline uint32_t co_min_u32(uint32_t a, uint32_t b)
 {
     return a < b ? a : b;
 }
 
-/* Little-endian helpers (CANopen is little-endian on the bus). */
+/* Little-endian helpers (CANopen is little-endian on the bus); p points
+ * to 2 or 4 bytes, any alignment. */
+
+/* The 16-bit value at p. */
 static inline uint16_t co_get_u16(const uint8_t *p)
 {
     return (uint16_t)(p[0] | (uint16_t)(p[1] << 8));
 }
 
+/* The 32-bit value at p. */
 static inline uint32_t co_get_u32(const uint8_t *p)
 {
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
            ((uint32_t)p[3] << 24);
 }
 
+/* v into the 2 bytes at p. */
 static inline void co_put_u16(uint8_t *p, uint16_t v)
 {
     p[0] = (uint8_t)v;
     p[1] = (uint8_t)(v >> 8);
 }
 
+/* v into the 4 bytes at p. */
 static inline void co_put_u32(uint8_t *p, uint32_t v)
 {
     p[0] = (uint8_t)v;

@@ -3,6 +3,13 @@
  * table for products that follow CiA 301's error model (error register
  * 0x1001 as the OR of the active errors' bits, an error-reset EMCY when the
  * last one clears, the pre-defined error field 0x1003).
+ *
+ * State: co_emcy_t in the node (the active errors, the history); nothing
+ * else is kept, no pointer is held. Frames go out through co_node_send(),
+ * never in stopped nor while 0x1014 bit 31 is set; a frame the board cannot
+ * queue is counted (co_node_tx_dropped) and not retried. A full error table
+ * (CO_EMCY_ACTIVE_MAX codes) takes no new code (co_emcy_error returns
+ * false); the history keeps the newest CO_EMCY_HIST_MAX entries.
  */
 #ifndef CO_EMCY_H
 #define CO_EMCY_H
@@ -86,9 +93,13 @@ void co_emcy_can_state(co_node_t *node, co_can_state_t old_state);
 
 /* Read hook for 0x1001 (error register from the error table). */
 co_res_t co_emcy_register_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
-/* Hooks for 0x1003: sub 0 count (write 0 clears), sub n the n-th newest. */
 #if CO_EMCY_HIST_MAX > 0
+/* Read hook for 0x1003 (pre-defined error field): sub 0 the number of
+ * entries, sub n the n-th newest (code | additional information << 16);
+ * a sub-index beyond the entries held reads CO_E_NO_DATA (0x08000024). */
 co_res_t co_emcy_hist_read(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
+/* Write hook for 0x1003 sub 0: 0 clears the history; any other value is
+ * CO_E_VAL (0x06090030, CiA 301), another sub-index CO_E_RO. */
 co_res_t co_emcy_hist_write(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 #endif
 /* Write hook for 0x1014: CiA 301 rules (bits 30..11 zero, CAN-ID changes

@@ -14,6 +14,9 @@
  * The life time reaches 65535 ms x 255 = 4.6 h, beyond the 71.6 min of the
  * wrapping microsecond clock (and the 35.8 min of co_time_before): it is
  * timed in laps of at most CO_GUARD_LAP_MS, exactly, whatever its length.
+ * State: co_guard_t in the node; linked where a product lists
+ * co_guard_service. It asks the heartbeat's period (co_hb_period_ms), it
+ * does not read co_hb_t.
  */
 #ifndef CO_GUARD_H
 #define CO_GUARD_H
@@ -42,6 +45,9 @@ void co_guard_reset(co_node_t *node);
 /* Handle a remote frame on 0x700 + node-ID. Returns true if it was one. */
 bool co_guard_receive(co_node_t *node, const co_frame_t *f);
 
+/* The life time (co_service_t.poll): raises the life-guard event when it
+ * ran out. Returns the delay (us) until it next needs to run, CO_NEVER
+ * while life guarding is off or waits for its first request. */
 uint32_t co_guard_poll(co_node_t *node, uint32_t now);
 
 #endif /* CO_GUARD_H */

@@ -5,6 +5,7 @@
  * Monitoring starts with the first heartbeat from that node; a missing one
  * for longer than the time is a heartbeat event: EMCY 8130h in the error
  * table and, from operational, pre-operational. The next heartbeat clears it.
+ * State: co_hbc_t in the node; linked where a product lists co_hbc_service.
  */
 #ifndef CO_HBC_H
 #define CO_HBC_H
@@ -29,6 +30,9 @@ void co_hbc_reconfig(co_node_t *node);
 /* A frame on 0x700 + the monitored node-ID. Returns true if consumed. */
 bool co_hbc_receive(co_node_t *node, const co_frame_t *f);
 
+/* The monitored node's time (co_service_t.poll): raises the heartbeat
+ * event when it ran out. Returns the delay (us) until it next needs to
+ * run, CO_NEVER while off, not started or lost. */
 uint32_t co_hbc_poll(co_node_t *node, uint32_t now);
 
 /* Write hook for 0x1016 sub n: reserved bits 31..24 must be 0. */

@@ -1,6 +1,7 @@
 /*
  * co_led.h - status LED patterns (CiA 303-3 style), computed from the node
- * state and the time passed in; no state of its own.
+ * state and the time passed in; no state of its own, no pointer kept, may
+ * be called from anywhere (pure functions of their arguments).
  */
 #ifndef CO_LED_H
 #define CO_LED_H

@@ -18,6 +18,9 @@
  * to waiting it resets communication with it (CiA 305). A configured
  * node-ID becomes active at the next reset communication; "store" keeps it
  * (and the bit rate) through the product's store hook, or the LSS class.
+ * State: co_lss_t in the node; linked where a product lists
+ * co_lss_service. Requests it does not know, or that arrive in the wrong
+ * LSS state, go unanswered (CiA 305); answers go out through co_node_send().
  */
 #ifndef CO_LSS_H
 #define CO_LSS_H
@@ -40,6 +43,10 @@ typedef struct co_lss {
     uint32_t switch_at;  /* (us) */
 } co_lss_t;
 
+/* Reset communication (co_service_t.reset): back to the waiting state, no
+ * selective switch, identification or Fastscan in progress, a configured
+ * bit timing forgotten; a configured node-ID stays pending (co_node_reset
+ * applies it). */
 void co_lss_init(co_node_t *node);
 
 /* Handle a frame on 0x7E5. Returns true if it was one. Works in every NMT

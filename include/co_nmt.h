@@ -1,5 +1,9 @@
 /*
  * co_nmt.h - NMT slave (CiA 301 7.2.8): states, the five commands, boot-up.
+ *
+ * State: co_nmt_t in the node; a product reads it with co_node_nmt_state()
+ * and changes it with co_nmt_enter() (its error behaviour), never from an
+ * interrupt. The reset commands run co_node_reset() before returning.
  */
 #ifndef CO_NMT_H
 #define CO_NMT_H
@@ -16,6 +20,7 @@ typedef enum co_nmt_state {
     CO_NMT_PREOP = 0x7F,
 } co_nmt_state_t;
 
+/* What a reset reloads (NMT commands, co_node_request_reset). */
 typedef enum co_reset {
     CO_RESET_COMM = 1, /* reload communication parameters (0x1000-0x1FFF) */
     CO_RESET_NODE = 2, /* reload everything; power-on is one too */
@@ -38,7 +43,7 @@ bool co_nmt_receive(co_node_t *node, const co_frame_t *f);
  */
 void co_nmt_enter(co_node_t *node, co_nmt_state_t state);
 
-/* Services allowed in the present state. */
+/* Whether SDO is served in NMT state state (pre-operational, operational). */
 static inline bool co_nmt_sdo_allowed(uint8_t state)
 {
     return state == CO_NMT_PREOP || state == CO_NMT_OPERATIONAL;

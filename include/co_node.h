@@ -1,16 +1,63 @@
 /*
  * co_node.h - the node object: one CANopen slave, all of its state.
  *
- * Typical main loop (see boards/linux/main.c):
- *     co_node_init(&node, &cfg, port, app, ram);
+ * The contract between a product (od/), a board (boards/) and the stack.
+ * co_node_t is visible so that its owner can allocate it (no heap); its
+ * fields are the stack's. A product or a board reads and changes a node
+ * only through the functions below and the modules' headers:
+ *  - Ownership. The caller owns the node, the config (const, shared by
+ *    every node of a product), the class RAM structs and the board and
+ *    product contexts; all of them outlive the node. The stack holds
+ *    pointers to them and never frees anything.
+ *  - Read, at any time (static inline, free): co_node_app(),
+ *    co_node_id(), co_node_bitrate(), co_node_nmt_state(),
+ *    co_node_can_state(), co_node_tx_dropped(), co_node_store_status();
+ *    dictionary values through co_node_entry() and co_od_get();
+ *    co_store_limit_reached(); co_od_checking() in a write hook.
+ *  - Change, from the product's reset hook only (co_node_ops_t.reset):
+ *    the node-ID (co_node_set_id), the bit-rate code (co_node_set_bitrate)
+ *    and the automatic start (co_node_set_autostart). Elsewhere they are a
+ *    broken contract (CO_CHECK, co_common.h) and change nothing.
+ *  - Change, from any hook, the product's poll or its sample function:
+ *    its own dictionary values (co_od_store() in a write hook), the byte
+ *    order of a TPDO (co_tpdo_set_msb_first), TPDO events
+ *    (co_tpdo_event), the NMT state (co_nmt_enter), errors (co_emcy_*),
+ *    the store (co_store_save, co_store_mark_corrupt,
+ *    co_store_report_emcy), a reset after the current answer
+ *    (co_node_request_reset), and co_node_wake() after a new sample.
+ *  - A board calls co_node_init/start/receive/poll, co_node_set_can_state
+ *    and co_node_leds, and provides co_port.h.
+ *  - Invalid arguments: an index or a value outside what a function's
+ *    comment allows is a programming error, checked with CO_CHECK (no
+ *    crash, nothing changed, reported in the unit tests). Results that a
+ *    master causes are co_res_t (SDO abort codes), never a CO_CHECK.
+ *
+ * Typical main loop (boards/common/mcu_main.c, boards/linux/main.c):
+ *     co_node_init(&node, &cfg, port, app, ram, nvm_base);
  *     co_node_start(&node, now());
  *     for (;;) {
  *         wait for a frame or for the delay co_node_poll() returned;
- *         co_node_poll(&node, now());          // stamps node->now
- *         while (frame received) co_node_receive(&node, &frame);
+ *         while (frame received) co_node_receive(&node, &frame, now());
+ *         co_node_poll(&node, now());          // timers, and what frames left to do
  *     }
  * Not reentrant for one node; separate nodes are independent. Never call
  * from an interrupt: a receive interrupt queues frames, the loop feeds them.
+ *
+ * Layering of src/ (no include or call cycle but through this object):
+ *   node        owns every module's state; dispatches frames, polls, resets
+ *     -> nmt, sdo, sync, tpdo, hb, emcy, store, the optional services
+ *        (guard, hbc, lss, rtr): the protocol modules
+ *          -> od (the dictionary), common: the leaves
+ *   incl (CiA 410), filter, led: libraries the products (led: the node)
+ *   call, calling no other module but filter
+ * A protocol module reaches another only downwards (sync -> tpdo at a
+ * SYNC, nmt -> tpdo at a state change, store -> emcy for 6300h, lss ->
+ * store, guard asks hb through co_hb_period_ms()), and everything may call
+ * back into the node (co_node_send, co_node_entry, co_node_reset, the NMT
+ * state in node->nmt). The dictionary calls no protocol module: a write
+ * hook of a product table (co_store_save_hook, co_tpdo_write_hook, ...) is
+ * named by the table, not by od.c, and a product's autosave is
+ * co_node_write()'s, not co_od_write()'s.
  */
 #ifndef CO_NODE_H
 #define CO_NODE_H
@@ -105,6 +152,8 @@ typedef struct co_node_cfg {
     const uint16_t *kbps;       /* kbit/s of each bit-rate code (16 codes; 0: unused), or NULL */
 } co_node_cfg_t;
 
+/* The node's state. Its fields are the stack's: the accessors below and
+ * the modules' functions are the product's and the board's way in. */
 struct co_node {
     /* Bytes first: on a Cortex-M0 a byte field is one load only within the
      * first 32 bytes of the struct (words: 128), so the hot ones go here. */
@@ -112,7 +161,6 @@ struct co_node {
     uint8_t bitrate;            /* active bit-rate code (the product's table) */
     uint8_t can_state;          /* co_can_state_t */
     bool autostart;             /* set by the reset op: go operational after boot-up */
-    bool pdo_msb_first;         /* PDO values big-endian (DST 0x5001 = 0) */
     uint8_t reset_request;      /* co_reset_t to perform at the next poll (0: none) */
     bool dirty;                 /* something happened since the last full poll */
     bool due_never;             /* the last full poll found no deadline at all */
@@ -125,7 +173,7 @@ struct co_node {
     void *app;                  /* product context for its hooks */
     void *ram[CO_CLS_COUNT];    /* the class structs, owned by the caller */
     uint32_t nvm_base;          /* where this node's records start in NVM */
-    uint32_t now;               /* time of the latest co_node_poll() */
+    uint32_t now;               /* time of the latest co_node_poll() or co_node_receive() */
     uint32_t due;               /* not dirty: no service needs to run before this time */
     uint32_t tx_dropped;        /* frames the board could not queue */
     co_sync_t sync;
@@ -153,14 +201,19 @@ extern const co_node_cfg_t CO_FIXED_CFG;
 #endif
 
 /*
- * Prepare a node; nothing is sent. cfg, port, app and the ram structs are
- * owned by the caller and must outlive the node. ram has CO_CLS_COUNT
- * entries (NULL where cfg->ram_size is 0).
+ * Prepare a node; nothing is sent, the board is not called. cfg, port, app
+ * and the ram structs are owned by the caller and must outlive the node;
+ * ram (copied) has CO_CLS_COUNT entries, NULL where cfg->ram_size is 0.
+ * nvm_base: where the node's records start in the board's EEPROM (each
+ * node of a device its own CO_STORE_NVM_SIZE bytes). Cannot fail.
  */
 void co_node_init(co_node_t *node, const co_node_cfg_t *cfg, void *port, void *app,
                   void *const ram[CO_CLS_COUNT], uint32_t nvm_base);
 
-/* Power-on: reset node (load the store, boot-up, pre-operational). */
+/* Power-on at time now: reset node (restore the stored sets, ask the
+ * board for the bit rate, boot-up, pre-operational or, with autostart,
+ * operational). A stored set that cannot be used is reported, never
+ * fatal: co_node_store_status(). */
 void co_node_start(co_node_t *node, uint32_t now);
 
 /*
@@ -179,6 +232,94 @@ static inline bool co_od_checking(const co_node_t *node)
     return node->od_checking;
 }
 
+/* ---- The product's and the board's view of the node (the contract above).
+ * Static inline: each is the one load or store it replaces, free in an
+ * image. */
+
+/* The product context given to co_node_init() (the product's instance). */
+static inline void *co_node_app(const co_node_t *node)
+{
+    return node->app;
+}
+
+/* The active node-ID: 1..127, or CO_LSS_UNCONFIGURED (0xFF: none yet, LSS). */
+static inline uint8_t co_node_id(const co_node_t *node)
+{
+    return node->node_id;
+}
+
+/* The active bit-rate code (the product's table, co_node_cfg_t.kbps). */
+static inline uint8_t co_node_bitrate(const co_node_t *node)
+{
+    return node->bitrate;
+}
+
+/* The NMT state (CO_NMT_INIT while a reset runs). */
+static inline co_nmt_state_t co_node_nmt_state(const co_node_t *node)
+{
+    return (co_nmt_state_t)node->nmt.state;
+}
+
+/* The CAN controller's state as the board last reported it. */
+static inline co_can_state_t co_node_can_state(const co_node_t *node)
+{
+    return (co_can_state_t)node->can_state;
+}
+
+/* Frames the board could not queue or that fell due while bus-off. */
+static inline uint32_t co_node_tx_dropped(const co_node_t *node)
+{
+    return node->tx_dropped;
+}
+
+/*
+ * What the last restore of class cls (CO_CLS_PARA, CO_CLS_LSS) found, as
+ * updated since (co_store.h: a full save makes a corrupt set sound again).
+ * Another cls: a broken contract (CO_CHECK), CO_STORE_BLANK.
+ */
+static inline co_store_status_t co_node_store_status(const co_node_t *node, co_cls_t cls)
+{
+    if (!CO_CHECK(cls == CO_CLS_PARA || cls == CO_CLS_LSS)) {
+        return CO_STORE_BLANK;
+    }
+    return (co_store_status_t)node->store.status[cls];
+}
+
+/* The node-ID, bit rate and automatic start are set by the stack at every
+ * reset (from the LSS set, else the config's defaults; autostart off) and
+ * then by the product's reset hook, if it has one: only there may a
+ * product change them (the NMT state is CO_NMT_INIT then). Anywhere else
+ * a call is a broken contract (CO_CHECK) and changes nothing. */
+
+/* Node-ID id (1..127, or CO_LSS_UNCONFIGURED) from the next boot-up on:
+ * a product that keeps it in its own object (the JD's 3000h). Another id:
+ * a broken contract (CO_CHECK), nothing changes. */
+static inline void co_node_set_id(co_node_t *node, uint8_t id)
+{
+    if (CO_CHECK(node->nmt.state == CO_NMT_INIT) &&
+        CO_CHECK((id >= 1u && id <= 127u) || id == CO_LSS_UNCONFIGURED)) {
+        node->node_id = id;
+    }
+}
+
+/* Bit-rate code (0..15, the product's table) activated by this reset: the
+ * board is asked for its rate when the reset ends (co_port_can_bitrate).
+ * Another code: a broken contract (CO_CHECK), nothing changes. */
+static inline void co_node_set_bitrate(co_node_t *node, uint8_t code)
+{
+    if (CO_CHECK(node->nmt.state == CO_NMT_INIT) && CO_CHECK(code <= 15u)) {
+        node->bitrate = code;
+    }
+}
+
+/* Go operational by itself after this boot-up (the DST's 0x5000, ...). */
+static inline void co_node_set_autostart(co_node_t *node, bool on)
+{
+    if (CO_CHECK(node->nmt.state == CO_NMT_INIT)) {
+        node->autostart = on;
+    }
+}
+
 /* Reset at the next poll, after the answer to the current request went out. */
 static inline void co_node_request_reset(co_node_t *node, co_reset_t kind)
 {
@@ -186,11 +327,21 @@ static inline void co_node_request_reset(co_node_t *node, co_reset_t kind)
     co_node_wake(node);
 }
 
-/* Reset node or communication now (what the NMT commands do). */
+/* Reset node or communication now (what the NMT commands do): the
+ * product's reset hook runs, the boot-up is sent. From a write hook use
+ * co_node_request_reset() instead, so that the answer goes out first. */
 void co_node_reset(co_node_t *node, co_reset_t kind);
 
-/* One received frame. */
-void co_node_receive(co_node_t *node, const co_frame_t *f);
+/*
+ * One received frame f (copied from where it is needed; the caller keeps
+ * f), at time now (us, the clock co_node_poll() gets): the time stamp of
+ * what the frame starts (a guard request's life time, a heartbeat
+ * consumer's timeout, an LSS switch delay). Answers go out through
+ * co_port_can_send() before it returns; what the frame leaves to do (a
+ * reset it asked for, a TPDO event) runs at the next co_node_poll(), which
+ * is due at once. Frames the node does not serve are ignored.
+ */
+void co_node_receive(co_node_t *node, const co_frame_t *f, uint32_t now);
 
 /*
  * Run timers; returns the delay (us) until the next call is needed. When
@@ -215,7 +366,10 @@ static inline bool co_node_send(co_node_t *node, const co_frame_t *f)
     return co_node_tx_drop(node);
 }
 
-/* The board's view of the CAN controller (LEDs, diagnostics). */
+/* The board's view of the CAN controller (LEDs, diagnostics): call it
+ * from the main loop when it changes (no-op when unchanged); while
+ * CO_CAN_BUSOFF the node sends nothing. The product's can_state hook
+ * runs. */
 void co_node_set_can_state(co_node_t *node, co_can_state_t s);
 
 /* The patterns the two LEDs show now (CiA 303-3 mapping, product hook). */
@@ -228,6 +382,17 @@ const char *co_led_pattern_name(co_led_pattern_t p);
  * LED levels at time now; *next_us receives the delay until either changes.
  */
 void co_node_leds(co_node_t *node, uint32_t now, bool *green, bool *red, uint32_t *next_us);
+
+/*
+ * Write len bytes (little-endian) to entry e of the node's dictionary as an
+ * SDO download does: co_od_write() (access, length, limits, write hook),
+ * then, where the product stores every change (cfg->autosave), a save of
+ * the entry's class (co_store_save()) at once. Returns co_od_write()'s
+ * result, or the save's (CO_E_STORE, CO_E_HW) when the value was taken
+ * but could not be stored. The SDO server writes through it, so that the
+ * dictionary never calls the store (see the layering above).
+ */
+co_res_t co_node_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len);
 
 /* Convenience: look up an entry in the node's dictionary (NULL if absent). */
 const co_od_entry_t *co_node_entry(const co_node_t *node, uint16_t index, uint8_t sub);

@@ -12,6 +12,17 @@
  * the bytes at .cdata for strings, unless a read hook computes it.
  *
  * Every function returns a co_res_t whose value is the SDO abort code.
+ *
+ * Ownership: the tables and their ext and string data are const and
+ * outlive every node using them; entries returned by co_od_find() point
+ * into them. The RAM structs are the product's (co_node_init). Nothing
+ * here keeps state of its own, allocates or blocks; the functions taking
+ * a node must not run from an interrupt. An entry pointer must come from
+ * the node's own table (co_od_find, co_node_entry): the functions trust
+ * its class, offset and size. Table sizes and offsets are checked when the
+ * table is compiled (CO_AT: an offset over 255 does not build).
+ * The dictionary calls no protocol module: the hooks a table names do
+ * (co_node.h, the layering).
  */
 #ifndef CO_OD_H
 #define CO_OD_H
@@ -93,12 +104,13 @@ struct co_od_entry {
 #endif
 };
 
-/* An entry's limits and hooks, none when it has no ext. */
+/* An entry's write hook, NULL when it has none (no ext, or none there). */
 static inline co_od_write_fn co_od_write_hook(const co_od_entry_t *e)
 {
     return e->ext != NULL ? e->ext->write : NULL;
 }
 
+/* An entry's read hook, NULL when it has none. */
 static inline co_od_read_fn co_od_read_hook(const co_od_entry_t *e)
 {
     return e->ext != NULL ? e->ext->read : NULL;
@@ -123,6 +135,10 @@ typedef struct co_od {
  * never hold it, and read as they always did.
  */
 #define CO_COBID_ABS 0x10000000u
+
+/* The COB-ID a CO_A_NODEID entry stands for: raw (the RAM value) with the
+ * node-ID added while its CAN-ID part is the default's base, as written
+ * (CO_COBID_ABS dropped) when it holds the flag, else raw itself. */
 uint32_t co_cobid_resolve(uint32_t raw, uint32_t def, uint8_t node_id);
 
 /* CiA 301 7.3.5 restricted CAN-IDs (NMT, SDO, LSS, NMT error control, ...):

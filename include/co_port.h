@@ -30,13 +30,31 @@ bool co_port_can_send(void *port, const co_frame_t *frame);
 bool co_port_can_bitrate(void *port, uint16_t kbps);
 
 /*
- * EEPROM emulation: byte-addressed non-volatile memory of co_port_nvm_size()
- * bytes. A read of never-written memory returns 0xFF. Reads and writes are
- * synchronous; a write returns only when the bytes are durable.
- * Both return false on a hardware failure (nothing is retried).
+ * EEPROM emulation: byte-addressed non-volatile memory; a node's records
+ * take CO_STORE_NVM_SIZE bytes from its nvm_base (co_node_init, co_store.h).
+ * A read of never-written memory returns 0xFF. Reads and writes are
+ * synchronous; a write returns only when the bytes are durable. Both
+ * return false on a hardware failure (nothing is retried), and for any
+ * byte beyond the board's EEPROM (nothing is read or written then).
+ *
+ * Decision (issue 12): the port has no size query. Until then it had
+ * co_port_nvm_size(), which nothing called. Its check at start would
+ * only say earlier what the range rule above already makes loud: a board
+ * whose EEPROM is too small for a node's slots fails those reads, so the
+ * store reports the class as CO_STORE_HW (co_store.h), the product shows
+ * its data-set error (DST 0x4001 bit 6 and EMCY 1000h; P+F and JD EMCY
+ * 6300h; the GSH-A has none), the Linux program logs the set it could not
+ * read, and every save is refused with 0x06060000. The check would have cost the DST X730 image
+ * flash it does not have to spare.
  */
-uint32_t co_port_nvm_size(void *port);
+/* Copy len bytes of the EEPROM from addr into buf (the caller's, len
+ * bytes). False: a hardware failure or a byte beyond the EEPROM; buf's
+ * contents are then undefined. */
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len);
+/* Write len bytes of buf (read only during the call) to the EEPROM at
+ * addr; durable when it returns true. False: a hardware failure or a byte
+ * beyond the EEPROM (what the bytes hold then is undefined: the store's
+ * records survive it, co_store.h). */
 bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len);
 
 #endif /* CO_PORT_H */

@@ -4,6 +4,13 @@
  * when the client wants it; one block carries any object, the
  * protocol-switch threshold is not used),
  * toggle and sequence checks, timeout, abort codes from co_res_t.
+ *
+ * State: co_sdo_t in the node, one transfer at a time (a new initiate
+ * replaces an unfinished one); the buffer of segmented and block downloads
+ * is its buf[CO_SDO_BUF]. The server reads and writes the dictionary
+ * (co_od_read, co_node_write) and answers through co_node_send(); every
+ * failure a client causes is answered with the abort code of its co_res_t
+ * (co_common.h), never a crash. Not reentrant; main loop only.
  */
 #ifndef CO_SDO_H
 #define CO_SDO_H
@@ -55,11 +62,15 @@ uint16_t co_crc16_ccitt(uint16_t crc, const uint8_t *data, uint32_t len);
 void co_sdo_init(co_sdo_t *sdo);
 
 /*
- * Handle one frame on 0x600 + node-ID. Frames that are not 8 bytes long
- * are ignored. Answers on 0x580 + node-ID through co_port_can_send().
- * Returns true if the frame was an SDO request to this node.
+ * Handle one frame on 0x600 + node-ID: co_node_receive() hands over every
+ * frame on that CAN-ID and only those (the CAN-ID is not checked again).
+ * Remote frames, frames that are not 8 bytes long and requests in stopped
+ * are ignored; every other request gets one answer on 0x580 + node-ID
+ * through co_port_can_send() before it returns (an abort with its
+ * co_res_t code where it fails), or none during a block download's
+ * sub-block and after a client's abort (CiA 301).
  */
-bool co_sdo_receive(co_node_t *node, const co_frame_t *f);
+void co_sdo_receive(co_node_t *node, const co_frame_t *f);
 
 /* Timeout of a segmented transfer; returns the delay until it next matters. */
 uint32_t co_sdo_poll(co_node_t *node, uint32_t now);

@@ -14,6 +14,17 @@
  * The layout hash is computed from the dictionary (index, sub-index, size
  * and offset of every entry of the class), so a firmware whose layout
  * differs treats an old image as invalid instead of misreading it.
+ *
+ * Ownership and errors: the records live in the board's EEPROM from the
+ * node's nvm_base on (CO_STORE_NVM_SIZE bytes: co_port.h), the live values
+ * in the product's class structs; state is co_store_t in the node. Every
+ * call is synchronous (the board's writes return when durable) and runs
+ * in the main loop, never from an interrupt. A failed NVM access is never
+ * retried: a read makes the class CO_STORE_HW (defaults in use), a write
+ * answers CO_E_HW; a refused save (signature, write-cycle limit) answers
+ * CO_E_STORE. cls must be CO_CLS_PARA or CO_CLS_LSS, and a class the
+ * product stores (cfg->ram_size): another is answered CO_E_STORE (save) or
+ * CO_STORE_BLANK (restore), nothing touched.
  */
 #ifndef CO_STORE_H
 #define CO_STORE_H
@@ -89,7 +100,9 @@ co_res_t co_store_save_group(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_
  * A value of the restored set of cls that only the product can judge (the
  * DST's bit-rate code, kept without a dictionary entry) failed: the product
  * set it to its default; the set is reported as corrupt, like one whose
- * values fail co_od_validate(), until the next full save.
+ * values fail co_od_validate(), until the next full save. cls must be
+ * CO_CLS_PARA or CO_CLS_LSS: another is a broken contract (CO_CHECK) and
+ * changes nothing.
  */
 void co_store_mark_corrupt(co_node_t *node, co_cls_t cls);
 
@@ -116,16 +129,26 @@ uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls);
 uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len);
 
 /*
- * Write hooks for 0x1010 and 0x1011 sub 1 (all parameters). "save" stores PARA (and LSS, if
- * cfg->save_includes_lss and it changed);
- * "load" requests defaults for PARA and LSS (unless the product keeps
- * LSS, cfg->load_keeps_lss) at the next reset. Wrong
- * signature: CO_E_STORE. Both call the node's on_store op afterwards.
+ * Write hook for 0x1010 sub 1 "save all parameters": value must be the
+ * signature "save" (CO_SIG_SAVE), else CO_E_STORE. Stores PARA, and LSS
+ * where cfg->save_includes_lss and it changed; results of co_store_save().
+ * On success the product's stored hook (co_node_ops_t.stored) runs.
  */
 co_res_t co_store_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+/*
+ * Write hook for 0x1011 sub 1 "restore default parameters": value must be
+ * "load" (CO_SIG_LOAD), else CO_E_STORE. Makes the next restore of PARA
+ * (and of LSS, unless cfg->load_keeps_lss) use defaults: the values in use
+ * stay until the next reset. Then the stored hook, as for "save".
+ */
 co_res_t co_store_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
-/* The same for sub 2..4: one CiA 301 group (co_store_save_group). */
+/* Write hook for 0x1010 sub 2..4: "save" of one CiA 301 group
+ * (co_store_save_group; LSS too where cfg->save_includes_lss). Another
+ * signature, or another sub-index: CO_E_STORE. */
 co_res_t co_store_group_save_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
+/* Write hook for 0x1011 sub 2..4: "load" of one group: its entries are
+ * stored as their defaults, the others keep their stored values. Same
+ * errors as the group save. */
 co_res_t co_store_group_load_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value);
 
 #endif /* CO_STORE_H */

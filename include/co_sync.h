@@ -1,6 +1,8 @@
 /*
  * co_sync.h - SYNC consumer (CiA 301 7.2.5). The COB-ID is 0x1005 when the
- * dictionary has it, 0x080 otherwise.
+ * dictionary has it, 0x080 otherwise. State: co_sync_t in the node. A SYNC
+ * in operational drives the synchronous TPDOs (co_tpdo_sync); elsewhere,
+ * or with more than one data byte, it is consumed and does nothing.
  */
 #ifndef CO_SYNC_H
 #define CO_SYNC_H
@@ -15,6 +17,8 @@ typedef struct co_sync {
     uint32_t count; /* SYNCs received in operational, for diagnostics */
 } co_sync_t;
 
+/* Re-read the SYNC COB-ID from 0x1005 (0x080 where the dictionary has
+ * none): at every reset and after a write of 0x1005. */
 void co_sync_reconfig(co_node_t *node);
 
 /* Write hook for 0x1005: store and use the new COB-ID at once. */

@@ -18,6 +18,15 @@
  *            sent once when it ends.
  * A remote request on the COB-ID (bit 30 of sub 1 clear) sends any valid
  * TPDO in operational.
+ *
+ * State: co_tpdo_t in the node, CO_TPDO_MAX of them; the mapped entries
+ * point into the product's const table. Frames go out through
+ * co_node_send(): one the board cannot queue is counted and lost. A
+ * TPDO number n a product passes must be below CO_TPDO_MAX: beyond it
+ * co_tpdo_reconfig, co_tpdo_set_msb_first, co_tpdo_event and
+ * co_tpdo_changed take it as a broken contract (CO_CHECK): nothing changes,
+ * co_tpdo_changed answers false. Values a master writes are judged by the
+ * write hooks below, which answer SDO abort codes.
  */
 #ifndef CO_TPDO_H
 #define CO_TPDO_H
@@ -50,14 +59,39 @@ typedef struct co_tpdo {
     uint8_t map_drop[CO_PDO_MAP_MAX]; /* 32 - bits of each: the high bits not sent */
     uint8_t len;           /* mapped bytes */
     uint8_t dlc;           /* of its frames: len, or 8 where the product pads */
+    bool msb_first;        /* mapped values big-endian (the product's choice, DST 0x5001 = 0):
+                            * co_tpdo_set_msb_first(); kept by co_tpdo_reconfig() */
     _Alignas(4) uint8_t last[8]; /* word aligned: copied in words (tpdo.c) */
 } co_tpdo_t;
 
-/* Re-read parameters and mapping of TPDO n (0-based) from the dictionary. */
+/*
+ * Re-read the communication parameters (0x1800 + n) and the mapping
+ * (0x1A00 + n) of TPDO n (0-based) from the dictionary: the stack calls it
+ * at every reset and from the write hooks below; a product calls it after
+ * changing those values itself. A TPDO whose parameters are missing or
+ * whose mapping is unusable stays invalid (sends nothing). While
+ * operational, its timers restart now. n must be below CO_TPDO_MAX: a
+ * larger n is a broken contract (CO_CHECK, co_common.h) and changes
+ * nothing.
+ */
 void co_tpdo_reconfig(co_node_t *node, unsigned n);
 
-/* Start (entering operational) or stop every TPDO. */
+/*
+ * The byte order of TPDO n's mapped values: little-endian as CiA 301 has
+ * it (false, the default after co_node_init()), or each value big-endian
+ * (true: the DST's 0x5001 "PDO coding" = 0). A property of the TPDO, kept
+ * across co_tpdo_reconfig() and resets: the product sets it, typically
+ * from its reset hook and the write hook of its own object. n must be
+ * below CO_TPDO_MAX: a larger n is a broken contract (CO_CHECK) and
+ * changes nothing.
+ */
+void co_tpdo_set_msb_first(co_node_t *node, unsigned n, bool msb_first);
+
+/* Entering operational: every TPDO starts afresh (SYNC count 0, no data
+ * sent yet, the event timer's first send at the next poll). */
 void co_tpdo_start(co_node_t *node);
+/* Leaving operational or resetting: event timers and pending events of
+ * every TPDO stop; nothing is sent until co_tpdo_start(). */
 void co_tpdo_stop(co_node_t *node);
 
 /* One SYNC received in operational. */

@@ -1,21 +1,22 @@
 /*
- * product_list.c - the product registry (the Linux program and the tests;
- * an MCU image links one product only, so it leaves this file out).
+ * registry.c - the product registry (the Linux program and the tests; an
+ * MCU image links one product only, so it leaves this file out). Its rows
+ * come from the families' declarations (od/<family>/family.cmake, through
+ * the generated product_registry.h): a product is added there, not here.
  */
 #include <string.h>
 
-#include "dst.h"
-#include "gsh.h"
-#include "jd.h"
-#include "pf.h"
 #include "product.h"
+#include "product_registry.h"
 
-const product_t *const product_list[] = {
-    &dst_x730_xy10, &dst_x730_xy15, &dst_x730_xy20, &dst_x730_xy30, &dst_x730_xy45,
-    &dst_x730_xy60, &dst_x730_xy90, &dst_x730_z360, &dst_x710_xy10, &dst_x710_xy15,
-    &dst_x710_xy20, &dst_x710_xy30, &dst_x710_xy45, &dst_x710_xy60, &dst_x710_xy90,
-    &dst_x710_z360, &gsh_a, &gsh_a_redundant, &jd1xxx, &jd2xxx, &pf_inx360d, &pf_iny360d, NULL,
-};
+/* The unit tests' build (CO_REGISTRY_EXAMPLES) also lists the templates. */
+#ifdef CO_REGISTRY_EXAMPLES
+#define REGISTRY_ROWS PRODUCT_REGISTRY_ROWS PRODUCT_REGISTRY_EXAMPLES
+#else
+#define REGISTRY_ROWS PRODUCT_REGISTRY_ROWS
+#endif
+
+const product_t *const product_list[] = {REGISTRY_ROWS NULL};
 
 const product_t *product_find(const char *id)
 {

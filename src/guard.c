@@ -34,7 +34,7 @@ bool co_guard_receive(co_node_t *node, const co_frame_t *f)
     if (!f->rtr || f->id != 0x700u + node->node_id) {
         return false;
     }
-    if (!g->enabled || node->hb.period_ms != 0u) {
+    if (!g->enabled || co_hb_period_ms(node) != 0u) {
         return true; /* not guarded, or the heartbeat is the protocol in use */
     }
     co_frame_t r = {.id = f->id, .dlc = 1, .data = {(uint8_t)(g->toggle | node->nmt.state)}};
@@ -67,7 +67,7 @@ uint32_t co_guard_poll(co_node_t *node, uint32_t now)
     /* Life time = guard time x life time factor (CiA 301), up to
      * 65535 x 255 ms: 32 bits hold it in ms, not in us. */
     uint32_t life_ms = get(node, 0x100C) * get(node, 0x100D);
-    if (life_ms == 0u || node->hb.period_ms != 0u) {
+    if (life_ms == 0u || co_hb_period_ms(node) != 0u) {
         /* Life guarding is off (no life time, or the heartbeat is the
          * protocol in use): it starts again with the first request answered
          * after. Kept, the last request's time stamp would be stale by then:

@@ -16,6 +16,11 @@ void co_hb_reconfig(co_node_t *node)
     node->hb.restart = true;
 }
 
+uint16_t co_hb_period_ms(const co_node_t *node)
+{
+    return node->hb.period_ms;
+}
+
 co_res_t co_hb_write_hook(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     co_res_t r = co_od_store(node, e, value);

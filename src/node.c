@@ -38,6 +38,15 @@ bool co_node_tx_drop(co_node_t *node)
     return false;
 }
 
+co_res_t co_node_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len)
+{
+    co_res_t r = co_od_write(node, e, buf, len);
+    if (r == CO_OK && co_cfg(node)->autosave && (e->cls == CO_CLS_PARA || e->cls == CO_CLS_LSS)) {
+        r = co_store_save(node, (co_cls_t)e->cls); /* the product stores every change */
+    }
+    return r;
+}
+
 /* A restore, and the check of a record's values (co_store.h). */
 static void restore(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)
 {
@@ -135,23 +144,29 @@ static bool services_receive(co_node_t *node, const co_frame_t *f, bool always)
     return false;
 }
 
-void co_node_receive(co_node_t *node, const co_frame_t *f)
+void co_node_receive(co_node_t *node, const co_frame_t *f, uint32_t now)
 {
+    node->now = now;
     co_node_wake(node);
     /* The frame a slave gets most, straight to its server: no other
      * service may use an SDO CAN-ID (restricted, CiA 301 7.3.5). */
     if (f->id == 0x600u + node->node_id && node->nmt.state != CO_NMT_INIT) {
-        (void)co_sdo_receive(node, f);
+        co_sdo_receive(node, f);
+        return;
+    }
+    /* An SDO request was served above: nothing else is on its CAN-ID.
+     * NMT and SYNC next, the frames a slave gets most after SDO: their
+     * CAN-IDs (0, a SYNC COB-ID that is never restricted) are no LSS
+     * frame's (0x7E5), so they go before the services that run in every
+     * state (SYNC on the JD2: 20 instructions less). */
+    bool init = node->nmt.state == CO_NMT_INIT;
+    if (!init && (co_nmt_receive(node, f) || co_sync_receive(node, f))) {
         return;
     }
     if (services_receive(node, f, true)) {
         return; /* LSS works in every state, and without a node-ID */
     }
-    if (node->nmt.state == CO_NMT_INIT) {
-        return;
-    }
-    if (co_nmt_receive(node, f) || co_sync_receive(node, f) || co_sdo_receive(node, f) ||
-        services_receive(node, f, false)) {
+    if (init || services_receive(node, f, false)) {
         return;
     }
     /* Anything else (other nodes' traffic, RTRs nobody serves) is ignored. */

@@ -7,7 +7,6 @@
 #include <string.h>
 
 #include "co_node.h"
-#include "co_store.h"
 
 static bool is_signed(const co_od_entry_t *e)
 {
@@ -219,9 +218,10 @@ co_res_t co_od_store(co_node_t *node, const co_od_entry_t *e, uint32_t value)
     return CO_OK;
 }
 
-/* Limits, then the hook or the plain store, then the product's autosave:
- * an SDO download's value, or a restored one in check mode (no autosave,
- * and the hooks act on nothing). Not inlined: one body for both. */
+/* Limits, then the hook or the plain store: an SDO download's value, or a
+ * restored one in check mode (the hooks act on nothing). Not inlined: one
+ * body for both. A product's autosave is the node's (co_node_write): the
+ * dictionary never calls the store. */
 static CO_NOINLINE co_res_t write_value(co_node_t *node, const co_od_entry_t *e, uint32_t v)
 {
     const co_od_ext_t *x = e->ext;
@@ -247,12 +247,7 @@ static CO_NOINLINE co_res_t write_value(co_node_t *node, const co_od_entry_t *e,
         }
         write = x->write;
     }
-    co_res_t r = write != NULL ? write(node, e, v) : co_od_store(node, e, v);
-    if (r == CO_OK && co_cfg(node)->autosave && !node->od_checking &&
-        (e->cls == CO_CLS_PARA || e->cls == CO_CLS_LSS)) {
-        r = co_store_save(node, (co_cls_t)e->cls); /* the product stores every change */
-    }
-    return r;
+    return write != NULL ? write(node, e, v) : co_od_store(node, e, v);
 }
 
 co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len)

@@ -1,5 +1,5 @@
 /*
- * sdo_server.c - SDO server: expedited transfer, the dispatch to the
+ * sdo.c - SDO server: expedited transfer, the dispatch to the
  * optional segmented (sdo_segment.c) and block (sdo_block.c) protocols,
  * their timeout. See co_sdo.h.
  */
@@ -19,7 +19,7 @@ void co_sdo_init(co_sdo_t *sdo)
  * frame's initialiser was a memset and the data a memcpy from an array,
  * 103 of the expedited read's instructions on the Cortex-M0 (byte loops,
  * libc_min.c); now about 20. */
-void co_sdo_send(co_node_t *node, co_frame_t *f)
+void sdo_send(co_node_t *node, co_frame_t *f)
 {
     f->id = (uint16_t)(0x580u + node->node_id);
     f->dlc = 8;
@@ -27,14 +27,14 @@ void co_sdo_send(co_node_t *node, co_frame_t *f)
     (void)co_node_send(node, f);
 }
 
-void co_sdo_reply(co_node_t *node, const uint8_t d[8])
+void sdo_reply(co_node_t *node, const uint8_t d[8])
 {
     co_frame_t f;
     memcpy(f.data, d, 8);
-    co_sdo_send(node, &f);
+    sdo_send(node, &f);
 }
 
-void co_sdo_reply_head(co_node_t *node, uint8_t cmd, const uint8_t *req, uint32_t val)
+void sdo_reply_head(co_node_t *node, uint8_t cmd, const uint8_t *req, uint32_t val)
 {
     co_frame_t f;
     f.data[0] = cmd;
@@ -42,18 +42,18 @@ void co_sdo_reply_head(co_node_t *node, uint8_t cmd, const uint8_t *req, uint32_
     f.data[2] = req[2];
     f.data[3] = req[3];
     co_put_u32(&f.data[4], val);
-    co_sdo_send(node, &f);
+    sdo_send(node, &f);
 }
 
-void co_sdo_abort(co_node_t *node, const uint8_t *mux, co_res_t r)
+void sdo_abort(co_node_t *node, const uint8_t *mux, co_res_t r)
 {
     node->sdo.state = SDO_IDLE;
-    co_sdo_reply_head(node, 0x80, mux, co_res_abort_code(r));
+    sdo_reply_head(node, 0x80, mux, co_res_abort_code(r));
 }
 
 /* Command byte placeholder and multiplexer of the transfer in progress,
  * laid out like a request so that abort replies can echo it. */
-void co_sdo_mux(const co_sdo_t *sdo, uint8_t mux[4])
+void sdo_mux(const co_sdo_t *sdo, uint8_t mux[4])
 {
     mux[0] = 0;
     mux[1] = (uint8_t)sdo->e->index;
@@ -61,18 +61,18 @@ void co_sdo_mux(const co_sdo_t *sdo, uint8_t mux[4])
     mux[3] = sdo->e->sub;
 }
 
-void co_sdo_restart(co_sdo_t *sdo)
+void sdo_restart(co_sdo_t *sdo)
 {
     sdo->restart = true;
 }
 
 /* The object a request's multiplexer names, or NULL after the abort. */
-const co_od_entry_t *co_sdo_find(co_node_t *node, const uint8_t *d)
+const co_od_entry_t *sdo_find(co_node_t *node, const uint8_t *d)
 {
     co_res_t r;
     const co_od_entry_t *e = co_od_find(co_cfg(node)->od, co_get_u16(&d[1]), d[3], &r);
     if (e == NULL) {
-        co_sdo_abort(node, d, r);
+        sdo_abort(node, d, r);
     }
     return e;
 }
@@ -82,9 +82,9 @@ const co_od_entry_t *co_sdo_find(co_node_t *node, const uint8_t *d)
  * be writable, fit the buffer, and match an indicated size. NULL after
  * answering with the abort.
  */
-const co_od_entry_t *co_sdo_download_target(co_node_t *node, const uint8_t *d, bool sized)
+const co_od_entry_t *sdo_download_target(co_node_t *node, const uint8_t *d, bool sized)
 {
-    const co_od_entry_t *e = co_sdo_find(node, d);
+    const co_od_entry_t *e = sdo_find(node, d);
     if (e == NULL) {
         return NULL;
     }
@@ -95,7 +95,7 @@ const co_od_entry_t *co_sdo_download_target(co_node_t *node, const uint8_t *d, b
         : co_od_size(e) > CO_SDO_BUF       ? CO_E_OOM
                                            : CO_OK;
     if (r != CO_OK) {
-        co_sdo_abort(node, d, r);
+        sdo_abort(node, d, r);
         return NULL;
     }
     return e;
@@ -103,22 +103,22 @@ const co_od_entry_t *co_sdo_download_target(co_node_t *node, const uint8_t *d, b
 
 static void download_expedited(co_node_t *node, const uint8_t *d)
 {
-    const co_od_entry_t *e = co_sdo_find(node, d);
+    const co_od_entry_t *e = sdo_find(node, d);
     if (e == NULL) {
         return;
     }
     if ((e->attr & CO_A_W) == 0u) {
-        co_sdo_abort(node, d, CO_E_RO);
+        sdo_abort(node, d, CO_E_RO);
         return;
     }
     /* Size not indicated (0x22): the object's own size, at most 4. */
     uint32_t len = (d[0] & 0x01u) != 0u ? 4u - ((d[0] >> 2) & 0x03u)
                                          : co_min_u32(co_od_size(e), 4u);
-    co_res_t r = co_od_write(node, e, &d[4], len);
+    co_res_t r = co_node_write(node, e, &d[4], len);
     if (r != CO_OK) {
-        co_sdo_abort(node, d, r);
+        sdo_abort(node, d, r);
     } else {
-        co_sdo_reply_head(node, 0x60, d, 0);
+        sdo_reply_head(node, 0x60, d, 0);
     }
 }
 
@@ -140,14 +140,14 @@ static bool upload_expedited(co_node_t *node, const uint8_t *d, const co_od_entr
         r = (e->attr & CO_A_R) == 0u ? CO_E_WO : co_od_get(node, e, &v);
     }
     if (r != CO_OK) {
-        co_sdo_abort(node, d, r);
+        sdo_abort(node, d, r);
         return true;
     }
     if (size < 4u) {
         v &= (1u << (8u * size)) - 1u; /* only the object's own bytes */
     }
     /* Expedited, size indicated (0x4F / 0x4B / 0x47 / 0x43). */
-    co_sdo_reply_head(node, (uint8_t)(0x43u | ((4u - size) << 2)), d, v);
+    sdo_reply_head(node, (uint8_t)(0x43u | ((4u - size) << 2)), d, v);
     return true;
 }
 
@@ -155,17 +155,18 @@ static bool upload_expedited(co_node_t *node, const uint8_t *d, const co_od_entr
 static void optional(co_node_t *node, const uint8_t *d, co_sdo_proto_fn proto)
 {
     if (proto == NULL || !proto(node, d)) {
-        co_sdo_abort(node, d, CO_E_CMD);
+        sdo_abort(node, d, CO_E_CMD);
     }
 }
 
-bool co_sdo_receive(co_node_t *node, const co_frame_t *f)
+/* Not inlined into co_node_receive, its one caller: there its frame and
+ * saved registers cost every other frame too (the JD2 SYNC on the
+ * Cortex-M0: 3 instructions). */
+CO_NOINLINE void co_sdo_receive(co_node_t *node, const co_frame_t *f)
 {
-    if (f->id != 0x600u + node->node_id || f->rtr) {
-        return false;
-    }
-    if (f->dlc != 8u || !co_nmt_sdo_allowed(node->nmt.state)) {
-        return true; /* CiA 301: SDO frames are 8 bytes; no SDO in stopped */
+    /* The CAN-ID is the node's to check (co_node_receive), once. */
+    if (f->rtr || f->dlc != 8u || !co_nmt_sdo_allowed(node->nmt.state)) {
+        return; /* CiA 301: SDO frames are 8 bytes; no SDO in stopped */
     }
     const uint8_t *d = f->data;
     co_sdo_t *sdo = &node->sdo;
@@ -174,11 +175,11 @@ bool co_sdo_receive(co_node_t *node, const co_frame_t *f)
     bool abort = sdo->state == SDO_BLK_DL ? d[0] == 0x80u : (d[0] >> 5) == CCS_ABORT;
     if (abort) {
         sdo->state = SDO_IDLE; /* the client gave up; no answer */
-        return true;
+        return;
     }
     if (sdo->state >= SDO_BLK_DL && co_cfg(node)->sdo_block != NULL) {
         (void)co_cfg(node)->sdo_block(node, d); /* a block transfer in progress */
-        return true;
+        return;
     }
     switch (d[0] >> 5) {
     case CCS_DOWNLOAD_INITIATE:
@@ -191,7 +192,7 @@ bool co_sdo_receive(co_node_t *node, const co_frame_t *f)
         break;
     case CCS_UPLOAD_INITIATE: {
         sdo->state = SDO_IDLE;
-        const co_od_entry_t *e = co_sdo_find(node, d);
+        const co_od_entry_t *e = sdo_find(node, d);
         if (e != NULL && !upload_expedited(node, d, e)) {
             optional(node, d, co_cfg(node)->sdo_segmented);
         }
@@ -206,10 +207,9 @@ bool co_sdo_receive(co_node_t *node, const co_frame_t *f)
         optional(node, d, co_cfg(node)->sdo_block);
         break;
     default:
-        co_sdo_abort(node, d, CO_E_CMD); /* reserved command specifier */
+        sdo_abort(node, d, CO_E_CMD); /* reserved command specifier */
         break;
     }
-    return true;
 }
 
 uint32_t co_sdo_poll(co_node_t *node, uint32_t now)
@@ -224,8 +224,8 @@ uint32_t co_sdo_poll(co_node_t *node, uint32_t now)
     }
     if (!co_time_before(now, sdo->deadline)) {
         uint8_t mux[4];
-        co_sdo_mux(sdo, mux);
-        co_sdo_abort(node, mux, CO_E_TIMEOUT);
+        sdo_mux(sdo, mux);
+        sdo_abort(node, mux, CO_E_TIMEOUT);
         return CO_NEVER;
     }
     return sdo->deadline - now;

@@ -30,7 +30,7 @@ static void block_download_initiate(co_node_t *node, const uint8_t *d)
 {
     co_sdo_t *sdo = &node->sdo;
     sdo->sized = (d[0] & 0x02u) != 0u;
-    const co_od_entry_t *e = co_sdo_download_target(node, d, sdo->sized);
+    const co_od_entry_t *e = sdo_download_target(node, d, sdo->sized);
     if (e == NULL) {
         return;
     }
@@ -41,9 +41,9 @@ static void block_download_initiate(co_node_t *node, const uint8_t *d)
     sdo->seq = 0;
     sdo->crc = (d[0] & 0x04u) != 0u;
     sdo->blksize = (uint8_t)BLKSIZE;
-    co_sdo_restart(sdo);
+    sdo_restart(sdo);
     uint8_t out[8] = {0xA4, d[1], d[2], d[3], sdo->blksize, 0, 0, 0}; /* CRC supported */
-    co_sdo_reply(node, out);
+    sdo_reply(node, out);
 }
 
 static void block_download_segment(co_node_t *node, const uint8_t *d)
@@ -52,12 +52,12 @@ static void block_download_segment(co_node_t *node, const uint8_t *d)
     uint8_t seqno = d[0] & 0x7Fu;
     bool c = (d[0] & 0x80u) != 0u;
     bool last = c;
-    co_sdo_restart(sdo);
+    sdo_restart(sdo);
     if (seqno == (uint8_t)(sdo->seq + 1u)) {
         if (sdo->pos + 7u > CO_SDO_BUF + 7u) {
             uint8_t mux[4];
-            co_sdo_mux(sdo, mux);
-            co_sdo_abort(node, mux, CO_E_LEN_HIGH);
+            sdo_mux(sdo, mux);
+            sdo_abort(node, mux, CO_E_LEN_HIGH);
             return;
         }
         /* Keep at most the buffer; bytes past it make the end check fail. */
@@ -70,7 +70,7 @@ static void block_download_segment(co_node_t *node, const uint8_t *d)
     }
     if (c || seqno >= sdo->blksize) {
         uint8_t ack[8] = {0xA2, sdo->seq, sdo->blksize, 0, 0, 0, 0, 0};
-        co_sdo_reply(node, ack);
+        sdo_reply(node, ack);
         if (last) {
             sdo->state = SDO_BLK_DL_END;
         }
@@ -82,29 +82,29 @@ static void block_download_end(co_node_t *node, const uint8_t *d)
 {
     co_sdo_t *sdo = &node->sdo;
     uint8_t mux[4];
-    co_sdo_mux(sdo, mux);
+    sdo_mux(sdo, mux);
     if (d[0] >> 5 != CCS_BLOCK_DOWNLOAD || (d[0] & 0x01u) == 0u) {
-        co_sdo_abort(node, mux, CO_E_CMD);
+        sdo_abort(node, mux, CO_E_CMD);
         return;
     }
     uint32_t unused = (d[0] >> 2) & 0x07u;
     uint32_t len = sdo->pos - unused;
     sdo->state = SDO_IDLE;
     if (len > CO_SDO_BUF || (sdo->sized && len != sdo->size)) {
-        co_sdo_abort(node, mux, CO_E_LEN);
+        sdo_abort(node, mux, CO_E_LEN);
         return;
     }
     if (sdo->crc && co_crc16_ccitt(0, sdo->buf, len) != co_get_u16(&d[1])) {
-        co_sdo_abort(node, mux, CO_E_CRC);
+        sdo_abort(node, mux, CO_E_CRC);
         return;
     }
-    co_res_t r = co_od_write(node, sdo->e, sdo->buf, len);
+    co_res_t r = co_node_write(node, sdo->e, sdo->buf, len);
     if (r != CO_OK) {
-        co_sdo_abort(node, mux, r);
+        sdo_abort(node, mux, r);
         return;
     }
     uint8_t out[8] = {0xA1, 0, 0, 0, 0, 0, 0, 0};
-    co_sdo_reply(node, out);
+    sdo_reply(node, out);
 }
 
 /* ---- block upload ----------------------------------------------------- */
@@ -112,26 +112,26 @@ static void block_download_end(co_node_t *node, const uint8_t *d)
 static void block_upload_initiate(co_node_t *node, const uint8_t *d)
 {
     co_sdo_t *sdo = &node->sdo;
-    const co_od_entry_t *e = co_sdo_find(node, d);
+    const co_od_entry_t *e = sdo_find(node, d);
     if (e == NULL) {
         return;
     }
     if ((e->attr & CO_A_R) == 0u) {
-        co_sdo_abort(node, d, CO_E_WO);
+        sdo_abort(node, d, CO_E_WO);
         return;
     }
     if (d[4] < 1u || d[4] > 127u) {
-        co_sdo_abort(node, d, CO_E_BLKSIZE);
+        sdo_abort(node, d, CO_E_BLKSIZE);
         return;
     }
     if (co_od_size(e) > CO_SDO_BUF) {
-        co_sdo_abort(node, d, CO_E_OOM); /* never cut an object short */
+        sdo_abort(node, d, CO_E_OOM); /* never cut an object short */
         return;
     }
     uint32_t len;
     co_res_t r = co_od_read(node, e, 0, sdo->buf, CO_SDO_BUF, &len);
     if (r != CO_OK) {
-        co_sdo_abort(node, d, r);
+        sdo_abort(node, d, r);
         return;
     }
     sdo->state = SDO_BLK_UL_START;
@@ -141,8 +141,8 @@ static void block_upload_initiate(co_node_t *node, const uint8_t *d)
     sdo->blk_start = 0;
     sdo->crc = (d[0] & 0x04u) != 0u;
     sdo->blksize = d[4];
-    co_sdo_restart(sdo);
-    co_sdo_reply_head(node, 0xC6, d, len); /* CRC supported, size indicated */
+    sdo_restart(sdo);
+    sdo_reply_head(node, 0xC6, d, len); /* CRC supported, size indicated */
 }
 
 static void block_upload_send(co_node_t *node)
@@ -158,30 +158,30 @@ static void block_upload_send(co_node_t *node)
         sdo->seq++;
         bool last = pos >= sdo->size;
         out[0] = (uint8_t)(sdo->seq | (last ? 0x80u : 0u));
-        co_sdo_reply(node, out);
+        sdo_reply(node, out);
         if (last) {
             break;
         }
     }
     sdo->state = SDO_BLK_UL;
-    co_sdo_restart(sdo);
+    sdo_restart(sdo);
 }
 
 static void block_upload_client(co_node_t *node, const uint8_t *d)
 {
     co_sdo_t *sdo = &node->sdo;
     uint8_t mux[4];
-    co_sdo_mux(sdo, mux);
+    sdo_mux(sdo, mux);
     uint8_t cs = d[0] & 0x03u;
     if (d[0] >> 5 != CCS_BLOCK_UPLOAD) {
-        co_sdo_abort(node, mux, CO_E_CMD);
+        sdo_abort(node, mux, CO_E_CMD);
         return;
     }
     if (sdo->state == SDO_BLK_UL_START && cs == 3u) {
         block_upload_send(node);
     } else if (sdo->state == SDO_BLK_UL && cs == 2u) {
         if (d[1] > sdo->seq || d[2] < 1u || d[2] > 127u) {
-            co_sdo_abort(node, mux, d[1] > sdo->seq ? CO_E_SEQNO : CO_E_BLKSIZE);
+            sdo_abort(node, mux, d[1] > sdo->seq ? CO_E_SEQNO : CO_E_BLKSIZE);
             return;
         }
         sdo->blk_start = co_min_u32(sdo->blk_start + 7u * d[1], sdo->size);
@@ -196,15 +196,15 @@ static void block_upload_client(co_node_t *node, const uint8_t *d)
                 co_put_u16(&out[1], co_crc16_ccitt(0, sdo->buf, sdo->size));
             }
             sdo->state = SDO_BLK_UL_END;
-            co_sdo_restart(sdo);
-            co_sdo_reply(node, out);
+            sdo_restart(sdo);
+            sdo_reply(node, out);
         } else {
             block_upload_send(node); /* the next block, or the rest of this one */
         }
     } else if (sdo->state == SDO_BLK_UL_END && cs == 1u) {
         sdo->state = SDO_IDLE; /* done; the client's end needs no answer */
     } else {
-        co_sdo_abort(node, mux, CO_E_CMD);
+        sdo_abort(node, mux, CO_E_CMD);
     }
 }
 

@@ -1,6 +1,7 @@
 /*
- * sdo_internal.h - what the SDO server (sdo_server.c) shares with its
- * optional block transfer (sdo_block.c). Not part of the public API.
+ * sdo_internal.h - what the SDO server (sdo.c) shares with its optional
+ * segmented (sdo_segment.c) and block (sdo_block.c) transfers. Not part of
+ * the public API: hence the prefix sdo_, not co_sdo_ (co_sdo.h).
  */
 #ifndef SDO_INTERNAL_H
 #define SDO_INTERNAL_H
@@ -29,15 +30,29 @@ enum {
     CCS_BLOCK_DOWNLOAD = 6,
 };
 
-/* Answer, abort and bookkeeping helpers of the server. */
-void co_sdo_reply(co_node_t *node, const uint8_t d[8]);
+/* Answer, abort and bookkeeping helpers of the server. Each answer goes
+ * out on 0x580 + node-ID through co_node_send() before it returns. */
+
+/* Send the 8 bytes d (copied) as the server's answer. */
+void sdo_reply(co_node_t *node, const uint8_t d[8]);
 /* Send f as the server's answer: f->data filled by the caller, all 8 bytes. */
-void co_sdo_send(co_node_t *node, co_frame_t *f);
-void co_sdo_reply_head(co_node_t *node, uint8_t cmd, const uint8_t *req, uint32_t val);
-void co_sdo_abort(co_node_t *node, const uint8_t *mux, co_res_t r);
-void co_sdo_mux(const co_sdo_t *sdo, uint8_t mux[4]);
-void co_sdo_restart(co_sdo_t *sdo);
-const co_od_entry_t *co_sdo_find(co_node_t *node, const uint8_t *d);
-const co_od_entry_t *co_sdo_download_target(co_node_t *node, const uint8_t *d, bool sized);
+void sdo_send(co_node_t *node, co_frame_t *f);
+/* Answer cmd, the request req's multiplexer (bytes 1..3), val in bytes 4..7. */
+void sdo_reply_head(co_node_t *node, uint8_t cmd, const uint8_t *req, uint32_t val);
+/* End the transfer (idle) and answer abort code r for the multiplexer in
+ * mux[1..3] (a request, or sdo_mux()'s). */
+void sdo_abort(co_node_t *node, const uint8_t *mux, co_res_t r);
+/* The multiplexer of the transfer in progress (sdo->e set), laid out like
+ * a request (mux[0] = 0) for sdo_abort(). */
+void sdo_mux(const co_sdo_t *sdo, uint8_t mux[4]);
+/* A segment arrived: the timeout restarts at the next co_sdo_poll(). */
+void sdo_restart(co_sdo_t *sdo);
+/* The entry request d names, or NULL after answering with the abort
+ * (0x06020000 no object, 0x06090011 no sub-index). */
+const co_od_entry_t *sdo_find(co_node_t *node, const uint8_t *d);
+/* The entry a segmented or block download initiate d names, checked for
+ * write access, the size d indicates (sized) and CO_SDO_BUF; NULL after
+ * answering with the abort. */
+const co_od_entry_t *sdo_download_target(co_node_t *node, const uint8_t *d, bool sized);
 
 #endif /* SDO_INTERNAL_H */

@@ -19,16 +19,16 @@ static bool begin(co_node_t *node, const uint8_t *d, uint8_t state, const co_od_
     sdo->size = co_od_size(e);
     sdo->pos = 0;
     sdo->toggle = 0;
-    co_sdo_restart(sdo);
+    sdo_restart(sdo);
     /* Download: 0x60; upload: 0x41 with the size indicated. */
-    co_sdo_reply_head(node, state == SDO_DOWNLOAD ? 0x60 : 0x41, d,
+    sdo_reply_head(node, state == SDO_DOWNLOAD ? 0x60 : 0x41, d,
                       state == SDO_DOWNLOAD ? 0u : sdo->size);
     return true;
 }
 
 static bool initiate_download(co_node_t *node, const uint8_t *d)
 {
-    const co_od_entry_t *e = co_sdo_download_target(node, d, (d[0] & 0x01u) != 0u);
+    const co_od_entry_t *e = sdo_download_target(node, d, (d[0] & 0x01u) != 0u);
     return e == NULL || begin(node, d, SDO_DOWNLOAD, e);
 }
 
@@ -38,7 +38,7 @@ static void download_segment(co_node_t *node, const uint8_t *d, const uint8_t mu
     co_sdo_t *sdo = &node->sdo;
     uint32_t n = 7u - ((d[0] >> 1) & 0x07u);
     if (sdo->pos + n > sdo->size) {
-        co_sdo_abort(node, mux, CO_E_LEN_HIGH);
+        sdo_abort(node, mux, CO_E_LEN_HIGH);
         return;
     }
     memcpy(&sdo->buf[sdo->pos], &d[1], n);
@@ -46,33 +46,33 @@ static void download_segment(co_node_t *node, const uint8_t *d, const uint8_t mu
     uint8_t ack[8] = {(uint8_t)(0x20u | sdo->toggle), 0, 0, 0, 0, 0, 0, 0};
     sdo->toggle ^= 0x10u;
     if ((d[0] & 0x01u) == 0u) { /* more segments follow */
-        co_sdo_restart(sdo);
-        co_sdo_reply(node, ack);
+        sdo_restart(sdo);
+        sdo_reply(node, ack);
         return;
     }
     sdo->state = SDO_IDLE;
     if (sdo->pos != sdo->size) {
         /* Fewer bytes than the object: more were refused segment by segment above. */
-        co_sdo_abort(node, mux, CO_E_LEN_LOW);
+        sdo_abort(node, mux, CO_E_LEN_LOW);
         return;
     }
-    co_res_t r = co_od_write(node, sdo->e, sdo->buf, sdo->pos);
+    co_res_t r = co_node_write(node, sdo->e, sdo->buf, sdo->pos);
     if (r != CO_OK) {
-        co_sdo_abort(node, mux, r);
+        sdo_abort(node, mux, r);
         return;
     }
-    co_sdo_reply(node, ack);
+    sdo_reply(node, ack);
 }
 
 /* An object of more than 4 bytes (the server answered the others). */
 static bool initiate_upload(co_node_t *node, const uint8_t *d)
 {
-    const co_od_entry_t *e = co_sdo_find(node, d);
+    const co_od_entry_t *e = sdo_find(node, d);
     if (e == NULL) {
         return true;
     }
     if ((e->attr & CO_A_R) == 0u) {
-        co_sdo_abort(node, d, CO_E_WO);
+        sdo_abort(node, d, CO_E_WO);
         return true;
     }
     return begin(node, d, SDO_UPLOAD, e);
@@ -82,12 +82,12 @@ static bool initiate_upload(co_node_t *node, const uint8_t *d)
 static void upload_segment(co_node_t *node, const uint8_t mux[4])
 {
     co_sdo_t *sdo = &node->sdo;
-    co_frame_t f; /* the answer, built in place (co_sdo_send) */
+    co_frame_t f; /* the answer, built in place (sdo_send) */
     uint8_t *out = f.data;
     uint32_t n;
     co_res_t r = co_od_read(node, sdo->e, sdo->pos, &out[1], 7, &n);
     if (r != CO_OK) {
-        co_sdo_abort(node, mux, r);
+        sdo_abort(node, mux, r);
         return;
     }
     for (uint32_t k = 1u + n; k < 8u; k++) {
@@ -100,9 +100,9 @@ static void upload_segment(co_node_t *node, const uint8_t mux[4])
     if (last) {
         sdo->state = SDO_IDLE;
     } else {
-        co_sdo_restart(sdo);
+        sdo_restart(sdo);
     }
-    co_sdo_send(node, &f);
+    sdo_send(node, &f);
 }
 
 bool co_sdo_segmented(co_node_t *node, const uint8_t *d)
@@ -118,13 +118,13 @@ bool co_sdo_segmented(co_node_t *node, const uint8_t *d)
         /* A segment belongs to the transfer in progress, of the same direction. */
         bool download = (d[0] >> 5) == CCS_DOWNLOAD_SEGMENT;
         if (sdo->state != (download ? SDO_DOWNLOAD : SDO_UPLOAD)) {
-            co_sdo_abort(node, d, CO_E_CMD);
+            sdo_abort(node, d, CO_E_CMD);
             return true;
         }
         uint8_t mux[4];
-        co_sdo_mux(sdo, mux);
+        sdo_mux(sdo, mux);
         if ((d[0] & 0x10u) != sdo->toggle) {
-            co_sdo_abort(node, mux, CO_E_TOGGLE);
+            sdo_abort(node, mux, CO_E_TOGGLE);
         } else if (download) {
             download_segment(node, d, mux);
         } else {

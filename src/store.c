@@ -240,7 +240,9 @@ co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, u
 
 void co_store_mark_corrupt(co_node_t *node, co_cls_t cls)
 {
-    node->store.status[cls] = CO_STORE_CORRUPT;
+    if (CO_CHECK(cls == CO_CLS_PARA || cls == CO_CLS_LSS)) {
+        node->store.status[cls] = CO_STORE_CORRUPT;
+    }
 }
 
 void co_store_report_emcy(co_node_t *node)

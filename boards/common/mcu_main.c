@@ -90,8 +90,8 @@ int main(void)
         co_frame_t f;
         while (board_can_receive(&f)) {
             for (unsigned i = 0; i < p->nodes; i++) {
-                co_node_poll(nodes[i], now);
-                co_node_receive(nodes[i], &f);
+                co_node_receive(nodes[i], &f, now);
+                co_node_poll(nodes[i], now); /* what the frame left to do, before the next one */
             }
         }
         for (unsigned i = 0; i < p->nodes; i++) {

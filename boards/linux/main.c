@@ -141,7 +141,7 @@ typedef struct app {
 static void sync_can_state(app_t *a, unsigned i)
 {
     co_can_state_t s = lp_can_state(&a->ports[i]);
-    if (s != (co_can_state_t)a->nodes[i]->can_state) {
+    if (s != co_node_can_state(a->nodes[i])) {
         co_node_set_can_state(a->nodes[i], s);
     }
 }
@@ -228,10 +228,10 @@ static void log_states(app_t *a)
     static const char *const names[] = {[0x00] = "initialising", [0x04] = "stopped",
                                         [0x05] = "operational", [0x7F] = "pre-operational"};
     for (unsigned i = 0; i < a->nnodes; i++) {
-        uint8_t s = a->nodes[i]->nmt.state;
+        uint8_t s = (uint8_t)co_node_nmt_state(a->nodes[i]);
         if (s != a->last_state[i]) {
             const char *name = (s < sizeof(names) / sizeof(names[0]) && names[s]) ? names[s] : "?";
-            lp_log("node %u (ID 0x%02X): NMT %s", i, a->nodes[i]->node_id, name);
+            lp_log("node %u (ID 0x%02X): NMT %s", i, co_node_id(a->nodes[i]), name);
             a->last_state[i] = s;
         }
     }
@@ -251,7 +251,7 @@ static void log_store_status(app_t *a, const lp_nvm_t *nvm)
             if (co_cfg(a->nodes[i])->ram_size[sets[k].cls] == 0u) {
                 continue;
             }
-            co_store_status_t st = (co_store_status_t)a->nodes[i]->store.status[sets[k].cls];
+            co_store_status_t st = co_node_store_status(a->nodes[i], sets[k].cls);
             if (st == CO_STORE_CORRUPT || st == CO_STORE_HW) {
                 lp_log("node %u: EEPROM file %s: stored %s %s: factory defaults in use until "
                        "the next save (the file is left as it is until then)",
@@ -461,8 +461,8 @@ int main(int argc, char **argv)
     for (unsigned i = 0; i < a.nnodes; i++) {
         co_node_start(a.nodes[i], t);
         lp_log("node %u: %s, node-ID 0x%02X on %s, bit-rate code %u = %u kbit/s (vcan ignores it)",
-               i, a.prod->id, a.nodes[i]->node_id, ifn[i], a.nodes[i]->bitrate,
-               product_kbps(a.prod, a.nodes[i]->bitrate));
+               i, a.prod->id, co_node_id(a.nodes[i]), ifn[i], co_node_bitrate(a.nodes[i]),
+               product_kbps(a.prod, co_node_bitrate(a.nodes[i])));
     }
     log_store_status(&a, &nvm);
     /* A regular file or a device never blocks: read one block a pass of the
@@ -542,7 +542,6 @@ int main(int argc, char **argv)
                 }
             } else if (src < a.nnodes) {
                 co_frame_t f;
-                co_node_poll(a.nodes[src], t);
                 /* At most 64 frames, then the timers again: a flooded bus
                  * must not starve the heartbeat (the rest stay queued in
                  * the socket; epoll reports them at once). */
@@ -552,7 +551,7 @@ int main(int argc, char **argv)
                         break;
                     }
                     if (rr == 1) {
-                        co_node_receive(a.nodes[src], &f);
+                        co_node_receive(a.nodes[src], &f, t);
                     }
                 }
                 sync_can_state(&a, src);
@@ -566,9 +565,9 @@ int main(int argc, char **argv)
         lp_report_drops(p);
         lp_log("node %u: %lu frames received, %lu dropped by the kernel (receive queue full)", i,
                p->rx_frames, p->rx_dropped);
-        if (a.nodes[i]->tx_dropped != 0u) {
+        if (co_node_tx_dropped(a.nodes[i]) != 0u) {
             lp_log("node %u: %u frames could not be sent (%lu while off the bus)", i,
-                   a.nodes[i]->tx_dropped, p->tx_off);
+                   co_node_tx_dropped(a.nodes[i]), p->tx_off);
         }
         lp_close(p);
     }

@@ -699,11 +699,6 @@ int lp_nvm_open(lp_nvm_t *n, const char *path, uint8_t *mem, uint32_t size, char
     return 0;
 }
 
-uint32_t co_port_nvm_size(void *port)
-{
-    return ((lp_port_t *)port)->nvm->size;
-}
-
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     lp_nvm_t *n = ((lp_port_t *)port)->nvm;

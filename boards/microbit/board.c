@@ -224,12 +224,6 @@ static const flash_ops_t nrf51_flash = {
 static const flash_ee_t eeprom = {.ops = &nrf51_flash, .ctx = 0, .base = EEPROM_BASE,
                                   .page_size = NRF51_PAGE_SIZE, .pages = EEPROM_PAGES};
 
-uint32_t co_port_nvm_size(void *port)
-{
-    (void)port;
-    return flash_ee_size(&eeprom);
-}
-
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     (void)port;

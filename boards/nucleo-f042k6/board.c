@@ -241,12 +241,6 @@ static const flash_ops_t f042_flash = {.erase = f042_erase, .program16 = f042_pr
 static const flash_ee_t eeprom = {.ops = &f042_flash, .ctx = 0, .base = 0x08006000u,
                                   .page_size = 1024u, .pages = 8u};
 
-uint32_t co_port_nvm_size(void *port)
-{
-    (void)port;
-    return flash_ee_size(&eeprom);
-}
-
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     (void)port;

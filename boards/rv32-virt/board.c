@@ -211,13 +211,6 @@ static const flash_ee_t *nvm(void)
     return eeprom.ops != NULL ? &eeprom : NULL;
 }
 
-uint32_t co_port_nvm_size(void *port)
-{
-    (void)port;
-    const flash_ee_t *fe = nvm();
-    return fe != NULL ? flash_ee_size(fe) : 0u;
-}
-
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     (void)port;

@@ -11,7 +11,7 @@
 
 static dst_dev_t *dev_of(co_node_t *n)
 {
-    return n->app;
+    return co_node_app(n);
 }
 
 /* ---- dictionary hooks ---------------------------------------------- */
@@ -85,7 +85,7 @@ co_res_t dst_write_bitrate(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 co_res_t dst_write_coding(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
     co_res_t r = co_od_store(n, e, v);
-    n->pdo_msb_first = dev_of(n)->para.pdo_coding == 0u;
+    co_tpdo_set_msb_first(n, 0, dev_of(n)->para.pdo_coding == 0u); /* TPDO1, its only one */
     return r;
 }
 
@@ -140,15 +140,15 @@ static void dst_reset(co_node_t *n, co_reset_t kind)
         /* A stored code beyond the table (0..7, as 0x20F2 accepts): the
          * default, and the set reported as corrupt (0x4001 bit 6). */
         d->lss.bitrate = co_cfg(n)->default_bitrate;
-        n->bitrate = d->lss.bitrate;
+        co_node_set_bitrate(n, d->lss.bitrate);
         co_store_mark_corrupt(n, CO_CLS_LSS);
     }
     /* Both copies read the active values after a reset (B-46). */
-    d->vol.id[0] = d->vol.id[1] = n->node_id;
+    d->vol.id[0] = d->vol.id[1] = co_node_id(n);
     d->vol.br[0] = d->vol.br[1] = d->lss.bitrate;
     /* Big-endian PDOs only where 0x5001 exists and says so (the X710 has none). */
-    n->pdo_msb_first = co_node_entry(n, 0x5001, 0) != NULL && d->para.pdo_coding == 0u;
-    n->autostart = d->para.autostart == 1u; /* B-11: after any reset */
+    co_tpdo_set_msb_first(n, 0, co_node_entry(n, 0x5001, 0) != NULL && d->para.pdo_coding == 0u);
+    co_node_set_autostart(n, d->para.autostart == 1u); /* B-11: after any reset */
     apply_filter(d);
     /* Errors are re-evaluated and re-reported after every boot-up. */
     d->reported = 0;
@@ -175,9 +175,10 @@ static uint8_t current_errors(dst_dev_t *d)
     /* The manual has one bit for stored-data checksums ("LSS parameter
      * checksum error"); a corrupt PARA set is reported with it too rather
      * than not at all. Defaults are in use until the next good save. */
-    if (n->store.status[CO_CLS_LSS] == CO_STORE_CORRUPT ||
-        n->store.status[CO_CLS_PARA] == CO_STORE_CORRUPT ||
-        n->store.status[CO_CLS_LSS] == CO_STORE_HW || n->store.status[CO_CLS_PARA] == CO_STORE_HW) {
+    co_store_status_t lss = co_node_store_status(n, CO_CLS_LSS);
+    co_store_status_t para = co_node_store_status(n, CO_CLS_PARA);
+    if (lss == CO_STORE_CORRUPT || para == CO_STORE_CORRUPT || lss == CO_STORE_HW ||
+        para == CO_STORE_HW) {
         e |= DST_ERR_CHECKSUM;
     }
     return e;
@@ -195,7 +196,8 @@ static uint32_t dst_poll(co_node_t *n, uint32_t now)
      * C-14), 0x00, 0x4001, 0, 0, 0. Error reset: all zero (B-27). */
     uint8_t msef[5] = {0x00, d->errors, 0, 0, 0};
     uint16_t code = d->errors != 0u ? CO_EMCY_GENERIC : CO_EMCY_NO_ERROR;
-    if (n->nmt.state != CO_NMT_PREOP && n->nmt.state != CO_NMT_OPERATIONAL) {
+    co_nmt_state_t st = co_node_nmt_state(n);
+    if (st != CO_NMT_PREOP && st != CO_NMT_OPERATIONAL) {
         return CO_NEVER; /* no EMCY in stopped: reported when it is allowed again */
     }
     (void)co_emcy_send(n, code, 0x00, msef); /* may be disabled by 0x1014 bit 31 */
@@ -203,7 +205,7 @@ static uint32_t dst_poll(co_node_t *n, uint32_t now)
     d->reported = d->errors;
     if (new_error) {
         /* 0x4000: 0 pre-operational, 2 stopped, anything else no change (C-42). */
-        if (d->para.err_behaviour == 0u && n->nmt.state == CO_NMT_OPERATIONAL) {
+        if (d->para.err_behaviour == 0u && st == CO_NMT_OPERATIONAL) {
             co_nmt_enter(n, CO_NMT_PREOP);
         } else if (d->para.err_behaviour == 2u) {
             co_nmt_enter(n, CO_NMT_STOPPED);

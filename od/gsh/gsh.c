@@ -8,7 +8,7 @@
 
 static gsh_chan_t *chan_of(co_node_t *n)
 {
-    return n->app;
+    return co_node_app(n);
 }
 
 uint8_t gsh_pdo_checksum(const uint8_t d[7])
@@ -47,7 +47,7 @@ static void gsh_reset(co_node_t *n, co_reset_t kind)
     (void)kind;
     gsh_chan_t *c = chan_of(n);
     c->counter = 0; /* 4.6: from 0 at every boot-up */
-    n->autostart = c->para.autostart == 1u; /* after every boot-up (C-22) */
+    co_node_set_autostart(n, c->para.autostart == 1u); /* after every boot-up (C-22) */
 }
 
 static void gsh_tpdo_fill(co_node_t *n, unsigned pdo, co_frame_t *f)

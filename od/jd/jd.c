@@ -15,7 +15,7 @@
 
 static jd_dev_t *dev_of(co_node_t *n)
 {
-    return n->app;
+    return co_node_app(n);
 }
 
 /* sin(deg) x 1000, one entry a degree over a quarter turn. */
@@ -250,12 +250,12 @@ static void jd_reset(co_node_t *n, co_reset_t kind)
 {
     jd_dev_t *d = dev_of(n);
     if (kind == CO_RESET_NODE && d->para.node_number <= 126u) {
-        n->node_id = (uint8_t)(d->para.node_number + 1u); /* 3000h + 1 (R41) */
+        co_node_set_id(n, (uint8_t)(d->para.node_number + 1u)); /* 3000h + 1 (R41) */
     }
     if (kind == CO_RESET_NODE) {
-        n->bitrate = d->para.bitrate; /* 3001h, read at power-on and reset node */
+        co_node_set_bitrate(n, d->para.bitrate); /* 3001h, read at power-on and reset node */
     }
-    n->autostart = d->para.autostart == 1u; /* 3005h, after every boot-up (C33) */
+    co_node_set_autostart(n, d->para.autostart == 1u); /* 3005h, after every boot-up (C33) */
 }
 
 /* CiA 305 bit-timing index to 0x3001 code (R46): 20k..1M are codes 0..7. */
@@ -277,16 +277,16 @@ static uint8_t jd_lss_store(co_node_t *n, uint8_t id, uint8_t br)
 static void jd_leds(co_node_t *n, co_led_pattern_t *g, co_led_pattern_t *r)
 {
     /* Green: on in pre-operational, flashing in operational (C20). */
-    if (n->nmt.state == CO_NMT_PREOP) {
+    if (co_node_nmt_state(n) == CO_NMT_PREOP) {
         *g = CO_LED_ON;
-    } else if (n->nmt.state == CO_NMT_OPERATIONAL) {
+    } else if (co_node_nmt_state(n) == CO_NMT_OPERATIONAL) {
         *g = CO_LED_BLINK;
     }
-    if (n->can_state == CO_CAN_BUSOFF) {
+    if (co_node_can_state(n) == CO_CAN_BUSOFF) {
         *r = CO_LED_ON;
     } else if (co_emcy_active(n, CO_EMCY_LIFE_GUARD)) {
         *r = CO_LED_FLASH2; /* guard or heartbeat event */
-    } else if (n->store.status[CO_CLS_PARA] == CO_STORE_CORRUPT) {
+    } else if (co_node_store_status(n, CO_CLS_PARA) == CO_STORE_CORRUPT) {
         *r = CO_LED_BLINK; /* general configuration error (R11) */
     }
     if (*r != CO_LED_OFF) {

@@ -11,7 +11,7 @@
 
 static pf_dev_t *dev_of(co_node_t *n)
 {
-    return n->app;
+    return co_node_app(n);
 }
 
 co_res_t pf_write_bitrate(co_node_t *n, const co_od_entry_t *e, uint32_t v)
@@ -49,7 +49,7 @@ static uint32_t pf_poll(co_node_t *n, uint32_t now)
 {
     (void)now;
     pf_dev_t *d = dev_of(n);
-    if (n->nmt.state == CO_NMT_INIT || n->nmt.state == CO_NMT_STOPPED) {
+    if (co_node_nmt_state(n) == CO_NMT_INIT || co_node_nmt_state(n) == CO_NMT_STOPPED) {
         return CO_NEVER; /* no EMCY in stopped: errors are raised when allowed */
     }
     /* Error register bits as the manual's example (C12) and R35. */
@@ -70,7 +70,7 @@ static void pf_leds(co_node_t *n, co_led_pattern_t *run, co_led_pattern_t *err)
      * bus-off / undervoltage on, EEPROM error 2x flash, warning 1x flash. */
     pf_dev_t *d = dev_of(n);
     bool undervoltage = (d->faults & PF_FAULT_UNDERVOLTAGE) != 0u;
-    if (n->can_state == CO_CAN_BUSOFF || undervoltage) {
+    if (co_node_can_state(n) == CO_CAN_BUSOFF || undervoltage) {
         *run = CO_LED_OFF;
         *err = CO_LED_ON;
     } else if (co_emcy_active(n, CO_EMCY_DATA_SET)) {

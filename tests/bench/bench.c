@@ -53,12 +53,6 @@ bool co_port_can_send(void *port, const co_frame_t *f)
     return true;
 }
 
-uint32_t co_port_nvm_size(void *port)
-{
-    (void)port;
-    return sizeof(nvm);
-}
-
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     (void)port;
@@ -101,10 +95,10 @@ static co_node_t *boot(const product_t *p)
 #else
 #define BENCH_MEASURED __attribute__((noinline))
 #endif
-BENCH_MEASURED void bench_receive(co_node_t *n, const co_frame_t *f);
-BENCH_MEASURED void bench_receive(co_node_t *n, const co_frame_t *f)
+BENCH_MEASURED void bench_receive(co_node_t *n, const co_frame_t *f, uint32_t now);
+BENCH_MEASURED void bench_receive(co_node_t *n, const co_frame_t *f, uint32_t now)
 {
-    co_node_receive(n, f);
+    co_node_receive(n, f, now);
 }
 
 BENCH_MEASURED void bench_tpdo(co_node_t *n);
@@ -140,7 +134,7 @@ static void op_sdo_expedited(long count)
     co_node_t *n = boot(&dst_x730_xy30); /* read 0x6010, as a master polls it */
     co_frame_t f = {.id = 0x67F, .dlc = 8, .data = {0x40, 0x10, 0x60, 0x00}};
     for (long i = 0; i < count; i++) {
-        bench_receive(n, &f);
+        bench_receive(n, &f, 0);
     }
 }
 #endif
@@ -151,13 +145,13 @@ static void op_sdo_segment(long count)
     co_node_t *n = boot(&pf_iny360d); /* 0x1008: 19 characters, 3 segments */
     co_frame_t init = {.id = 0x601, .dlc = 8, .data = {0x40, 0x08, 0x10, 0x00}};
     for (long i = 0; i < count; i++) {
-        co_node_receive(n, &init);
+        co_node_receive(n, &init, 0);
         co_frame_t seg = {.id = 0x601, .dlc = 8, .data = {0x60}};
-        bench_receive(n, &seg); /* the first segment: 7 bytes */
+        bench_receive(n, &seg, 0); /* the first segment: 7 bytes */
         seg.data[0] = 0x70;
-        co_node_receive(n, &seg);
+        co_node_receive(n, &seg, 0);
         seg.data[0] = 0x60;
-        co_node_receive(n, &seg);
+        co_node_receive(n, &seg, 0);
     }
 }
 #endif
@@ -167,7 +161,7 @@ static void op_tpdo(long count)
 {
     co_node_t *n = boot(&dst_x730_xy30); /* X and Y, 8 bytes */
     co_frame_t start = {.id = 0x000, .dlc = 2, .data = {0x01, 0x7F}};
-    co_node_receive(n, &start);
+    co_node_receive(n, &start, 0);
     for (long i = 0; i < count; i++) {
         bench_tpdo(n);
     }
@@ -189,10 +183,10 @@ static void op_sync(long count)
 {
     co_node_t *n = boot(&jd2xxx); /* two TPDOs, both synchronous (type 1) */
     co_frame_t start = {.id = 0x000, .dlc = 2, .data = {0x01, 0x0A}};
-    co_node_receive(n, &start);
+    co_node_receive(n, &start, 0);
     co_frame_t sync = {.id = 0x080, .dlc = 0};
     for (long i = 0; i < count; i++) {
-        bench_receive(n, &sync);
+        bench_receive(n, &sync, 0);
     }
 }
 #endif

@@ -40,6 +40,7 @@
 #include "co_port.h"
 #include "flash_ee.h"
 #include "fuzz_format.h"
+#include "fuzz_products.h"
 #include "fuzz_input.h"
 #include "product.h"
 #include "product_registry.h"
@@ -181,12 +182,6 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
     return true;
 }
 
-uint32_t co_port_nvm_size(void *port)
-{
-    (void)port;
-    return flash_ee_size(&g_fe);
-}
-
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     (void)port;
@@ -218,7 +213,7 @@ static void deliver(dev_t *d, const co_frame_t *f)
 {
     for (unsigned k = 0; k < d->nnodes; k++) {
         (void)co_node_poll(d->nodes[k], d->now);
-        co_node_receive(d->nodes[k], f);
+        co_node_receive(d->nodes[k], f, d->now);
         (void)co_node_poll(d->nodes[k], d->now); /* a reset it asked for (the JD's save-reset) */
     }
 }
@@ -453,41 +448,21 @@ static void api(fz_t *in)
     }
 }
 
-/* The seeds were written for this order of product_list (fuzz_format.h). */
-static void check_products(void)
-{
-    static const char *const ids[FZ_PRODUCT_COUNT] = {FZ_PRODUCT_IDS};
-    unsigned n = 0;
-    while (product_list[n] != NULL) {
-        if (n >= FZ_PRODUCT_COUNT || strcmp(product_list[n]->id, ids[n]) != 0) {
-            fprintf(stderr, "product_list differs from FZ_PRODUCT_IDS at %u: update fuzz_format.h "
-                            "and rewrite the seeds (tools/fuzz --seeds)\n", n);
-            abort();
-        }
-        n++;
-    }
-    if (n != FZ_PRODUCT_COUNT) {
-        fprintf(stderr, "product_list has %u products, FZ_PRODUCT_IDS %u\n", n, FZ_PRODUCT_COUNT);
-        abort();
-    }
-}
+/* The products by selector byte (fuzz_products.h). */
+static fz_products_t g_products;
 
 int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
     (void)argc;
     (void)argv;
-    check_products();
+    fz_products_init(&g_products);
     return 0;
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     fz_t in = {data, size};
-    unsigned nprod = 0;
-    while (product_list[nprod] != NULL) {
-        nprod++;
-    }
-    g_prod = product_list[u8(&in) % nprod];
+    g_prod = fz_product(&g_products, u8(&in));
     g_product = g_prod->id;
     uint8_t ps = u8(&in);
     g_flash.page = ps % 8u < 7u ? 64u << (ps % 8u) : (uint32_t)(u16(&in) % PAGE_MAX) + 1u;

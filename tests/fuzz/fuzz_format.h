@@ -23,9 +23,11 @@
 #ifndef FUZZ_FORMAT_H
 #define FUZZ_FORMAT_H
 
-/* product_list[] as the seed corpus was written for it (the first input
- * byte); the harness checks it at start, so that a reordered registry is
- * noticed and the seeds rewritten (tools/fuzz --seeds). */
+/* The products the seed corpus was written for, by their selector byte
+ * (an input's first byte): the harnesses take them by ID, in this order,
+ * then every other product of the registry (fuzz_products.h), so the seeds
+ * survive a new family; a product dropped from the registry stops them
+ * (rewrite the seeds: tools/fuzz --seeds). */
 #define FZ_PRODUCT_IDS                                                                          \
     "dst-x730-xy10", "dst-x730-xy15", "dst-x730-xy20", "dst-x730-xy30", "dst-x730-xy45",          \
         "dst-x730-xy60", "dst-x730-xy90", "dst-x730-z360", "dst-x710-xy10", "dst-x710-xy15",      \

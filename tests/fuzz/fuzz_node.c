@@ -59,6 +59,7 @@
 #include "co_node.h"
 #include "co_port.h"
 #include "fuzz_format.h"
+#include "fuzz_products.h"
 #include "fuzz_input.h"
 #include "product.h"
 #include "product_registry.h"
@@ -278,12 +279,6 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
     return !p->tx_full;
 }
 
-uint32_t co_port_nvm_size(void *port)
-{
-    (void)port;
-    return NVM_SIZE;
-}
-
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     port_t *p = port;
@@ -468,7 +463,7 @@ static void deliver(dev_t *d, const co_frame_t *f)
         w->in_guard_rtr = f->rtr && has_id(n) && f->id == 0x700u + n->node_id;
         w->sdo_count = 0;
         const co_od_entry_t *written = expedited_write(n, f);
-        co_node_receive(n, f);
+        co_node_receive(n, f, now32(d));
         if (written != NULL) {
             check_read_back(d, k, written, f);
         }
@@ -1466,30 +1461,14 @@ static void run_op(fz_t *in, dev_t *d)
     }
 }
 
-/* The seeds were written for this order of product_list (fuzz_format.h). */
-static void check_products(void)
-{
-    static const char *const ids[FZ_PRODUCT_COUNT] = {FZ_PRODUCT_IDS};
-    unsigned n = 0;
-    while (product_list[n] != NULL) {
-        if (n >= FZ_PRODUCT_COUNT || strcmp(product_list[n]->id, ids[n]) != 0) {
-            fprintf(stderr, "product_list differs from FZ_PRODUCT_IDS at %u: update fuzz_format.h "
-                            "and rewrite the seeds (tools/fuzz --seeds)\n", n);
-            abort();
-        }
-        n++;
-    }
-    if (n != FZ_PRODUCT_COUNT) {
-        fprintf(stderr, "product_list has %u products, FZ_PRODUCT_IDS %u\n", n, FZ_PRODUCT_COUNT);
-        abort();
-    }
-}
+/* The products by selector byte (fuzz_products.h). */
+static fz_products_t g_products;
 
 int LLVMFuzzerInitialize(int *argc, char ***argv)
 {
     (void)argc;
     (void)argv;
-    check_products();
+    fz_products_init(&g_products);
     const char *t = getenv("FUZZ_TRACE");
     g_trace = t != NULL && t[0] == '1';
     /* The invariant's restricted set is the stack's own (CiA 301 7.3.5). */
@@ -1504,12 +1483,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     fz_t in = {data, size};
     dev_t *d = &g_dev;
-    unsigned nprod = 0;
-    while (product_list[nprod] != NULL) {
-        nprod++;
-    }
     memset(d, 0, sizeof(*d));
-    d->prod = product_list[u8(&in) % nprod];
+    d->prod = fz_product(&g_products, u8(&in));
     g_product = d->prod->id;
     g_op = 0;
     uint8_t clock = u8(&in);

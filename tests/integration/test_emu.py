@@ -31,8 +31,8 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 EMU = str(ROOT / "tools" / "emu")
 PRODUCT = "dst-x730-xy30"
 NODE = 0x7F
-ERR_CHECKSUM = 0x40  # DST 0x4001 bit 6: stored parameter checksum error (od/dst.h)
-MAGIC = 0x53506F43   # src/param_store.c, STORE_MAGIC
+ERR_CHECKSUM = 0x40  # DST 0x4001 bit 6: stored parameter checksum error (od/dst/dst.h)
+MAGIC = 0x53506F43   # src/store.c, STORE_MAGIC
 
 # Per board: its toolchain file, the flash file's size and the distance of
 # the store's slots in it (one erase unit each).

@@ -46,12 +46,6 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
     return true;
 }
 
-uint32_t co_port_nvm_size(void *port)
-{
-    (void)port;
-    return FAKE_NVM_SIZE;
-}
-
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     fake_port_t *p = port;
@@ -167,7 +161,7 @@ void h_rx_frame(h_dev_t *d, const co_frame_t *f)
 {
     for (unsigned i = 0; i < d->nnodes; i++) {
         co_node_poll(d->nodes[i], d->now);
-        co_node_receive(d->nodes[i], f);
+        co_node_receive(d->nodes[i], f, d->now);
         co_node_poll(d->nodes[i], d->now);
     }
 }

@@ -199,12 +199,6 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
 
 static uint8_t nvm[CO_STORE_NVM_SIZE];
 
-uint32_t co_port_nvm_size(void *port)
-{
-    (void)port;
-    return sizeof(nvm);
-}
-
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     (void)port;

@@ -445,6 +445,31 @@ static void test_derived_pdo_coding(void)
     EXPECT_TPDO("11 94 00 00 00 00 00 00"); /* D19: big-endian */
 }
 
+/* D19's byte order is TPDO1's (co_tpdo_set_msb_first): it holds across a
+ * change of TPDO1's parameters (co_tpdo_reconfig), a reset communication
+ * and, saved, a power cycle; 0x5001 = 1 is little-endian again. */
+static void test_pdo_coding_is_tpdo1s(void)
+{
+    boot(M->xy90);
+    d->truth[0] = 45000;
+    operational_settled();
+    set_res_001();
+    SDO(d, "2F 01 50 00 00 00 00 00", "60 01 50 00 00 00 00 00");
+    SDO(d, "2B 00 18 05 32 00 00 00", "60 00 18 05 00 00 00 00"); /* event timer 50 ms */
+    EXPECT_TPDO("11 94 00 00 00 00 00 00");
+    h_rx(d, 0x000, "82 7F"); /* reset communication: PARA 0x1000.. only */
+    h_rx(d, 0x000, "01 7F");
+    h_drain(d);
+    EXPECT_TPDO("11 94 00 00 00 00 00 00");
+    SAVE();
+    h_power_cycle(d);
+    EXPECT(d, 0x77F, "00");
+    operational_settled();
+    EXPECT_TPDO("11 94 00 00 00 00 00 00");
+    SDO(d, "2F 01 50 00 01 00 00 00", "60 01 50 00 00 00 00 00");
+    EXPECT_TPDO("94 11 00 00 00 00 00 00");
+}
+
 static void test_derived_preset_and_diff(void)
 {
     boot(M->xy30);
@@ -615,6 +640,7 @@ int main(void)
     }
     M = &x730;
     RUN(test_derived_pdo_coding); /* D19: X730 only */
+    RUN(test_pdo_coding_is_tpdo1s);
     RUN(test_x730_own_vectors);
     M = &x710;
     RUN(test_x710_own_vectors);

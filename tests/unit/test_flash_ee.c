@@ -101,12 +101,6 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
     return true;
 }
 
-uint32_t co_port_nvm_size(void *port)
-{
-    (void)port;
-    return flash_ee_size(ee);
-}
-
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {
     (void)port;
@@ -136,7 +130,7 @@ static uint32_t sdo(const char *hex)
 {
     co_frame_t f = {.id = 0x67F, .dlc = 8};
     h_hex(hex, f.data, 8);
-    co_node_receive(node, &f);
+    co_node_receive(node, &f, 0);
     return last_tx.data[0] == 0x80u ? co_get_u32(&last_tx.data[4]) : 0u;
 }
 

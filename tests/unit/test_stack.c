@@ -531,6 +531,62 @@ static void test_tpdo_sync_and_bad_mapping(void)
     SDO(d, "40 05 10 00 00 00 00 00", "43 05 10 00 81 00 00 00");
 }
 
+/* co_tpdo_reconfig() of a TPDO this build has no room for (a product's
+ * index past CO_TPDO_MAX): a broken contract, reported by CO_CHECK, and
+ * nothing written (before the check it cleared the bytes after tpdo[]). */
+static void test_tpdo_reconfig_out_of_range(void)
+{
+    boot();
+    h_rx(d, 0x000, "01 10");
+    SDO(d, "2F 00 18 02 01 00 00 00", "60 00 18 02 00 00 00 00"); /* TPDO1 at every SYNC */
+    h_drain(d);
+    co_node_t *n = d->nodes[0];
+    static co_node_t before;
+    memcpy(&before, n, sizeof(before));
+    unsigned seen = h_asserts;
+    h_expect_assert(2);
+    co_tpdo_reconfig(n, CO_TPDO_MAX);
+    co_tpdo_reconfig(n, 0xFFFFFFFFu);
+    CHECK_EQ(h_asserts, seen + 2u);
+    CHECK(memcmp(&before, n, sizeof(before)) == 0);
+    /* TPDOs there are: no report; TPDO1 still sends at a SYNC. */
+    co_tpdo_reconfig(n, 0);
+    co_tpdo_reconfig(n, CO_TPDO_MAX - 1u);
+    CHECK_EQ(h_asserts, seen + 2u);
+    h_drain(d);
+    h_rx(d, 0x080, "");
+    const co_frame_t *f = h_next(d);
+    CHECK(f != NULL && f->id == 0x190);
+}
+
+/* The contract's setters (co_node.h): node-ID, bit rate and automatic
+ * start only from the reset hook; a TPDO's byte order, a store status and
+ * a corrupt mark only for what exists. Anything else: a CO_CHECK report, nothing changed. */
+static void test_contract_broken_changes_nothing(void)
+{
+    boot();
+    co_node_t *n = d->nodes[0];
+    static co_node_t before;
+    memcpy(&before, n, sizeof(before));
+    unsigned seen = h_asserts;
+    h_expect_assert(7);
+    co_node_set_id(n, 0x20);        /* pre-operational: not in a reset */
+    co_node_set_bitrate(n, 1);
+    co_node_set_autostart(n, true);
+    co_tpdo_set_msb_first(n, CO_TPDO_MAX, true);
+    CHECK_EQ(co_node_store_status(n, CO_CLS_VOL), CO_STORE_BLANK);
+    CHECK_EQ(co_node_store_status(n, CO_CLS_COUNT), CO_STORE_BLANK);
+    co_store_mark_corrupt(n, CO_CLS_COUNT);
+    CHECK_EQ(h_asserts, seen + 7u);
+    CHECK(memcmp(&before, n, sizeof(before)) == 0);
+    CHECK_EQ(co_node_id(n), 0x10);
+    CHECK_EQ(co_node_nmt_state(n), CO_NMT_PREOP);
+    /* What exists: no report. */
+    CHECK_EQ(co_node_store_status(n, CO_CLS_PARA), CO_STORE_BLANK); /* a fresh EEPROM */
+    co_tpdo_set_msb_first(n, CO_TPDO_MAX - 1u, false);
+    CHECK_EQ(h_asserts, seen + 7u);
+}
+
 static void test_emcy(void)
 {
     boot();
@@ -734,7 +790,10 @@ static void test_tpdo_events_and_inhibit(void)
     CHECK(h_next(d) != NULL);
     EXPECT_NONE(d); /* the two events went out as one */
     CHECK(d->now - t0 >= 100000);
-    co_tpdo_event(d->node, 5); /* no such TPDO: ignored */
+    unsigned seen = h_asserts;
+    h_expect_assert(1);
+    co_tpdo_event(d->node, 5); /* no such TPDO: ignored (a broken contract, CO_CHECK) */
+    CHECK_EQ(h_asserts, seen + 1u);
 }
 
 /*
@@ -1015,6 +1074,8 @@ int main(void)
     RUN(test_heartbeat_timing);
     RUN(test_tpdo_event_and_inhibit);
     RUN(test_tpdo_sync_and_bad_mapping);
+    RUN(test_tpdo_reconfig_out_of_range);
+    RUN(test_contract_broken_changes_nothing);
     RUN(test_emcy);
     RUN(test_tx_full_is_counted);
     RUN(test_two_nodes_one_process);
