@@ -250,7 +250,8 @@ typedef struct co_incl {
  * output stops there and co_incl_beyond() reports beyond it (0: no
  * limit); wrap: a full-turn sensor, angles wrap at +-180 deg (no limit).
  * p is owned by the caller and must outlive incl; incl is the caller's
- * too (no heap). Cannot fail.
+ * too (no heap). axes above CO_INCL_AXES break the contract: CO_CHECK
+ * fails and CO_INCL_AXES are set up (0 axes: every output reads 0).
  */
 void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limit_mdeg, bool wrap);
 

@@ -20,6 +20,9 @@ int32_t co_div_round(int32_t a, int32_t b)
 
 void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limit_mdeg, bool wrap)
 {
+    if (!CO_CHECK(axes <= CO_INCL_AXES)) {
+        axes = CO_INCL_AXES;
+    }
     memset(incl, 0, sizeof(*incl));
     incl->p = p;
     incl->axes = axes;

@@ -271,6 +271,17 @@ static void test_incl_axis_bounds(void)
     CHECK_EQ(r, 0);
     CHECK_EQ(h_asserts, reports + 4u);
     CHECK_EQ(co_incl_slope(&in, 0), 1234); /* the device's axis as before */
+    /* More axes than the arrays hold: CO_INCL_AXES set up, samples and
+     * reads stay inside them. */
+    volatile uint8_t three = 3;
+    h_expect_assert(1);
+    co_incl_init(&in, &p, three, 0, false);
+    CHECK_EQ(h_asserts, reports + 5u);
+    CHECK_EQ(in.axes, CO_INCL_AXES);
+    int32_t b[CO_INCL_AXES] = {10000, -20000};
+    co_incl_sample(&in, b);
+    CHECK_EQ(in.angle[1], -20000);
+    CHECK_EQ(co_incl_slope(&in, 1), -2000 + 55); /* the offset of the preset above */
 }
 
 /* Two axes, circular outputs (0..359.9 deg), the filter on: each axis keeps
