@@ -1,7 +1,8 @@
 /*
  * dst.h - the Danfoss DST inclinometer family: DST X730 and DST X710.
- * Behaviour shared by the family lives in dst.c; each model's dictionary
- * table in its own file (dst_x730.c, dst_x710.c).
+ * Behaviour shared by the family lives in dst.c; the two models'
+ * dictionaries, one list with the X710's differences marked, in
+ * dst_tables.c.
  */
 #ifndef DST_H
 #define DST_H

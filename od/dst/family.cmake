@@ -3,7 +3,7 @@
 co_family(dst
   HEADER dst.h
   INSTANCE dst_dev_t
-  SOURCES dst.c dst_x730.c dst_x710.c
+  SOURCES dst.c dst_tables.c
   TESTS test_dst_manual
   PRODUCTS
     # ID             product symbol  MCU image's fixed config

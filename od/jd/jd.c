@@ -1,14 +1,17 @@
 /*
  * jd.c - behaviour of the ifm JD1xxx / JD2xxx (shared/specs/ifm-jd.md).
  * Integer arithmetic only (the target MCUs have no FPU).
+ * The CiA 410 arithmetic (slopes, presets, wrap, measured angles) is the
+ * shared module's (co_incl.h); here is what the JD's objects and manual
+ * add: a 16- and a 32-bit slope object per axis with one preset (R56),
+ * the JD1's unsigned 16-bit preset, the ranges, the rescale of 0x6000
+ * (R55), the moving average (R59), the fold at +-90 deg (R49).
  */
 #include "jd.h"
 
 #include <string.h>
 
-#include "co_incl.h"
-
-#define TURN 360000 /* mdeg */
+#define TURN CO_INCL_TURN_MDEG
 
 static jd_dev_t *dev_of(co_node_t *n)
 {
@@ -24,21 +27,10 @@ static const int16_t sin_q[91] = {
     899, 906, 914, 921, 927, 934, 940, 946, 951, 956, 961, 966, 970, 974, 978, 982,
     985, 988, 990, 993, 995, 996, 998, 999, 999, 1000, 1000};
 
-static int32_t wrap180(int32_t a)
-{
-    a %= TURN;
-    if (a >= TURN / 2) {
-        a -= TURN;
-    } else if (a < -TURN / 2) {
-        a += TURN;
-    }
-    return a;
-}
-
 /* sin of an angle in mdeg, x 1000, linear between whole degrees. */
 static int32_t isin(int32_t mdeg)
 {
-    int32_t a = wrap180(mdeg);
+    int32_t a = co_incl_wrap180(mdeg);
     int32_t sign = a < 0 ? -1 : 1;
     a = a < 0 ? -a : a;
     if (a > 90000) {
@@ -51,74 +43,22 @@ static int32_t isin(int32_t mdeg)
     return sign * (lo + (hi - lo) * f / 1000);
 }
 
-/* Non-negative a mod m (m > 0). Within one turn either side, which is
- * where a slope's terms are (normalised offsets, a measured angle of
- * 0..N), without a division: the JD1's slope read (every PDO) divided
- * three times before. */
-static int32_t mod_pos(int32_t a, int32_t m)
+/* The angles in resolution units and one turn in them at the present
+ * 0x6000 (co_incl_meas_t: divided once per sample and once per change of
+ * 0x6000, never per read; with a division per read a SYNC with both JD2
+ * TPDOs spent half its time in the division helper, issue 11). */
+CO_INCL_INLINE const co_incl_meas_t *meas(jd_dev_t *d)
 {
-    if (a >= -m && a < m) {
-        return a < 0 ? a + m : a;
-    }
-    int32_t r = a % m;
-    return r < 0 ? r + m : r;
+    return co_incl_meas_at(&d->meas, d->raw, d->para.resolution);
 }
 
-/* The angles in resolution units and one turn in them: divided once per
- * sample (jd_sample) and once per change of 0x6000, never per read. A
- * SYNC with both JD2 TPDOs read four slopes and divided four times: 1,284
- * of its 2,465 instructions on the Cortex-M0 went to the division helper;
- * with the division here the SYNC took 1,117 (issue 11).
- * The resolution the figures hold is kept with them: 0x6000 reaches the
- * parameters through its hook, a restore and a load alike, so a read
- * compares rather than relies on every writer telling us. */
-static void remeasure(jd_dev_t *d)
+/* How the slope objects hold their values (co_incl_fit_t): JD1 modulo a
+ * turn, 0..N-1, its offsets in (-N/2, N/2] (R54, R56); JD2 saturated to
+ * the object's type, never wrapped (R53). */
+CO_INCL_INLINE co_incl_fit_t fit(jd_dev_t *d, const co_incl_meas_t *c, bool wide)
 {
-    int32_t res = (int32_t)d->para.resolution;
-    d->meas_res = d->para.resolution;
-    d->meas_turn = TURN / res;
-    for (unsigned a = 0; a < 2u; a++) {
-        d->meas[a] = co_div_round(d->raw[a], res); /* rounded (R57) */
-    }
-}
-
-/* One turn in resolution units (JD1 wrap). */
-static int32_t turn_lsb(jd_dev_t *d)
-{
-    if (d->meas_res != d->para.resolution) {
-        remeasure(d);
-    }
-    return d->meas_turn;
-}
-
-/* Physical angle in resolution units, rounded (R57). */
-static int32_t measure(jd_dev_t *d, unsigned axis)
-{
-    if (d->meas_res != d->para.resolution) {
-        remeasure(d);
-    }
-    return d->meas[axis];
-}
-
-/* JD1 offsets live in (-N/2, N/2] (R54). */
-static int32_t norm_offset(jd_dev_t *d, int32_t off)
-{
-    if (d->axes != 1u) {
-        return off;
-    }
-    int32_t n = turn_lsb(d);
-    int32_t r = mod_pos(off, n);
-    return r > n / 2 ? r - n : r;
-}
-
-static int32_t clamp16(int32_t v)
-{
-    return v > INT16_MAX ? INT16_MAX : (v < INT16_MIN ? INT16_MIN : v);
-}
-
-static int32_t clamp32(int64_t v)
-{
-    return v > INT32_MAX ? INT32_MAX : (v < INT32_MIN ? INT32_MIN : (int32_t)v);
+    co_incl_fit_t f = {.turn = d->axes == 1u ? c->turn : 0, .wide = wide, .centred = true};
+    return f;
 }
 
 /* The largest differential offset, in resolution units: JD1 (-N/2, N/2]
@@ -127,54 +67,48 @@ static int32_t clamp32(int64_t v)
 static bool diff_ok(jd_dev_t *d, int32_t v)
 {
     if (d->axes == 1u) {
-        int32_t half = turn_lsb(d) / 2;
+        int32_t half = meas(d)->turn / 2;
         return v > -half && v <= half;
     }
     int32_t lim = 90000 / (int32_t)d->para.resolution;
     return v >= -lim && v <= lim;
 }
 
-/* The slope of one axis, 16- or 32-bit flavour (R51, R53, R54, R56). */
-static int32_t slope(jd_dev_t *d, unsigned axis, bool wide)
+/* The slope of one axis, 16- or 32-bit object (R51, R53, R54, R56): each
+ * has its own operating parameter, offset and differential offset; c is
+ * meas(d). */
+CO_INCL_INLINE int32_t slope(jd_dev_t *d, const co_incl_meas_t *c, unsigned axis, bool wide)
 {
     if (axis >= d->axes) {
         return 0; /* JD1: 6020h / 6120h read 0 (L1671) */
     }
+    int32_t m = c->m[axis];
+    co_incl_fit_t f = fit(d, c, wide);
     const jd_para_t *p = &d->para;
     uint8_t op = wide ? p->op32[axis] : p->op16[axis];
-    int32_t v = measure(d, axis);
-    if ((op & CO_INCL_OP_INVERT) != 0u) {
-        v = -v;
+    if ((op & CO_INCL_OP_SCALING) == 0u) {
+        /* co_incl_output does not read the offsets then: not loaded
+         * either (gcc loads arguments first): the JD2 SYNC of tools/bench
+         * took 843 Cortex-M0 instructions with the loads, 799 without. */
+        return co_incl_output(m, op, 0, 0, f);
     }
-    int32_t off = 0;
-    int32_t diff = 0;
-    if ((op & CO_INCL_OP_SCALING) != 0u) {
-        off = wide ? p->off32[axis] : p->off16[axis];
-        diff = wide ? p->diff32[axis] : p->diff16[axis];
+    if (wide) {
+        return co_incl_output(m, op, p->off32[axis], p->diff32[axis], f);
     }
-    if (d->axes == 1u) {
-        /* 0..N-1: each term reduced first, so the sum never overflows
-         * whatever a stored offset holds (N <= 36000). */
-        int32_t n = turn_lsb(d);
-        int32_t sum = mod_pos(v, n) + mod_pos(off, n) + mod_pos(diff, n);
-        while (sum >= n) { /* below 3N: at most two passes, no division */
-            sum -= n;
-        }
-        return sum;
-    }
-    /* Saturated, never wrapped: the output stops at the type's end (R53:
-     * "clamp only to the data type's range"). */
-    int32_t sum = clamp32((int64_t)v + off + diff);
-    return wide ? sum : clamp16(sum);
+    return co_incl_output(m, op, p->off16[axis], p->diff16[axis], f);
 }
 
 /* ---- dictionary hooks ------------------------------------------------ */
 
 co_res_t jd_read_slope(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
 {
+    jd_dev_t *d = dev_of(n);
+    /* The angles first, while little is live across the rare remeasure
+     * (the JD2 SYNC of tools/bench: 851 -> 843 Cortex-M0 instructions). */
+    const co_incl_meas_t *c = meas(d);
     unsigned axis = (e->index & 0x00F0u) == 0x0020u ? 1u : 0u;
     bool wide = (e->index & 0x0100u) != 0u;
-    *v = (uint32_t)slope(dev_of(n), axis, wide);
+    *v = (uint32_t)slope(d, c, axis, wide);
     return CO_OK;
 }
 
@@ -196,7 +130,7 @@ co_res_t jd_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
         if (e->size == 2u) {
             p = (int32_t)(uint16_t)v; /* 0..N-1, an unsigned bit pattern (2600h) */
         }
-        if (p < 0 || p >= turn_lsb(d)) {
+        if (p < 0 || p >= meas(d)->turn) {
             return CO_E_VAL;
         }
     } else if (p < -lim || p > lim) {
@@ -205,12 +139,13 @@ co_res_t jd_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     if (co_od_checking(n)) {
         return CO_OK;
     }
-    int32_t m = measure(d, axis);
-    int32_t m16 = (d->para.op16[axis] & CO_INCL_OP_INVERT) != 0u ? -m : m;
-    int32_t m32 = (d->para.op32[axis] & CO_INCL_OP_INVERT) != 0u ? -m : m;
+    /* One preset, an offset per object: P - s*m with the object's own
+     * sign (R52, R56); the differential offset stays out of it. */
+    const co_incl_meas_t *c = meas(d);
     d->para.preset[axis] = p;
-    d->para.off16[axis] = (int16_t)clamp16(norm_offset(d, p - m16));
-    d->para.off32[axis] = norm_offset(d, p - m32);
+    d->para.off16[axis] =
+        (int16_t)co_incl_preset_offset(p, c->m[axis], d->para.op16[axis], 0, fit(d, c, false));
+    d->para.off32[axis] = co_incl_preset_offset(p, c->m[axis], d->para.op32[axis], 0, fit(d, c, true));
     return CO_OK;
 }
 
@@ -233,7 +168,7 @@ static int32_t rescale(int32_t v, int32_t old, int32_t now)
         return co_div_round(v, now / old); /* any v: see co_div_round */
     }
     int32_t k = old / now;
-    return clamp32((int64_t)v * k);
+    return co_incl_saturate((int64_t)v * k, true);
 }
 
 co_res_t jd_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
@@ -251,9 +186,9 @@ co_res_t jd_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     /* Every preset and offset follows into the new unit (R55). */
     for (unsigned a = 0; a < 2u; a++) {
         p->preset[a] = rescale(p->preset[a], old, now);
-        p->off16[a] = (int16_t)clamp16(rescale(p->off16[a], old, now));
+        p->off16[a] = (int16_t)co_incl_saturate(rescale(p->off16[a], old, now), false);
         p->off32[a] = rescale(p->off32[a], old, now);
-        p->diff16[a] = (int16_t)clamp16(rescale(p->diff16[a], old, now));
+        p->diff16[a] = (int16_t)co_incl_saturate(rescale(p->diff16[a], old, now), false);
         p->diff32[a] = rescale(p->diff32[a], old, now);
     }
     p->resolution = (uint16_t)v;
@@ -423,7 +358,7 @@ void jd_sample(void *mem, const int32_t values[], uint32_t faults)
     jd_dev_t *d = mem;
     int32_t in[2] = {0, 0};
     for (unsigned a = 0; a < d->axes; a++) {
-        int32_t t = wrap180(values[a]);
+        int32_t t = co_incl_wrap180(values[a]);
         if (d->axes == 2u) {
             /* +-90 deg, folded back beyond: the output of a gravity sensor (R49). */
             if (t > 90000) {
@@ -432,7 +367,7 @@ void jd_sample(void *mem, const int32_t values[], uint32_t faults)
                 t = -180000 - t;
             }
         } else {
-            t = mod_pos(t, TURN);
+            t = co_incl_mod(t, TURN);
             /* Average across 0/360 on the side of the last value. */
             if (d->maf_fill > 0u && t - d->raw[0] > TURN / 2) {
                 t -= TURN;
@@ -449,7 +384,7 @@ void jd_sample(void *mem, const int32_t values[], uint32_t faults)
          * raw[0]'s frame (else a turn's worth of offset enters the mean and
          * sticks: 1 deg read as 271 after crossing 0). Inputs then stay
          * within half a turn of [0, 360): the sum is bounded. */
-        int32_t shift = d->raw[0] - mod_pos(d->raw[0], TURN);
+        int32_t shift = d->raw[0] - co_incl_mod(d->raw[0], TURN);
         if (shift != 0) {
             for (unsigned i = 0; i < d->maf_fill; i++) {
                 d->maf_buf[0][i] -= shift;
@@ -460,16 +395,13 @@ void jd_sample(void *mem, const int32_t values[], uint32_t faults)
     }
     /* A board samples once before the node's first reset loads the
      * parameters (resolution 0 then): the first read after it computes. */
-    d->meas_res = 0;
-    if (d->para.resolution != 0u) {
-        remeasure(d);
-    }
+    co_incl_remeasure(&d->meas, d->raw, d->para.resolution);
     /* Rates (0.1 deg/s) from the 5 ms sample period, accelerations (mg). */
     int32_t x = values[0];
     int32_t y = d->axes == 2u ? values[1] : 0;
     for (unsigned a = 0; a < 2u; a++) {
         int32_t now = a == 0u ? x : y;
-        int32_t rate = wrap180(now - d->prev[a]) * 2; /* mdeg per 5 ms -> 0.1 deg/s */
+        int32_t rate = co_incl_wrap180(now - d->prev[a]) * 2; /* mdeg per 5 ms -> 0.1 deg/s */
         rate = rate > 5000 ? 5000 : (rate < -5000 ? -5000 : rate);
         d->prev[a] = now;
         if (d->axes == 2u) {

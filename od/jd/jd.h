@@ -6,6 +6,7 @@
 #ifndef JD_H
 #define JD_H
 
+#include "co_incl.h"
 #include "co_node.h"
 #include "product.h"
 
@@ -52,9 +53,7 @@ typedef struct jd_dev {
     jd_para_t para;
     uint8_t axes;             /* 1: JD1 (Z, 0..360), 2: JD2 (X, Y, +-90) */
     int32_t raw[2];           /* physical angle after the MAF, mdeg */
-    int32_t meas[2];          /* raw in resolution units (jd.c remeasure) */
-    int32_t meas_turn;        /* one turn in resolution units */
-    uint16_t meas_res;        /* the resolution meas holds; 0: none yet */
+    co_incl_meas_t meas;      /* raw in resolution units, one turn in them */
     int32_t prev[2];          /* previous sample, for the gyro rates */
     int16_t gyro[3];          /* 0x3400.. 0.1 deg/s */
     int16_t accel[3];         /* 0x3403.. mg */

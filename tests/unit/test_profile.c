@@ -95,7 +95,10 @@ static void test_incl_arithmetic(void)
     /* No such axis. Through a volatile: with a constant 5, gcc's array-bounds
      * check sees the out[] access the axes test keeps it from reaching. */
     volatile unsigned no_axis = 5;
+    unsigned reports = h_asserts;
+    h_expect_assert(1); /* past CO_INCL_AXES: a broken contract, reported */
     CHECK_EQ(co_incl_slope(&in, no_axis), 0);
+    CHECK_EQ(h_asserts, reports + 1u);
     /* Same resolution: offsets kept. New one: cleared. */
     p.diff[0] = 7;
     CHECK_EQ(co_incl_set_resolution(&in, 50), CO_OK);
@@ -134,6 +137,189 @@ static void test_incl_wrap(void)
         co_incl_sample(&in, a);
     }
     CHECK_EQ(co_incl_slope(&in, 0), -18000);
+}
+
+/* The arithmetic of one output, as a product with its own objects uses it
+ * (the ifm JD's 16- and 32-bit slopes): each fit of co_incl_fit_t. */
+static void test_incl_output_fits(void)
+{
+    const uint8_t sc = CO_INCL_OP_SCALING;
+    const uint8_t inv = CO_INCL_OP_INVERT;
+    co_incl_fit_t i16 = {.turn = 0, .wide = false, .centred = false};
+    co_incl_fit_t i32 = {.turn = 0, .wide = true, .centred = false};
+    /* Linear: s*m, + offsets with the scaling bit, saturated to the type. */
+    CHECK_EQ(co_incl_output(1234, 0, 100, 10, i16), 1234); /* offsets not read */
+    CHECK_EQ(co_incl_output(1234, sc, 100, 10, i16), 1344);
+    CHECK_EQ(co_incl_output(1234, sc | inv, 100, 10, i16), -1124);
+    CHECK_EQ(co_incl_output(30000, sc, 2000, 1000, i16), 32767);
+    CHECK_EQ(co_incl_output(30000, sc, 2000, 1000, i32), 33000);
+    CHECK_EQ(co_incl_output(-30000, sc, -2000, -1000, i16), -32768);
+    CHECK_EQ(co_incl_output(1, sc, INT32_MAX, INT32_MAX, i32), INT32_MAX); /* exact sum, saturated */
+    CHECK_EQ(co_incl_output(-1, sc, INT32_MIN, INT32_MIN, i32), INT32_MIN);
+    CHECK_EQ(co_incl_output(5, sc, INT32_MAX, INT32_MIN, i32), 4);
+    /* Circular: modulo the turn, 0..turn-1, whatever the offsets hold. */
+    co_incl_fit_t c = {.turn = 36000, .wide = false, .centred = false};
+    CHECK_EQ(co_incl_output(35999, 0, 0, 0, c), 35999);
+    CHECK_EQ(co_incl_output(36000, 0, 0, 0, c), 0);
+    CHECK_EQ(co_incl_output(1000, inv, 0, 0, c), 35000);
+    CHECK_EQ(co_incl_output(0, inv, 0, 0, c), 0);
+    CHECK_EQ(co_incl_output(35000, sc, 2000, -500, c), 500);
+    CHECK_EQ(co_incl_output(1000, sc, INT32_MAX, INT32_MAX, c), 24294); /* 1000 + 2 x 11647 */
+    CHECK_EQ(co_incl_output(1000, sc, INT32_MIN, 0, c), 25352); /* -2^31 mod 36000 = 24352 */
+    /* The preset's offset: preset - s*m - diff, fitted the same way. */
+    CHECK_EQ(co_incl_preset_offset(100, 1234, 0, 0, i16), -1134);
+    CHECK_EQ(co_incl_preset_offset(100, 1234, inv, 0, i16), 1334);
+    CHECK_EQ(co_incl_preset_offset(100, 1234, 0, 50, i16), -1184);
+    CHECK_EQ(co_incl_preset_offset(-32000, 2000, 0, 0, i16), -32768);
+    CHECK_EQ(co_incl_preset_offset(-32000, 2000, 0, 0, i32), -34000);
+    CHECK_EQ(co_incl_preset_offset(INT32_MIN, 1, 0, 0, i32), INT32_MIN);
+    CHECK_EQ(co_incl_preset_offset(100, 1000, 0, 0, c), 35100); /* [0, turn) */
+    co_incl_fit_t cc = {.turn = 36000, .wide = false, .centred = true};
+    CHECK_EQ(co_incl_preset_offset(100, 1000, 0, 0, cc), -900); /* (-turn/2, turn/2] */
+    CHECK_EQ(co_incl_preset_offset(18000, 0, 0, 0, cc), 18000);
+    CHECK_EQ(co_incl_preset_offset(18001, 0, 0, 0, cc), -17999);
+    CHECK_EQ(co_incl_preset_offset(100, 1000, inv, 0, cc), 1100);
+    /* The output then reads the preset (+ a differential offset left out). */
+    int32_t off = co_incl_preset_offset(100, 1000, inv, 0, cc);
+    CHECK_EQ(co_incl_output(1000, sc | inv, off, 0, cc), 100);
+    CHECK_EQ(co_incl_output(1000, sc | inv, off, 7, cc), 107);
+    off = co_incl_preset_offset(250, 1000, 0, 7, c);
+    CHECK_EQ(co_incl_output(1000, sc, off, 7, c), 250);
+    /* Angles: +-180 deg window, non-negative modulo. */
+    CHECK_EQ(co_incl_wrap180(180000), -180000);
+    CHECK_EQ(co_incl_wrap180(-180001), 179999);
+    CHECK_EQ(co_incl_wrap180(3600000 + 90000), 90000);
+    CHECK_EQ(co_incl_wrap180(-7200000 - 90000), -90000);
+    CHECK_EQ(co_incl_mod(-1, 360), 359);
+    CHECK_EQ(co_incl_mod(720, 360), 0);
+    CHECK_EQ(co_incl_mod(-1081, 360), 359);
+    CHECK_EQ(co_incl_mod(INT32_MIN, 36000), 24352);
+    /* A modulus or divisor of 0 or less: a broken contract, 0. Through a
+     * volatile, so that the compiler sees no constant division by 0. */
+    volatile int32_t zero = 0;
+    unsigned reports = h_asserts;
+    h_expect_assert(3);
+    CHECK_EQ(co_incl_mod(7, zero), 0);
+    CHECK_EQ(co_incl_mod(7, zero - 360), 0);
+    CHECK_EQ(co_div_round(7, zero), 0);
+    CHECK_EQ(h_asserts, reports + 3u);
+}
+
+/* Measured angles: divided when the resolution changes, not per read. */
+static void test_incl_meas(void)
+{
+    co_incl_meas_t c;
+    memset(&c, 0, sizeof(c));
+    int32_t raw[CO_INCL_AXES] = {12345, -12345};
+    const co_incl_meas_t *r = co_incl_meas_at(&c, raw, 0); /* no parameters yet */
+    CHECK_EQ(r->m[0], 0);
+    CHECK_EQ(r->turn, 0);
+    r = co_incl_meas_at(&c, raw, 10);
+    CHECK_EQ(r->m[0], 1235); /* half away from zero */
+    CHECK_EQ(r->m[1], -1235);
+    CHECK_EQ(r->turn, 36000);
+    raw[0] = 99999; /* the same resolution: the figures it holds */
+    CHECK_EQ(co_incl_meas_at(&c, raw, 10)->m[0], 1235);
+    CHECK_EQ(co_incl_meas_at(&c, raw, 1000)->m[0], 100);
+    CHECK_EQ(c.turn, 360);
+    co_incl_remeasure(&c, raw, 0);
+    CHECK_EQ(c.m[0], 0);
+    CHECK_EQ(c.m[1], 0);
+    CHECK_EQ(c.res, 0);
+}
+
+/* An axis from the product: the device's axes read, a lateral axis a
+ * single-axis device lacks reads 0 (its objects are in the family's
+ * table), one past CO_INCL_AXES is a broken contract (CO_CHECK) that
+ * leaves everything as it was. */
+static void test_incl_axis_bounds(void)
+{
+    co_incl_para_t p = {.resolution = 10, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
+    co_incl_t in;
+    co_incl_init(&in, &p, 1, 0, false);
+    int32_t a[2] = {12340, 5000};
+    co_incl_sample(&in, a);
+    volatile unsigned lateral = 1; /* volatile: as test_incl_arithmetic */
+    volatile unsigned past = CO_INCL_AXES;
+    unsigned reports = h_asserts;
+    CHECK_EQ(co_incl_refresh_slope(&in, 0), 1234);
+    CHECK_EQ(co_incl_refresh_slope(&in, lateral), 0);
+    uint32_t v = 7;
+    CHECK_EQ(co_incl_refresh_read(&in, lateral, &v), CO_OK);
+    CHECK_EQ(v, 0);
+    co_incl_set_preset(&in, lateral, 55); /* stored, from a measured 0 */
+    CHECK_EQ(p.preset[1], 55);
+    CHECK_EQ(p.offset[1], 55);
+    CHECK_EQ(h_asserts, reports); /* none of these is a broken contract */
+
+    co_incl_para_t before = p;
+    h_expect_assert(1);
+    CHECK_EQ(co_incl_refresh_slope(&in, past), 0);
+    CHECK_EQ(h_asserts, reports + 1u);
+    h_expect_assert(1);
+    v = 7;
+    CHECK_EQ(co_incl_refresh_read(&in, past + 3u, &v), CO_OK);
+    CHECK_EQ(v, 0);
+    CHECK_EQ(h_asserts, reports + 2u);
+    h_expect_assert(1);
+    co_incl_set_preset(&in, past, 99);
+    CHECK_EQ(h_asserts, reports + 3u);
+    CHECK(memcmp(&before, &p, sizeof(p)) == 0); /* nothing written */
+    h_expect_assert(1);
+    uint32_t r = 7;
+    CHECK_EQ(co_incl_read(&in, past, &r), CO_OK);
+    CHECK_EQ(r, 0);
+    CHECK_EQ(h_asserts, reports + 4u);
+    CHECK_EQ(co_incl_slope(&in, 0), 1234); /* the device's axis as before */
+    /* More axes than the arrays hold: CO_INCL_AXES set up, samples and
+     * reads stay inside them. */
+    volatile uint8_t three = 3;
+    h_expect_assert(1);
+    co_incl_init(&in, &p, three, 0, false);
+    CHECK_EQ(h_asserts, reports + 5u);
+    CHECK_EQ(in.axes, CO_INCL_AXES);
+    int32_t b[CO_INCL_AXES] = {10000, -20000};
+    co_incl_sample(&in, b);
+    CHECK_EQ(in.angle[1], -20000);
+    CHECK_EQ(co_incl_slope(&in, 1), -2000 + 55); /* the offset of the preset above */
+}
+
+/* Two axes, circular outputs (0..359.9 deg), the filter on: each axis keeps
+ * its own continuous angle. With one value shared by both, the second axis
+ * was unwrapped against the first one's input (170 / -100 deg in gave
+ * 171.4 / 79.3 deg out; issue 12). */
+static void test_incl_two_axes_circular(void)
+{
+    co_incl_para_t p = {.resolution = 100, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
+    co_incl_t in;
+    co_incl_init(&in, &p, 2, 0, true);
+    in.circular = true;
+    in.shift = co_filter_shift(0); /* slow */
+    int32_t a[2] = {170000, -100000};
+    for (int i = 0; i < 2000; i++) { /* 10 s: settled whatever the filter */
+        co_incl_sample(&in, a);
+    }
+    CHECK_EQ(co_incl_slope(&in, 0), 1700);
+    CHECK_EQ(co_incl_slope(&in, 1), 2600); /* -100 deg = 260 deg */
+    /* Each axis crosses +-180 by the short way, on its own: X from 170 to
+     * -170 (190 deg), Y stays; Y's output never moves. */
+    a[0] = -170000;
+    int16_t y_lo = 32767;
+    int16_t y_hi = -32768;
+    int16_t x_far = 0; /* largest distance of X from 180 deg on the way */
+    for (int i = 0; i < 2000; i++) {
+        co_incl_sample(&in, a);
+        int16_t y = co_incl_slope(&in, 1);
+        y_lo = y < y_lo ? y : y_lo;
+        y_hi = y > y_hi ? y : y_hi;
+        int16_t dx = (int16_t)(co_incl_slope(&in, 0) - 1800);
+        dx = (int16_t)(dx < 0 ? -dx : dx);
+        x_far = dx > x_far ? dx : x_far;
+    }
+    CHECK_EQ(y_lo, 2600);
+    CHECK_EQ(y_hi, 2600);
+    CHECK(x_far <= 100); /* through 180, never back through 0 */
+    CHECK_EQ(co_incl_slope(&in, 0), 1900);
 }
 
 static void test_led_patterns(void)
@@ -176,6 +362,10 @@ int main(void)
     RUN(test_filter_through_the_device);
     RUN(test_incl_arithmetic);
     RUN(test_incl_wrap);
+    RUN(test_incl_output_fits);
+    RUN(test_incl_meas);
+    RUN(test_incl_axis_bounds);
+    RUN(test_incl_two_axes_circular);
     RUN(test_led_patterns);
     return h_finish();
 }
