@@ -19,7 +19,7 @@ BOARD_RAM = {"nucleo-f042k6": 6 * 1024,  # STM32F042K6
 
 
 ROOT = Path(__file__).resolve().parents[1]
-SOURCES = sorted(ROOT.glob("src/*.c")) + sorted(ROOT.glob("od/*.c")) + sorted(ROOT.glob("boards/**/*.c"))
+SOURCES = sorted(ROOT.glob("src/*.c")) + sorted(ROOT.glob("od/**/*.c")) + sorted(ROOT.glob("boards/**/*.c"))
 
 
 def origin_of(path):
