@@ -52,7 +52,8 @@
  *   call, calling no other module but filter
  * A protocol module reaches another only downwards (sync -> tpdo at a
  * SYNC, nmt -> tpdo at a state change, store -> emcy for 6300h, lss ->
- * store, guard asks hb through co_hb_period_ms()), and everything may call
+ * store, sdo -> nmt (SDO allowed in this state), guard and hbc -> nmt and
+ * emcy (their timeouts), guard asks hb through co_hb_period_ms()), and everything may call
  * back into the node (co_node_send, co_node_entry, co_node_reset, the NMT
  * state in node->nmt). The dictionary calls no protocol module: a write
  * hook of a product table (co_store_write_save, co_tpdo_write_comm, ...) is

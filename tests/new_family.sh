@@ -4,30 +4,54 @@
 # family "demo" from the template (od/skeleton); without any other edit
 # the host build then lists its product in the Linux program, builds and
 # passes its unit test (also with its fixed MCU config), and the Cortex-M0
-# build makes its firmware image. (ctest build.new_family)
+# build makes its firmware image. Then broken declarations must fail the
+# configure with a message naming the mistake. (ctest build.new_family)
 set -euo pipefail
 src=$(cd "$1" && pwd)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-# The tree as git sees it (tracked and new files, no build trees).
+# The tree as git sees it (tracked and new files), without any build tree
+# (a directory holding a CMakeCache.txt) a developer keeps in it.
+skip=$(cd "$src" && find . -name CMakeCache.txt -not -path './.git/*' -printf '%h\n' | sed 's#^\./##')
 git -C "$src" ls-files -z --cached --others --exclude-standard |
+  { if [ -n "$skip" ]; then grep -zv -F -f <(printf '%s/\n' $skip); else cat; fi; } |
   (cd "$src" && tar --null -T - -cf - 2>/dev/null) | tar -xf - -C "$tmp"
 cd "$tmp"
 tools/new-family demo
-cmake -S . -B b -G Ninja -DCO_SANITIZE=OFF >/dev/null
-ninja -C b canopen-sensor test_demo test_demo.demo_cfg >/dev/null
-b/bin/test_demo
-b/bin/test_demo.demo_cfg
-b/bin/canopen-sensor --list-products | tee list.txt
+cmake -S . -B .nf-host -G Ninja -DCO_SANITIZE=OFF >/dev/null
+ninja -C .nf-host canopen-sensor test_demo test_demo.demo_cfg >/dev/null
+.nf-host/bin/test_demo
+.nf-host/bin/test_demo.demo_cfg
+.nf-host/bin/canopen-sensor --list-products | tee list.txt
 grep -q '^demo-incl ' list.txt || { echo "FAIL: demo-incl not in --list-products" >&2; exit 1; }
 if grep -q '^skeleton-incl' list.txt; then
   echo "FAIL: the template is listed as a product" >&2; exit 1
 fi
-if command -v arm-none-eabi-gcc >/dev/null; then
-  cmake -S . -B m0 -G Ninja -DCMAKE_TOOLCHAIN_FILE=cmake/arm-none-eabi.cmake >/dev/null
-  ninja -C m0 fw-demo-incl.elf >/dev/null
-  arm-none-eabi-size m0/bin/fw-demo-incl.elf
-else
-  echo "FAIL: arm-none-eabi-gcc missing (tools/setup installs it)" >&2; exit 1
-fi
+command -v arm-none-eabi-gcc >/dev/null ||
+  { echo "FAIL: arm-none-eabi-gcc missing (tools/setup installs it)" >&2; exit 1; }
+cmake -S . -B .nf-m0 -G Ninja -DCMAKE_TOOLCHAIN_FILE=cmake/arm-none-eabi.cmake >/dev/null
+ninja -C .nf-m0 fw-demo-incl.elf >/dev/null
+arm-none-eabi-size .nf-m0/bin/fw-demo-incl.elf
+
+# Broken declarations: the configure fails and says what is wrong.
+decl=od/demo/family.cmake
+cp "$decl" good.cmake
+broken() { # what, expected message, sed script
+  sed -e "$3" good.cmake > "$decl"
+  if cmake -S . -B ".nf-bad" -G Ninja >bad.log 2>&1; then
+    echo "FAIL: $1 was accepted" >&2; exit 1
+  fi
+  grep -q "$2" bad.log || { echo "FAIL: $1: no '$2' in:" >&2; cat bad.log >&2; exit 1; }
+  echo "refused: $1"
+  rm -rf .nf-bad
+}
+broken "a product ID twice" "declared twice" 's/demo-incl /inx360d /'
+broken "SIZES for an unknown config" "which no PRODUCTS row" 's/^    demo_cfg CO_TPDO/    demo_cgf CO_TPDO/'
+broken "an unknown size switch" "is no size switch" 's/CO_SDO_BUF=4u/CO_SDO_BUFF=4u/'
+broken "a misspelt keyword" "needs TESTS" 's/^  TESTS /  TEST /'
+broken "a test that does not exist" "does not exist" 's/^  TESTS test_demo/  TESTS test_dmeo/'
+broken "a source that does not exist" "does not exist" 's/^  SOURCES demo.c/  SOURCES demo.c demo_tables.c/'
+broken "a family named unlike its folder" "must be named" 's/^co_family(demo/co_family(demo2/'
+broken "no declaration" "must declare its family" 's/^co_family(demo/set(x/;s/)$//'
+cp good.cmake "$decl"
 echo "new family: ok"

@@ -60,15 +60,16 @@ static uint32_t skel_poll(co_node_t *n, uint32_t now)
 
 static const co_node_ops_t skel_ops = {.poll = skel_poll};
 
+/* Build the instance: the node runs the product's own config (p->cfg), so
+ * that each product of a family may have its table. */
 static void skel_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
 {
-    (void)p;
     skel_dev_t *d = mem;
     memset(d, 0, sizeof(*d));
     co_incl_init(&d->incl, &d->para.incl, 1, 0, false);
     d->incl.shift = 0; /* no filter: one sample, one output */
     void *const ram[CO_CLS_COUNT] = {NULL, NULL, &d->para, NULL};
-    co_node_init(&d->node, &skel_cfg, ports[0], d, ram, 0);
+    co_node_init(&d->node, p->cfg, ports[0], d, ram, 0);
     nodes[0] = &d->node;
 }
 

@@ -433,12 +433,19 @@ def test_facts_cover_every_product():
     list know, and no other (so a new product cannot miss this suite)."""
     assert set(list_products()) == set(PRODUCTS)
     mcu = []
+    families = {}
     for path in (Path(__file__).resolve().parents[2] / "od").glob("*/family.cmake"):
         text = re.sub(r"#.*", "", path.read_text())  # the declaration, comments out
         if not re.search(r"\bEXAMPLE\b", text):   # templates ship no image
-            mcu += re.findall(r"^\s+([a-z0-9-]+)\s+[A-Za-z_]\w*\s+(?:[A-Za-z_]\w*|-)\)?\s*$",
-                              text, re.M)
+            ids = re.findall(r"^\s+([a-z0-9-]+)\s+[A-Za-z_]\w*\s+(?:[A-Za-z_]\w*|-)\)?\s*$",
+                             text, re.M)
+            families[path.parent.name] = set(ids)
+            mcu += ids
     assert len(mcu) == len(set(mcu))
     assert set(mcu) == set(PRODUCTS)
+    # Every family runs on every target in CI (a new one cannot be left out).
+    for target, ids in CI_PRODUCTS.items():
+        for family, members in families.items():
+            assert members & set(ids), f"no {family} product in CI_PRODUCTS[{target!r}]"
     for target, ids in CI_PRODUCTS.items():
         assert set(ids) <= set(PRODUCTS), target

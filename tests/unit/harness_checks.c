@@ -102,7 +102,9 @@ int h_finish(void)
 #define H_XSTR(x) H_STR(x)
     printf(", %d not applicable to the fixed config " H_XSTR(CO_FIXED_CFG), h_not_applicable);
     if (h_tests == 0) {
-        printf("\nno test applied to this config: wrong family tests for it?\n");
+        printf("\nno test booted a product of this config: every product row of a family "
+               "needs a test that boots it (the family's TESTS), and its create() must "
+               "start the node with the product's own config (p->cfg)\n");
         return 1;
     }
 #endif

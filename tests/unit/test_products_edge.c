@@ -22,6 +22,18 @@ static void test_registry(void)
     for (size_t i = 0; product_list[i] != NULL; i++) {
         CHECK(product_find(product_list[i]->id) == product_list[i]);
     }
+    /* Each product's own id is the ID its family's declaration gives its
+     * row (od/<family>/family.cmake, cmake/families.cmake checks that no
+     * ID is declared twice), in the registry's order. */
+    static const char *const ids[] = {PRODUCT_REGISTRY_IDS PRODUCT_REGISTRY_EXAMPLE_IDS};
+    size_t n = 0;
+    for (; product_list[n] != NULL; n++) {
+        CHECK(n < sizeof(ids) / sizeof(ids[0]) && strcmp(product_list[n]->id, ids[n]) == 0);
+        for (size_t j = 0; j < n; j++) {
+            CHECK(strcmp(product_list[j]->id, product_list[n]->id) != 0);
+        }
+    }
+    CHECK_EQ(n, sizeof(ids) / sizeof(ids[0]));
     CHECK(product_find("dst-x730") == NULL); /* a prefix is no ID */
     CHECK(product_find("") == NULL);
     CHECK(product_find("DST-X730-XY30") == NULL);
