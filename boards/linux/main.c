@@ -402,7 +402,7 @@ static int parse_options(int argc, char **argv, options_t *o)
         case 's': {
             char *end;
             errno = 0;
-            o->seed = strtoull(optarg, &end, 0);
+            o->seed = strtoull(optarg, &end, 10);
             if (end == optarg || *end != '\0' || errno != 0 || optarg[0] == '-') {
                 return USAGE_ERROR("--seed takes a number 0..2^64-1, not '%s'", optarg);
             }
