@@ -278,7 +278,7 @@ static bool motion_command(sim_t *s, const char *cmd, char **save, char *err, un
     int i = a != NULL ? input_index(s->prod, a, nlen) : -1;
     double lim = i >= 0 ? s->prod->inputs[i].limit : 0.0;
     int32_t now = i >= 0 ? motion_value(s, (unsigned)i, s->t_us) : 0;
-    if (cmd[0] == 'r') {
+    if (strcmp(cmd, "ramp") == 0) {
         int32_t to = 0;
         uint64_t dur = 0;
         if (i < 0 || eq == NULL || b == NULL || strcmp(b, "in") != 0 || c == NULL || extra) {
@@ -299,7 +299,7 @@ static bool motion_command(sim_t *s, const char *cmd, char **save, char *err, un
         s->motion[i].dur_us = dur;
         return true;
     }
-    if (cmd[0] == 's') {
+    if (strcmp(cmd, "sine") == 0) {
         const char *amp = keyed(b, "amp") != NULL ? keyed(b, "amp") : keyed(c, "amp");
         const char *per = keyed(b, "period") != NULL ? keyed(b, "period") : keyed(c, "period");
         int32_t am = 0;
@@ -327,6 +327,7 @@ static bool motion_command(sim_t *s, const char *cmd, char **save, char *err, un
         s->motion[i].dur_us = dur;
         return true;
     }
+    /* noise */
     const char *sd = keyed(b, "sd");
     int32_t v = 0;
     if (i < 0 || eq != NULL || sd == NULL || c != NULL) {
