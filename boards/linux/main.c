@@ -55,12 +55,23 @@ static void usage(FILE *f)
             "  --led-green LINE   the green (run) LED line (default 0) and\n"
             "  --led-red LINE     the red (error) LED line (default 1); without --led-chip\n"
             "                     LED changes are logged\n"
+            "  --seed N           seed of the simulated noise (default 1): the same\n"
+            "                     commands at the same times give the same values\n"
             "  --eds              print the product's EDS (CiA 306) and exit\n"
             "  --list-products    print every product ID with a description\n"
             "  --help             this text\n"
             "\n"
             "Standard input, one command a line (a bad line is rejected whole):\n"
             "  set NAME=VALUE ...         true value of the product's inputs (below)\n"
+            "  ramp NAME=VALUE in DUR     linear from the value now to VALUE over DUR\n"
+            "                             (e.g. 5s, 250ms), then held\n"
+            "  sine NAME amp=A period=DUR around the value now, starting there going up\n"
+            "  noise NAME sd=S            Gaussian noise (S in the input's unit) on top of\n"
+            "                             the motion; sd=0 stops it\n"
+            "  replay FILE.csv            header t,NAME,... then rows SECONDS,VALUE,...\n"
+            "                             from now: linear between rows, last row held\n"
+            "    set/ramp/sine/replay replace an input's motion, noise stays; values\n"
+            "    beyond an input's limit are refused, noise is saturated at it\n"
             "  fault NAME on|off          force one of the product's faults (below)\n"
             "  can bus-off [SECONDS]      the CAN controller goes bus-off: nothing sent; the\n"
             "                             bus stays unusable SECONDS (default 0), then it\n"
@@ -292,6 +303,7 @@ typedef struct options {
     int led_red;
     bool eds;
     bool quit_on_eof;
+    uint64_t seed; /* --seed: the simulator's noise */
     /* --iface split at its commas: one interface per node (the first one
      * for every node when one is given); ifn[] points into ifbuf. */
     char ifbuf[PRODUCT_MAX_NODES * IFNAMSIZ + 8];
@@ -355,12 +367,14 @@ static int parse_options(int argc, char **argv, options_t *o)
      * --on-eof run is for input that ends at once (/dev/null, a daemon, a
      * file of commands, tools/vcan-run). */
     o->quit_on_eof = true;
+    o->seed = SIM_SEED_DEFAULT;
     static const struct option opts[] = {
         {"product", required_argument, NULL, 'p'}, {"iface", required_argument, NULL, 'i'},
         {"nvm", required_argument, NULL, 'n'},     {"log", required_argument, NULL, 'l'},
         {"led-chip", required_argument, NULL, 'c'}, {"led-green", required_argument, NULL, 'g'},
         {"led-red", required_argument, NULL, 'r'}, {"list-products", no_argument, NULL, 'L'},
         {"eds", no_argument, NULL, 'E'},           {"on-eof", required_argument, NULL, 'o'},
+        {"seed", required_argument, NULL, 's'},
         {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0},
     };
     opterr = 0; /* our own one-line messages */
@@ -385,6 +399,15 @@ static int parse_options(int argc, char **argv, options_t *o)
             }
             o->quit_on_eof = strcmp(optarg, "quit") == 0;
             break;
+        case 's': {
+            char *end;
+            errno = 0;
+            o->seed = strtoull(optarg, &end, 10);
+            if (end == optarg || *end != '\0' || errno != 0 || optarg[0] == '-') {
+                return USAGE_ERROR("--seed takes a number 0..2^64-1, not '%s'", optarg);
+            }
+            break;
+        }
         case 'E':
             o->eds = true;
             break;
@@ -456,6 +479,7 @@ static int set_up(app_t *a, const options_t *o)
     bool logf = o->log_path != NULL;
     a->nnodes = a->prod->nodes;
     sim_init(&a->sim, a->prod);
+    sim_seed(&a->sim, o->seed);
 
     char err[600];
     int r = lp_nvm_open(&a->nvm, o->nvm_path, a->nvm_mem,
@@ -506,6 +530,7 @@ static int set_up(app_t *a, const options_t *o)
         return start_failure(logf, 1, "product instance too large");
     }
     a->prod->create(a->prod, a->inst, ports, a->nodes);
+    sim_step(&a->sim, t);
     a->prod->sample(a->inst, a->sim.values, a->sim.faults);
     t = now_us();
     for (unsigned i = 0; i < a->nnodes; i++) {
@@ -593,6 +618,7 @@ static int run(app_t *a)
     while (!a->sim.quit) {
         uint32_t t = now_us();
         if (!co_time_before(t, a->next_sample)) {
+            sim_step(&a->sim, t);
             a->prod->sample(a->inst, a->sim.values, a->sim.faults);
             a->next_sample += CO_FILTER_PERIOD_US;
             if (!co_time_before(t, a->next_sample)) {

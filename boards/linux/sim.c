@@ -3,6 +3,7 @@
  */
 #include "sim.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,8 +33,125 @@ void sim_init(sim_t *s, const product_t *p)
 {
     memset(s, 0, sizeof(*s));
     s->prod = p;
+    s->seed = SIM_SEED_DEFAULT;
     for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
         s->values[i] = p->inputs[i].initial;
+        s->motion[i].kind = SIM_HOLD;
+        s->motion[i].from = p->inputs[i].initial;
+        s->replay.col[i] = -1;
+    }
+}
+
+void sim_seed(sim_t *s, uint64_t seed)
+{
+    s->seed = seed;
+}
+
+/* splitmix64's output function: a well-mixed 64-bit value of x. */
+static uint64_t mix64(uint64_t x)
+{
+    x += 0x9E3779B97F4A7C15u;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9u;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBu;
+    return x ^ (x >> 31);
+}
+
+/* A uniform number in (0, 1] from 64 random bits. */
+static double unit_interval(uint64_t r)
+{
+    return (double)((r >> 11) + 1u) * (1.0 / 9007199254740992.0);
+}
+
+/*
+ * Standard normal value of input i in simulated millisecond ms: counter-
+ * based (a function of seed, i and ms only), Box-Muller on two uniforms.
+ */
+static double gauss(uint64_t seed, unsigned i, uint64_t ms)
+{
+    uint64_t key = mix64(seed) ^ mix64(ms * PRODUCT_MAX_INPUTS + i);
+    double u1 = unit_interval(mix64(key));
+    double u2 = unit_interval(mix64(key ^ 0xD1B54A32D192ED03u));
+    return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
+}
+
+/* num / den rounded to nearest (halves away from zero), den > 0. */
+static int64_t div_round(int64_t num, int64_t den)
+{
+    return num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
+}
+
+/* The motion's value of input i at simulated time t (noise left out). */
+static int32_t motion_value(const sim_t *s, unsigned i, uint64_t t)
+{
+    const sim_motion_t *m = &s->motion[i];
+    uint64_t el = t - m->start_us; /* commands start at the last step: t >= start */
+    switch (m->kind) {
+    case SIM_RAMP:
+        if (el >= m->dur_us) {
+            return m->to;
+        }
+        return m->from + (int32_t)div_round(((int64_t)m->to - m->from) * (int64_t)el,
+                                            (int64_t)m->dur_us);
+    case SIM_SINE: {
+        double phase = (double)(el % m->dur_us) / (double)m->dur_us;
+        return m->from + (int32_t)lround((double)m->amp * sin(6.283185307179586 * phase));
+    }
+    case SIM_REPLAY: {
+        const sim_replay_t *r = &s->replay;
+        int c = r->col[i];
+        if (el < r->t_us[0]) {
+            return m->from;
+        }
+        uint32_t k = 1;
+        while (k < r->rows && r->t_us[k] <= el) {
+            k++;
+        }
+        if (k >= r->rows) {
+            return r->v[r->rows - 1u][c];
+        }
+        int64_t v0 = r->v[k - 1u][c];
+        int64_t dt = (int64_t)(r->t_us[k] - r->t_us[k - 1u]);
+        return (int32_t)(v0 + div_round((r->v[k][c] - v0) * (int64_t)(el - r->t_us[k - 1u]), dt));
+    }
+    case SIM_HOLD:
+    default:
+        return m->from;
+    }
+}
+
+/* values[] at the simulated time: motion + noise, saturated at +-limit. */
+static void compute(sim_t *s)
+{
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && s->prod->inputs[i].name != NULL; i++) {
+        int64_t v = motion_value(s, i, s->t_us);
+        if (s->motion[i].sd != 0) {
+            v += lround((double)s->motion[i].sd * gauss(s->seed, i, s->t_us / 1000u));
+        }
+        int64_t lim = (int64_t)s->prod->inputs[i].limit * 1000;
+        v = v > lim ? lim : v < -lim ? -lim : v;
+        s->values[i] = (int32_t)v;
+    }
+}
+
+void sim_step(sim_t *s, uint32_t now_us)
+{
+    if (s->stepped) {
+        s->t_us += (uint32_t)(now_us - s->last_us);
+    }
+    s->stepped = true;
+    s->last_us = now_us;
+    compute(s);
+}
+
+/* A new motion of input i from now on (its noise kept). */
+static void start_motion(sim_t *s, unsigned i, sim_kind_t kind, int32_t from)
+{
+    sim_motion_t *m = &s->motion[i];
+    m->kind = kind;
+    m->from = from;
+    m->start_us = s->t_us;
+    if (s->replay.col[i] >= 0 && kind != SIM_REPLAY) {
+        s->replay.col[i] = -1; /* off the replay */
     }
 }
 
@@ -91,6 +209,302 @@ static bool can_command(sim_t *s, char **save, char *err, unsigned errlen)
     return true;
 }
 
+/* "12.5" into thousandths, within +-lim: false if not such a number. */
+static bool parse_value(const char *str, double lim, int32_t *out)
+{
+    char *end;
+    double x = strtod(str, &end);
+    if (end == str || *end != '\0' || !isfinite(x) || fabs(x) > lim) {
+        return false;
+    }
+    *out = (int32_t)lround(x * 1000.0);
+    return true;
+}
+
+/* "5s", "250ms", "1.5s" into microseconds: more than 0 (at least 1 us
+ * after rounding), at most SIM_DURATION_MAX_S. */
+static bool parse_duration(const char *str, uint64_t *us)
+{
+    char *end;
+    double x = strtod(str, &end);
+    double scale;
+    if (end == str || !isfinite(x)) {
+        return false;
+    }
+    if (strcmp(end, "s") == 0) {
+        scale = 1e6;
+    } else if (strcmp(end, "ms") == 0) {
+        scale = 1e3;
+    } else {
+        return false;
+    }
+    double t = x * scale;
+    if (!(t >= 1.0) || t > (double)SIM_DURATION_MAX_S * 1e6) {
+        return false;
+    }
+    *us = (uint64_t)llround(t);
+    return true;
+}
+
+/* `KEY=VALUE` with this key: the value, else NULL. */
+static const char *keyed(const char *tok, const char *key)
+{
+    size_t n = strlen(key);
+    return tok != NULL && strncmp(tok, key, n) == 0 && tok[n] == '=' ? tok + n + 1 : NULL;
+}
+
+/* The product's input names as "x|y". */
+static void input_list(const product_t *p, char *buf, size_t len)
+{
+    buf[0] = '\0';
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && p->inputs[i].name != NULL; i++) {
+        size_t at = strlen(buf);
+        snprintf(buf + at, len - at, "%s%s", i ? "|" : "", p->inputs[i].name);
+    }
+}
+
+/* `ramp NAME=VALUE in DURATION`, `sine NAME amp=A period=DURATION`,
+ * `noise NAME sd=S`: checked whole, then applied. */
+static bool motion_command(sim_t *s, const char *cmd, char **save, char *err, unsigned errlen)
+{
+    char list[64];
+    input_list(s->prod, list, sizeof(list));
+    char *a = strtok_r(NULL, " \t\r", save);
+    char *b = strtok_r(NULL, " \t\r", save);
+    char *c = strtok_r(NULL, " \t\r", save);
+    bool extra = strtok_r(NULL, " \t\r", save) != NULL;
+    char *eq = a != NULL ? strchr(a, '=') : NULL;
+    size_t nlen = a == NULL ? 0u : eq != NULL ? (size_t)(eq - a) : strlen(a);
+    int i = a != NULL ? input_index(s->prod, a, nlen) : -1;
+    double lim = i >= 0 ? s->prod->inputs[i].limit : 0.0;
+    int32_t now = i >= 0 ? motion_value(s, (unsigned)i, s->t_us) : 0;
+    if (strcmp(cmd, "ramp") == 0) {
+        int32_t to = 0;
+        uint64_t dur = 0;
+        if (i < 0 || eq == NULL || b == NULL || strcmp(b, "in") != 0 || c == NULL || extra) {
+            snprintf(err, errlen, "usage: ramp %s=VALUE in DURATION (e.g. 5s, 250ms)", list);
+            return false;
+        }
+        if (!parse_value(eq + 1, lim, &to)) {
+            snprintf(err, errlen, "'%s': not a number within +-%.0f", a, lim);
+            return false;
+        }
+        if (!parse_duration(c, &dur)) {
+            snprintf(err, errlen, "'%s': not a duration (s or ms, more than 0, at most %us)", c,
+                     SIM_DURATION_MAX_S);
+            return false;
+        }
+        start_motion(s, (unsigned)i, SIM_RAMP, now);
+        s->motion[i].to = to;
+        s->motion[i].dur_us = dur;
+        return true;
+    }
+    if (strcmp(cmd, "sine") == 0) {
+        const char *amp = keyed(b, "amp") != NULL ? keyed(b, "amp") : keyed(c, "amp");
+        const char *per = keyed(b, "period") != NULL ? keyed(b, "period") : keyed(c, "period");
+        int32_t am = 0;
+        uint64_t dur = 0;
+        if (i < 0 || eq != NULL || amp == NULL || per == NULL || extra) {
+            snprintf(err, errlen, "usage: sine %s amp=A period=DURATION (e.g. 2s, 500ms)", list);
+            return false;
+        }
+        if (!parse_value(amp, lim, &am) || am < 0) {
+            snprintf(err, errlen, "amp=%s: not a number within 0..%.0f", amp, lim);
+            return false;
+        }
+        if (!parse_duration(per, &dur)) {
+            snprintf(err, errlen, "period=%s: not a duration (s or ms, more than 0, at most %us)",
+                     per, SIM_DURATION_MAX_S);
+            return false;
+        }
+        if (llabs((long long)now) + am > (long long)lim * 1000) {
+            snprintf(err, errlen, "sine around %.3f with amp=%s leaves +-%.0f", now / 1000.0, amp,
+                     lim);
+            return false;
+        }
+        start_motion(s, (unsigned)i, SIM_SINE, now);
+        s->motion[i].amp = am;
+        s->motion[i].dur_us = dur;
+        return true;
+    }
+    /* noise */
+    const char *sd = keyed(b, "sd");
+    int32_t v = 0;
+    if (i < 0 || eq != NULL || sd == NULL || c != NULL) {
+        snprintf(err, errlen, "usage: noise %s sd=S (S >= 0 in the input's unit; 0 stops it)",
+                 list);
+        return false;
+    }
+    if (!parse_value(sd, lim, &v) || v < 0) {
+        snprintf(err, errlen, "sd=%s: not a number within 0..%.0f", sd, lim);
+        return false;
+    }
+    s->motion[i].sd = v;
+    return true;
+}
+
+/* Split a CSV line at commas into at most max fields (spaces around them
+ * trimmed); returns the count, or max + 1 when there are more. */
+static unsigned csv_fields(char *line, char *field[], unsigned max)
+{
+    unsigned n = 0;
+    char *p = line;
+    for (;;) {
+        char *comma = strchr(p, ',');
+        if (comma != NULL) {
+            *comma = '\0';
+        }
+        if (n == max) {
+            return max + 1u;
+        }
+        p += strspn(p, " \t");
+        size_t len = strlen(p);
+        while (len > 0u && (p[len - 1u] == ' ' || p[len - 1u] == '\t' || p[len - 1u] == '\r')) {
+            p[--len] = '\0';
+        }
+        field[n++] = p;
+        if (comma == NULL) {
+            return n;
+        }
+        p = comma + 1;
+    }
+}
+
+/* Read and check a replay file into *r (col[] set). False with the cause. */
+static bool replay_load(const sim_t *s, const char *file, sim_replay_t *r, char *err,
+                        unsigned errlen)
+{
+    FILE *f = fopen(file, "r");
+    if (f == NULL) {
+        snprintf(err, errlen, "replay %s: %s", file, strerror(errno));
+        return false;
+    }
+    char line[SIM_LINE_MAX + 2u];
+    char *field[PRODUCT_MAX_INPUTS + 1u];
+    int input_of[PRODUCT_MAX_INPUTS + 1u] = {0}; /* column -> input */
+    unsigned cols = 0;                           /* 0: header not read yet */
+    unsigned no = 0;
+    bool ok = true;
+    memset(r, 0, sizeof(*r));
+    memset(r->col, -1, sizeof(r->col));
+    while (ok && fgets(line, sizeof(line), f) != NULL) {
+        no++;
+        size_t len = strlen(line);
+        if (len > 0u && line[len - 1u] == '\n') {
+            line[--len] = '\0';
+        } else if (!feof(f)) {
+            snprintf(err, errlen, "replay %s: line %u: longer than %u characters", file, no,
+                     SIM_LINE_MAX);
+            ok = false;
+            break;
+        }
+        if (strlen(line) != len) {
+            snprintf(err, errlen, "replay %s: line %u: holds a NUL byte", file, no);
+            ok = false;
+            break;
+        }
+        size_t lead = strspn(line, " \t\r");
+        if (line[lead] == '\0' || line[lead] == '#') {
+            continue;
+        }
+        unsigned n = csv_fields(line, field, PRODUCT_MAX_INPUTS + 1u);
+        if (cols == 0u) {
+            if (n < 2u || n > PRODUCT_MAX_INPUTS + 1u ||
+                (strcmp(field[0], "t") != 0 && strcmp(field[0], "time") != 0)) {
+                snprintf(err, errlen, "replay %s: line %u: expected a header t,NAME,...", file,
+                         no);
+                ok = false;
+                break;
+            }
+            for (unsigned k = 1; k < n && ok; k++) {
+                int i = input_index(s->prod, field[k], strlen(field[k]));
+                if (i < 0 || r->col[i] >= 0) {
+                    snprintf(err, errlen, "replay %s: line %u: '%s' is %s", file, no, field[k],
+                             i < 0 ? "not one of the product's inputs" : "named twice");
+                    ok = false;
+                } else {
+                    r->col[i] = (int8_t)(k - 1u);
+                    input_of[k - 1u] = i;
+                }
+            }
+            cols = n;
+            continue;
+        }
+        if (n != cols) {
+            snprintf(err, errlen, "replay %s: line %u: not %u fields like the header", file, no,
+                     cols);
+            ok = false;
+            break;
+        }
+        if (r->rows >= SIM_REPLAY_ROWS) {
+            snprintf(err, errlen, "replay %s: more than %u rows", file, SIM_REPLAY_ROWS);
+            ok = false;
+            break;
+        }
+        char *end;
+        double t = strtod(field[0], &end);
+        if (end == field[0] || *end != '\0' || !isfinite(t) || t < 0.0 ||
+            t > (double)SIM_DURATION_MAX_S) {
+            snprintf(err, errlen, "replay %s: line %u: time '%s' not within 0..%u s", file, no,
+                     field[0], SIM_DURATION_MAX_S);
+            ok = false;
+            break;
+        }
+        uint64_t tu = (uint64_t)llround(t * 1e6);
+        if (r->rows > 0u && tu <= r->t_us[r->rows - 1u]) {
+            snprintf(err, errlen, "replay %s: line %u: time %s not after the row before", file,
+                     no, field[0]);
+            ok = false;
+            break;
+        }
+        r->t_us[r->rows] = tu;
+        for (unsigned k = 1; k < n && ok; k++) {
+            double lim = s->prod->inputs[input_of[k - 1u]].limit;
+            if (!parse_value(field[k], lim, &r->v[r->rows][k - 1u])) {
+                snprintf(err, errlen, "replay %s: line %u: '%s' not a number within +-%.0f",
+                         file, no, field[k], lim);
+                ok = false;
+            }
+        }
+        r->rows++;
+    }
+    if (ok && ferror(f)) {
+        snprintf(err, errlen, "replay %s: read error", file);
+        ok = false;
+    }
+    if (ok && r->rows == 0u) {
+        snprintf(err, errlen, "replay %s: %s", file, cols == 0u ? "empty" : "no data rows");
+        ok = false;
+    }
+    fclose(f);
+    return ok;
+}
+
+/* `replay FILE`: the former replay stops, the file's inputs follow it. */
+static bool replay_command(sim_t *s, const char *file, char *err, unsigned errlen)
+{
+    sim_replay_t r;
+    if (!replay_load(s, file, &r, err, errlen)) {
+        return false;
+    }
+    int32_t now[PRODUCT_MAX_INPUTS];
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
+        now[i] = motion_value(s, i, s->t_us);
+    }
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
+        if (s->motion[i].kind == SIM_REPLAY) {
+            start_motion(s, i, SIM_HOLD, now[i]); /* the former replay stops */
+        }
+    }
+    s->replay = r;
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
+        if (r.col[i] >= 0) {
+            start_motion(s, i, SIM_REPLAY, now[i]);
+        }
+    }
+    return true;
+}
+
 bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
 {
     char buf[SIM_LINE_MAX + 1u];
@@ -136,8 +550,8 @@ bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
         return true;
     }
     if (strcmp(cmd, "set") == 0) {
-        int32_t v[PRODUCT_MAX_INPUTS];
-        memcpy(v, s->values, sizeof(v));
+        int32_t v[PRODUCT_MAX_INPUTS] = {0};
+        bool named[PRODUCT_MAX_INPUTS] = {false};
         char usage[128];
         names(s->prod, usage, sizeof(usage));
         char *tok;
@@ -149,27 +563,50 @@ bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
                 snprintf(err, errlen, "'%s': expected %s", tok, usage);
                 return false;
             }
-            char *end;
-            double x = strtod(eq + 1, &end);
             double lim = s->prod->inputs[i].limit;
-            if (end == eq + 1 || *end != '\0' || !isfinite(x) || fabs(x) > lim) {
+            if (!parse_value(eq + 1, lim, &v[i])) {
                 snprintf(err, errlen, "'%s': not a number within +-%.0f", tok, lim);
                 return false;
             }
-            v[i] = (int32_t)lround(x * 1000.0);
+            named[i] = true;
             count++;
         }
         if (count == 0) {
             snprintf(err, errlen, "usage: set %s", usage);
             return false;
         }
-        memcpy(s->values, v, sizeof(v));
+        for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
+            if (named[i]) {
+                start_motion(s, i, SIM_HOLD, v[i]);
+            }
+        }
+        compute(s);
+        return true;
+    }
+    if (strcmp(cmd, "ramp") == 0 || strcmp(cmd, "sine") == 0 || strcmp(cmd, "noise") == 0) {
+        if (!motion_command(s, cmd, &save, err, errlen)) {
+            return false;
+        }
+        compute(s);
+        return true;
+    }
+    if (strcmp(cmd, "replay") == 0) {
+        char *file = strtok_r(NULL, " \t\r", &save);
+        if (file == NULL || strtok_r(NULL, " \t\r", &save) != NULL) {
+            snprintf(err, errlen, "usage: replay FILE.csv (no spaces in FILE)");
+            return false;
+        }
+        if (!replay_command(s, file, err, errlen)) {
+            return false;
+        }
+        compute(s);
         return true;
     }
     if (strcmp(cmd, "can") == 0) {
         return can_command(s, &save, err, errlen);
     }
-    snprintf(err, errlen, "unknown command '%s' (set, fault, can, quit)", cmd);
+    snprintf(err, errlen,
+             "unknown command '%s' (set, ramp, sine, noise, replay, fault, can, quit)", cmd);
     return false;
 }
 
