@@ -540,6 +540,7 @@ static uint32_t poll_nodes(app_t *a, uint32_t t, uint32_t wait, bool *backlog)
         wait = co_min_u32(wait, lp_poll(&a->ports[i], t));
         sync_can_state(a, i);
         wait = co_min_u32(wait, co_node_poll(a->nodes[i], t));
+        lp_filter(&a->ports[i], a->nodes[i]); /* the CAN-IDs it consumes now (port.h) */
         bool g;
         bool rd;
         uint32_t led_next;
