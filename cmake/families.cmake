@@ -46,6 +46,7 @@ set(CO_MCU_PRODUCTS)
 set(CO_MCU_FIXED_CFGS)
 set(co_registry_includes "")
 set(co_registry_rows "")
+set(co_registry_families "")
 set(co_registry_examples "")
 set(co_registry_union "")
 
@@ -88,6 +89,7 @@ macro(co_family name)
       string(APPEND co_registry_examples "&${sym}, ")
     else()
       string(APPEND co_registry_rows "&${sym}, ")
+      string(APPEND co_registry_families "\"${name}\", ")
       list(APPEND CO_MCU_PRODUCTS "${id} ${sym} ${name} ${fam_INSTANCE} ${cfg}")
     endif()
     if(NOT cfg STREQUAL "-" AND NOT "${cfg} ${name}" IN_LIST CO_MCU_FIXED_CFGS)
@@ -123,6 +125,8 @@ file(CONFIGURE OUTPUT ${CMAKE_BINARY_DIR}/generated/product_registry.h CONTENT
 @co_registry_includes@
 /* The products of the Linux program (--list-products order). */
 #define PRODUCT_REGISTRY_ROWS @co_registry_rows@
+/* The family of each of those products, in the same order. */
+#define PRODUCT_REGISTRY_FAMILIES @co_registry_families@
 /* Templates (EXAMPLE families): built and tested, not shipped. */
 #define PRODUCT_REGISTRY_EXAMPLES @co_registry_examples@
 /* Every instance type, for memory that holds any product (product.h). */
