@@ -46,6 +46,7 @@ set(CO_MCU_PRODUCTS)
 set(CO_MCU_FIXED_CFGS)
 set(co_registry_includes "")
 set(co_registry_rows "")
+set(co_registry_families "")
 set(co_registry_examples "")
 set(co_registry_union "")
 set(co_registry_ids "")
@@ -122,6 +123,7 @@ macro(co_family name)
     else()
       string(APPEND co_registry_rows "&${sym}, ")
       string(APPEND co_registry_ids "\"${id}\", ")
+      string(APPEND co_registry_families "\"${name}\", ")
       list(APPEND CO_MCU_PRODUCTS "${id} ${sym} ${name} ${fam_INSTANCE} ${cfg}")
     endif()
     if(NOT cfg STREQUAL "-" AND NOT "${cfg} ${name}" IN_LIST CO_MCU_FIXED_CFGS)
@@ -174,6 +176,8 @@ file(CONFIGURE OUTPUT ${CMAKE_BINARY_DIR}/generated/product_registry.h CONTENT
 @co_registry_includes@
 /* The products of the Linux program (--list-products order). */
 #define PRODUCT_REGISTRY_ROWS @co_registry_rows@
+/* The family of each of those products, in the same order. */
+#define PRODUCT_REGISTRY_FAMILIES @co_registry_families@
 /* Templates (EXAMPLE families): built and tested, not shipped. */
 #define PRODUCT_REGISTRY_EXAMPLES @co_registry_examples@
 /* The IDs the declarations give the rows above, in the same order (a

@@ -395,6 +395,37 @@ void co_node_leds(co_node_t *node, uint32_t now, bool *green, bool *red, uint32_
  */
 co_res_t co_node_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len);
 
+/* One CAN-ID a node consumes (co_node_rx_ids). */
+typedef struct co_rx_id {
+    uint16_t id; /* 11-bit CAN-ID */
+    bool rtr;    /* true: only remote frames on it serve the node; false: any frame
+                  * on it may (the service looks at the RTR bit itself) */
+} co_rx_id_t;
+
+/* Entries co_node_rx_ids() may fill: NMT, SYNC, SDO, LSS, guarding,
+ * one heartbeat consumed, and a remote request per TPDO. */
+#define CO_NODE_RX_IDS_MAX (6u + CO_TPDO_MAX)
+
+/*
+ * The CAN-IDs the node consumes now, for a board that filters what it
+ * receives (a SocketCAN CAN_RAW_FILTER, a controller's acceptance
+ * filters): NMT (0x000), the SYNC COB-ID (0x1005), the SDO request
+ * (0x600 + node-ID; none while unconfigured, CO_LSS_UNCONFIGURED), the LSS
+ * master (0x7E5, products with LSS), node guarding (0x700 + node-ID,
+ * remote frames, where guarding is enabled), the remote request on each
+ * valid TPDO whose COB-ID allows it (products with co_rtr_service) and
+ * the heartbeat consumed (0x1016 sub 1, while its time and node-ID are
+ * set). A frame on any other CAN-ID is ignored by co_node_receive(), so a
+ * board may drop it. The list follows every change of a COB-ID or the
+ * node-ID (SDO write, reset, LSS): a board asks again after each
+ * co_node_receive() or co_node_poll() and compares. Writes up to max
+ * entries to ids (owned by the caller) in a fixed order, no duplicates;
+ * returns the count (at most CO_NODE_RX_IDS_MAX: more than max means
+ * the list was cut at max). Reads the node only, never blocks. In its own
+ * file (node_rx.c), so that an image that does not call it does not link it.
+ */
+unsigned co_node_rx_ids(const co_node_t *node, co_rx_id_t *ids, unsigned max);
+
 /* Convenience: look up an entry in the node's dictionary (NULL if absent). */
 const co_od_entry_t *co_node_entry(const co_node_t *node, uint16_t index, uint8_t sub);
 

@@ -30,6 +30,7 @@
 #include "leds.h"
 #include "port.h"
 #include "product.h"
+#include "products_json.h"
 #include "product_registry.h"
 #include "sim.h"
 
@@ -38,7 +39,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: canopen-sensor --product ID --iface IFACE [options]\n"
             "       canopen-sensor --product ID --eds\n"
-            "       canopen-sensor --list-products\n"
+            "       canopen-sensor --list-products [--json]\n"
             "\n"
             "Runs a simulated CANopen sensor on a SocketCAN interface.\n"
             "\n"
@@ -59,6 +60,10 @@ static void usage(FILE *f)
             "                     commands at the same times give the same values\n"
             "  --eds              print the product's EDS (CiA 306) and exit\n"
             "  --list-products    print every product ID with a description\n"
+            "  --json             with --list-products: a JSON array instead, one object a\n"
+            "                     product: id, family, summary, vendor, nodes,\n"
+            "                     default_node_ids (one per node), default_bitrate_kbps,\n"
+            "                     lss, inputs (name, unit, limit, initial), faults\n"
             "  --help             this text\n"
             "\n"
             "Standard input, one command a line (a bad line is rejected whole):\n"
@@ -356,6 +361,8 @@ static int parse_options(int argc, char **argv, options_t *o)
 {
     memset(o, 0, sizeof(*o));
     const char *product = NULL;
+    bool list = false;
+    bool json = false;
     o->led_green = 0;
     o->led_red = 1;
     /* --on-eof quit by default: standard input is the sensor's tie to whoever
@@ -375,7 +382,8 @@ static int parse_options(int argc, char **argv, options_t *o)
         {"led-red", required_argument, NULL, 'r'}, {"list-products", no_argument, NULL, 'L'},
         {"eds", no_argument, NULL, 'E'},           {"on-eof", required_argument, NULL, 'o'},
         {"seed", required_argument, NULL, 's'},
-        {"help", no_argument, NULL, 'h'},          {NULL, 0, NULL, 0},
+        {"help", no_argument, NULL, 'h'},          {"json", no_argument, NULL, 'J'},
+        {NULL, 0, NULL, 0},
     };
     opterr = 0; /* our own one-line messages */
     int c;
@@ -412,10 +420,11 @@ static int parse_options(int argc, char **argv, options_t *o)
             o->eds = true;
             break;
         case 'L':
-            for (size_t i = 0; product_list[i] != NULL; i++) {
-                printf("%-18s %s\n", product_list[i]->id, product_list[i]->summary);
-            }
-            return 0;
+            list = true;
+            break;
+        case 'J':
+            json = true;
+            break;
         case 'h':
             usage(stdout);
             return 0;
@@ -427,6 +436,18 @@ static int parse_options(int argc, char **argv, options_t *o)
     }
     if (optind != argc) {
         return USAGE_ERROR("unexpected argument '%s'", argv[optind]);
+    }
+    if (json && !list) {
+        return USAGE_ERROR("--json goes with --list-products");
+    }
+    if (list) {
+        if (json) {
+            return products_json(stdout) == 0 ? 0 : 1;
+        }
+        for (size_t i = 0; product_list[i] != NULL; i++) {
+            printf("%-18s %s\n", product_list[i]->id, product_list[i]->summary);
+        }
+        return 0;
     }
     if (product == NULL) {
         return USAGE_ERROR("--product is missing");
@@ -565,6 +586,7 @@ static uint32_t poll_nodes(app_t *a, uint32_t t, uint32_t wait, bool *backlog)
         wait = co_min_u32(wait, lp_poll(&a->ports[i], t));
         sync_can_state(a, i);
         wait = co_min_u32(wait, co_node_poll(a->nodes[i], t));
+        lp_filter(&a->ports[i], a->nodes[i]); /* the CAN-IDs it consumes now (port.h) */
         bool g;
         bool rd;
         uint32_t led_next;

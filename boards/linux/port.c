@@ -298,6 +298,54 @@ uint32_t lp_poll(lp_port_t *p, uint32_t now)
 
 /* ---- CAN: frames -------------------------------------------------------- */
 
+/* The kernel's filter from the list: a classic frame on the CAN-ID (data
+ * or remote, the node's service tells), or only remote frames on it. */
+static void filter_install(lp_port_t *p)
+{
+    struct can_filter cf[CO_NODE_RX_IDS_MAX];
+    for (unsigned k = 0; k < p->nfilt; k++) {
+        cf[k].can_id = p->filt[k].id | (p->filt[k].rtr ? CAN_RTR_FLAG : 0u);
+        cf[k].can_mask = CAN_SFF_MASK | CAN_EFF_FLAG | (p->filt[k].rtr ? CAN_RTR_FLAG : 0u);
+    }
+    p->filt_changes++;
+    if (setsockopt(p->fd, SOL_CAN_RAW, CAN_RAW_FILTER, cf,
+                   (socklen_t)(p->nfilt * sizeof(cf[0]))) == 0) {
+        return;
+    }
+    int e = errno;
+    /* Receive everything rather than miss a frame: the node ignores what
+     * is not its own, at a cost in CPU only. */
+    struct can_filter all = {.can_id = 0, .can_mask = 0};
+    (void)setsockopt(p->fd, SOL_CAN_RAW, CAN_RAW_FILTER, &all, sizeof(all));
+    if (lp_rate_allow(&p->err_rate, p->now, 3u)) {
+        lp_log("node %u: CAN receive filter on %s refused (%s): receiving every frame", p->node,
+               p->iface, strerror(e));
+    }
+}
+
+void lp_filter(lp_port_t *p, const co_node_t *node)
+{
+    p->filt_node = node;
+    co_rx_id_t ids[CO_NODE_RX_IDS_MAX];
+    unsigned n = co_node_rx_ids(node, ids, CO_NODE_RX_IDS_MAX);
+    if (n > CO_NODE_RX_IDS_MAX) {
+        n = CO_NODE_RX_IDS_MAX; /* cannot happen: the stack's own bound */
+    }
+    bool same = p->filt_set && n == p->nfilt;
+    for (unsigned k = 0; same && k < n; k++) {
+        same = ids[k].id == p->filt[k].id && ids[k].rtr == p->filt[k].rtr;
+    }
+    if (same) {
+        return; /* unchanged: the usual case, no system call */
+    }
+    for (unsigned k = 0; k < n; k++) {
+        p->filt[k] = ids[k];
+    }
+    p->nfilt = n;
+    p->filt_set = true;
+    filter_install(p);
+}
+
 /* Errors that mean the interface went down or away. */
 static bool link_errno(int e)
 {
@@ -363,6 +411,9 @@ bool co_port_can_bitrate(void *port, uint16_t kbps)
 bool co_port_can_send(void *port, const co_frame_t *frame)
 {
     lp_port_t *p = port;
+    if (p->filt_node != NULL) {
+        lp_filter(p, p->filt_node); /* the filter first, then the answer (port.h) */
+    }
     if (lp_can_state(p) == CO_CAN_BUSOFF) {
         p->tx_off++; /* a controller off the bus sends nothing */
         return false;

@@ -90,6 +90,13 @@ typedef struct lp_port {
     lp_rate_t rx_rate;        /* one drop line a second at most */
     lp_rate_t err_rate;       /* unexpected socket errors: a few lines a second */
     uint32_t now;             /* latest time given to lp_poll / lp_read */
+    /* the kernel's receive filter (CAN_RAW_FILTER): the node's CAN-IDs as
+     * last installed (lp_filter) */
+    co_rx_id_t filt[CO_NODE_RX_IDS_MAX];
+    unsigned nfilt;
+    bool filt_set;            /* filt[] is what the kernel has */
+    const co_node_t *filt_node; /* the node filtered for (lp_filter), or NULL */
+    unsigned long filt_changes; /* times the filter was (re)installed */
 } lp_port_t;
 
 /* Log a line with a time stamp to the log (stderr or --log FILE). */
@@ -139,6 +146,22 @@ void lp_sim_can(lp_port_t *p, co_can_state_t s, uint32_t now, uint32_t hold_us,
 
 /* Log the dropped frames not logged yet, whatever the rate (at exit). */
 void lp_report_drops(lp_port_t *p);
+
+/*
+ * Keep the socket's kernel filter (CAN_RAW_FILTER) on the CAN-IDs node
+ * consumes (co_node_rx_ids): the first call installs it, later calls
+ * compare the list and call setsockopt only when it changed (a COB-ID or
+ * the node-ID did: SDO write, reset, LSS). Call it after every
+ * co_node_poll(); from then on the port also calls it before each frame
+ * the node sends, so that an answer which changed an ID (the SDO answer
+ * to a write of 0x1005, the boot-up after a reset with a new node-ID)
+ * goes out only once the filter takes the new ID: a master that sends on
+ * it as soon as it has the answer is heard. Error frames are
+ * not affected (CAN_RAW_ERR_FILTER, set by lp_open). A filter the kernel
+ * refuses is logged and the socket then receives every frame, as before
+ * filters existed. node is only read.
+ */
+void lp_filter(lp_port_t *p, const co_node_t *node);
 
 /* Try to hand queued frames to the kernel. Returns frames still queued. */
 unsigned lp_flush(lp_port_t *p);

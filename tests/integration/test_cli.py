@@ -30,11 +30,44 @@ def test_list_products():
     assert all(len(line.split(None, 1)) == 2 for line in r.stdout.splitlines())
 
 
+def test_list_products_json():
+    """--list-products --json: valid JSON, the same products in the same
+    order as the text list, and what the products declare."""
+    import json
+    r = run("--list-products", "--json")
+    assert r.returncode == 0, r.stderr
+    products = json.loads(r.stdout)
+    text_ids = [line.split()[0] for line in run("--list-products").stdout.splitlines()]
+    assert [p["id"] for p in products] == text_ids
+    assert run("--json", "--list-products").stdout == r.stdout  # either order
+    by_id = {p["id"]: p for p in products}
+    for p in products:
+        assert set(p) == {"id", "family", "summary", "vendor", "nodes", "default_node_ids",
+                          "default_bitrate_kbps", "lss", "inputs", "faults"}
+        assert len(p["default_node_ids"]) == p["nodes"]
+        assert all(1 <= n <= 127 for n in p["default_node_ids"])
+        assert p["inputs"] and all(set(i) == {"name", "unit", "limit", "initial"}
+                                   for i in p["inputs"])
+    dst = by_id["dst-x730-xy30"]
+    assert (dst["family"], dst["default_node_ids"], dst["default_bitrate_kbps"], dst["lss"]) \
+        == ("dst", [0x7F], 250, False)
+    assert dst["inputs"] == [{"name": "x", "unit": "deg", "limit": 3600, "initial": 0},
+                             {"name": "y", "unit": "deg", "limit": 3600, "initial": 0}]
+    assert dst["faults"] == ["sensor"]
+    assert by_id["gsh-a-redundant"]["family"] == "gsh"
+    assert by_id["gsh-a-redundant"]["default_node_ids"] == [0x13, 0x14]
+    assert by_id["jd2xxx"]["lss"] is True and by_id["jd2xxx"]["faults"] == []
+    assert by_id["jd2xxx"]["default_node_ids"] == [10]
+    assert by_id["inx360d"]["family"] == "pf"
+    assert by_id["inx360d"]["faults"] == ["range-x", "range-y", "undervoltage"]
+    one_line(run("--json"), 2, "--json goes with --list-products")
+
+
 def test_help():
     r = run("--help")
     assert r.returncode == 0
     for word in ("--product", "--iface", "--nvm", "--log", "--list-products", "--led-chip",
-                 "--eds", "--on-eof quit|run", "set NAME=VALUE", "fault NAME on|off",
+                 "--eds", "--on-eof quit|run", "--json", "set NAME=VALUE", "fault NAME on|off",
                  "can bus-off [SECONDS]", "can passive|warning|active", "quit", "SIGHUP",
                  "Exit status"):
         assert word in r.stdout

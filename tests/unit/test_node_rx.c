@@ -1,0 +1,195 @@
+/*
+ * test_node_rx.c - co_node_rx_ids(): the CAN-IDs a node consumes, the list
+ * a board's receive filter (the Linux port's CAN_RAW_FILTER) is built
+ * from. On every product and node: what the list holds, and that every
+ * frame outside it leaves the node exactly as it was (so a filter that
+ * drops it loses nothing); again after the SYNC COB-ID, a TPDO COB-ID, the
+ * heartbeat consumer and the node-ID (LSS) changed.
+ */
+#include "harness.h"
+#include "jd.h"
+#include "pf.h"
+
+static h_dev_t dev;
+static h_dev_t *const d = &dev;
+
+static void boot(const product_t *p)
+{
+    h_boot(d, p, false);
+    h_advance(d, 1000);
+    h_drain(d);
+}
+
+static unsigned list(co_node_t *node, co_rx_id_t ids[CO_NODE_RX_IDS_MAX])
+{
+    unsigned n = co_node_rx_ids(node, ids, CO_NODE_RX_IDS_MAX);
+    CHECK(n <= CO_NODE_RX_IDS_MAX);
+    return n < CO_NODE_RX_IDS_MAX ? n : CO_NODE_RX_IDS_MAX;
+}
+
+/* 1: (id, rtr) passes the list (an entry with rtr passes remote frames only). */
+static bool passes(const co_rx_id_t *ids, unsigned n, uint16_t id, bool rtr)
+{
+    for (unsigned k = 0; k < n; k++) {
+        if (ids[k].id == id && (!ids[k].rtr || rtr)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+static bool has(const co_rx_id_t *ids, unsigned n, uint16_t id, bool rtr)
+{
+    for (unsigned k = 0; k < n; k++) {
+        if (ids[k].id == id && ids[k].rtr == rtr) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/* Every classic frame a filter from the list drops (each CAN-ID, data and
+ * remote, 0, 1, 2 and 8 bytes) leaves the node as it was and sends
+ * nothing. Returns the frames tried. */
+static unsigned dropped_frames_unused(co_node_t *node)
+{
+    co_rx_id_t ids[CO_NODE_RX_IDS_MAX];
+    unsigned n = list(node, ids);
+    static const uint8_t lens[] = {0, 1, 2, 8};
+    unsigned tried = 0;
+    for (uint16_t id = 0; id < 0x800u; id++) {
+        for (unsigned r = 0; r < 2u; r++) {
+            if (passes(ids, n, id, r != 0u)) {
+                continue;
+            }
+            for (unsigned l = 0; l < sizeof(lens); l++) {
+                co_frame_t f = {.id = id, .rtr = r != 0u, .dlc = lens[l],
+                                .data = {0x01, 0x40, 0x05, 0, 0, 0, 0, 0}};
+                if (id == 0x000u) {
+                    f.data[1] = 0; /* NMT to all nodes (in the list anyway) */
+                }
+                co_node_t before = *node;
+                unsigned ntx = d->port.ntx;
+                co_node_receive(node, &f, node->now);
+                node->dirty = before.dirty;
+                if (memcmp(&before, node, sizeof(before)) != 0 || d->port.ntx != ntx) {
+                    fprintf(stderr, "  %s: frame %03X rtr %u dlc %u outside the list was used\n",
+                            d->prod->id, id, r, f.dlc);
+                    FAIL("a frame the filter drops changed the node");
+                    return tried;
+                }
+                tried++;
+            }
+        }
+    }
+    return tried;
+}
+
+/* Every product, every node, pre-operational and operational: the fixed
+ * entries, and nothing outside the list serves the node. */
+static void test_rx_ids_every_product(void)
+{
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        const product_t *p = product_list[i];
+        boot(p);
+        for (unsigned k = 0; k < d->nnodes; k++) {
+            co_node_t *node = d->nodes[k];
+            co_rx_id_t ids[CO_NODE_RX_IDS_MAX];
+            unsigned n = list(node, ids);
+            uint8_t id = co_node_id(node);
+            CHECK(has(ids, n, 0x000, false));
+            CHECK(has(ids, n, 0x600u + id, false));
+            CHECK(has(ids, n, node->sync.cob_id, false));
+            CHECK_EQ(has(ids, n, 0x7E5, false), node->cfg->lss);
+            for (unsigned a = 0; a < n; a++) {
+                CHECK(ids[a].id <= 0x7FFu);
+                for (unsigned b = a + 1u; b < n; b++) {
+                    CHECK(ids[a].id != ids[b].id);
+                }
+            }
+            CHECK(dropped_frames_unused(node) > 4000u);
+        }
+        h_rx(d, 0x000, "01 00"); /* all nodes operational */
+        h_drain(d);
+        for (unsigned k = 0; k < d->nnodes; k++) {
+            CHECK_EQ(co_node_nmt_state(d->nodes[k]), CO_NMT_OPERATIONAL);
+            CHECK(dropped_frames_unused(d->nodes[k]) > 4000u);
+        }
+    }
+}
+
+/* A list cut at max: the full count comes back, nothing beyond max is written. */
+static void test_rx_ids_cut(void)
+{
+    boot(&jd2xxx);
+    co_rx_id_t ids[3] = {{0}, {0}, {.id = 0xABC, .rtr = true}};
+    unsigned n = co_node_rx_ids(d->node, ids, 2);
+    CHECK(n > 2u);
+    CHECK_EQ(ids[0].id, 0x000);
+    CHECK_EQ(ids[2].id, 0xABC);
+    CHECK(ids[2].rtr);
+}
+
+/* The list follows SDO writes of the SYNC COB-ID, a TPDO COB-ID and the
+ * heartbeat consumer, and a node-ID set by LSS at reset communication. */
+static void test_rx_ids_follow_changes(void)
+{
+    co_rx_id_t ids[CO_NODE_RX_IDS_MAX];
+    boot(&jd2xxx); /* node 0x0A: LSS, guarding, heartbeat consumer, RTR */
+    unsigned n = list(d->node, ids);
+    CHECK(has(ids, n, 0x080, false));
+    CHECK(has(ids, n, 0x60A, false));
+    CHECK(has(ids, n, 0x70A, true));  /* guarding: remote frames only */
+    CHECK(has(ids, n, 0x18A, true));  /* TPDO 1 on request */
+    CHECK(!passes(ids, n, 0x18A, false));
+    CHECK(!passes(ids, n, 0x705, false));
+    SDO(d, "23 05 10 00 81 00 00 00", "60 05 10 00 00 00 00 00"); /* SYNC on 0x081 */
+    n = list(d->node, ids);
+    CHECK(has(ids, n, 0x081, false));
+    CHECK(!passes(ids, n, 0x080, false));
+    SDO(d, "23 16 10 01 64 00 05 00", "60 16 10 01 00 00 00 00"); /* watch node 5 */
+    n = list(d->node, ids);
+    CHECK(has(ids, n, 0x705, false));
+    SDO(d, "23 00 18 01 8A 01 00 C0", "60 00 18 01 00 00 00 00"); /* TPDO 1: no RTR */
+    n = list(d->node, ids);
+    CHECK(!passes(ids, n, 0x18A, true));
+    CHECK(dropped_frames_unused(d->node) > 4000u);
+    /* LSS: node-ID 0x25, active from reset communication on. */
+    h_rx(d, 0x7E5, "04 01 00 00 00 00 00 00");
+    h_rx(d, 0x7E5, "11 25 00 00 00 00 00 00");
+    h_rx(d, 0x7E5, "04 00 00 00 00 00 00 00");
+    n = list(d->node, ids);
+    CHECK(has(ids, n, 0x60A, false)); /* not yet */
+    h_rx(d, 0x000, "82 00");
+    h_drain(d);
+    CHECK_EQ(co_node_id(d->node), 0x25);
+    n = list(d->node, ids);
+    CHECK(has(ids, n, 0x625, false));
+    CHECK(!passes(ids, n, 0x60A, false));
+    CHECK(has(ids, n, 0x725, true));
+    CHECK(dropped_frames_unused(d->node) > 4000u);
+    /* Without a node-ID (LSS 0xFF): NMT, SYNC and LSS only, no SDO. */
+    h_rx(d, 0x7E5, "04 01 00 00 00 00 00 00");
+    h_rx(d, 0x7E5, "11 FF 00 00 00 00 00 00");
+    h_rx(d, 0x7E5, "04 00 00 00 00 00 00 00");
+    h_rx(d, 0x000, "82 00");
+    h_drain(d);
+    CHECK_EQ(co_node_id(d->node), CO_LSS_UNCONFIGURED);
+    n = list(d->node, ids);
+    CHECK(has(ids, n, 0x7E5, false));
+    CHECK(!passes(ids, n, 0x625, false));
+    CHECK(dropped_frames_unused(d->node) > 4000u);
+    /* A product without LSS or RTR service: the P+F's guarding and RTR. */
+    boot(&pf_inx360d);
+    n = list(d->node, ids);
+    CHECK(!has(ids, n, 0x7E5, false));
+    CHECK(has(ids, n, (uint16_t)(0x700u + co_node_id(d->node)), true));
+}
+
+int main(void)
+{
+    RUN(test_rx_ids_every_product);
+    RUN(test_rx_ids_cut);
+    RUN(test_rx_ids_follow_changes);
+    return h_finish();
+}
