@@ -4,6 +4,7 @@ node-ID given on the command line is its factory default (what a blank
 EEPROM boots with and what 0x1011 "restore defaults" returns to). The
 usage errors need no CAN: they are refused before any socket opens."""
 import signal
+import socket
 import subprocess
 import time
 
@@ -142,3 +143,35 @@ def test_two_node_product_and_two_interfaces(tmp_path, network, bus):
     log = (tmp_path / "sensor.log").read_text()
     assert "jd1xxx, node-ID 0x21 on vcan1" in log
     assert "gsh-a-redundant, node-ID 0x31 on vcan0" in log
+
+
+def test_127_nodes_in_one_process(tmp_path, bus):
+    """The most one bus holds: every node boots on its command-line ID and
+    the last one answers through the control socket."""
+    sock = str(tmp_path / "ctl.sock")
+    cmd = [BINARY, "--iface", IFACE, "--on-eof", "run", "--log", str(tmp_path / "log"),
+           "--control", f"unix:{sock}"]
+    products = ["jd2xxx", "dst-x730-xy30", "inx360d", "gsh-a"]
+    for i in range(1, 128):
+        cmd += ["--node", f"{products[i % 4]}@{i}"]
+    bus.clear()
+    proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL)
+    try:
+        seen = set()
+        for m in bus.frames(10):
+            if 0x701 <= m.arbitration_id <= 0x77F and bytes(m.data) == b"\0":
+                seen.add(m.arbitration_id - 0x700)
+            if len(seen) == 127:
+                break
+        assert seen == set(range(1, 128))
+        s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        s.connect(sock)
+        s.sendall(b"@125 get\n126 set x=1.5\n126 get\n")  # ID 126: inx360d
+        f = s.makefile("rb")
+        assert f.readline().startswith(b"ok x=0.000 ")
+        assert f.readline() == b"ok\n"
+        assert f.readline().startswith(b"ok x=1.500 ")
+        s.close()
+    finally:
+        proc.terminate()
+        assert proc.wait(timeout=10) == 0
