@@ -196,6 +196,9 @@ bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx)
 
 void ctl_close(ctl_t *c)
 {
+    if (c->fd < 0) {
+        return; /* never opened (the clients' slots may be all zero) */
+    }
     for (unsigned k = 0; k < CTL_CLIENTS; k++) {
         if (c->cl[k].fd >= 0) {
             drop(&c->cl[k]);

@@ -63,7 +63,8 @@ int ctl_accept(ctl_t *c);
  * discarded). */
 bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx);
 
-/* Close every client and the listening socket (a unix path is removed). */
+/* Close every client and the listening socket (a unix path is removed);
+ * nothing when ctl_open() was not called or failed (c->fd -1). */
 void ctl_close(ctl_t *c);
 
 #endif /* LINUX_CONTROL_H */
