@@ -150,6 +150,11 @@ typedef struct co_node_cfg {
     bool save_includes_lss;     /* 0x1010 "save" stores the node-ID / bit-rate set too */
     bool lss;                   /* LSS slave (CiA 305): list co_lss_service too */
     uint16_t lss_bitrates;      /* CiA 305 bit-timing indices supported (bit n = index n) */
+    uint8_t id_offset;          /* id_index holds the node-ID minus this (the JD's 3000h: 1) */
+    uint16_t id_index;          /* 0, or a product's own U8 object (sub 0) of the PARA class
+                                 * holding the node-ID (minus id_offset): where a factory
+                                 * node-ID (co_node_set_factory_id) goes when its defaults are
+                                 * loaded. A node-ID in the LSS class needs none. */
     const uint16_t *kbps;       /* kbit/s of each bit-rate code (16 codes; 0: unused), or NULL */
 } co_node_cfg_t;
 
@@ -166,6 +171,7 @@ struct co_node {
     bool dirty;                 /* something happened since the last full poll */
     bool due_never;             /* the last full poll found no deadline at all */
     bool od_checking;           /* write hooks only validate (co_od_validate) */
+    uint8_t factory_id;         /* co_node_set_factory_id(); 0: the config's default */
     co_nmt_t nmt;
     uint16_t can_kbps;          /* bit rate the board was last asked for (co_port_can_bitrate);
                                  * here, in what was padding before cfg */
@@ -319,6 +325,33 @@ static inline void co_node_set_autostart(co_node_t *node, bool on)
     if (CO_CHECK(node->nmt.state == CO_NMT_INIT)) {
         node->autostart = on;
     }
+}
+
+/*
+ * The factory node-ID of this node (1..127), instead of the config's
+ * default_node_id, which all nodes of a product share: what a blank EEPROM
+ * boots with and what "restore defaults" (0x1011, then a reset) returns
+ * to. The stack puts it in the LSS set's defaults and, where the product
+ * keeps its node-ID in its own object (co_node_cfg_t.id_index), in that
+ * object's default. A board that runs several nodes of one product (the
+ * Linux program's --node PRODUCT@ID) calls it after co_node_init() and
+ * before co_node_start(). While the node runs (its NMT state is not
+ * CO_NMT_INIT), or another id, it is a broken contract (CO_CHECK) and
+ * changes nothing.
+ */
+static inline void co_node_set_factory_id(co_node_t *node, uint8_t id)
+{
+    if (CO_CHECK(node->nmt.state == CO_NMT_INIT) &&
+        CO_CHECK(id >= 1u && id <= 127u)) {
+        node->factory_id = id;
+        node->node_id = id;
+    }
+}
+
+/* The node's factory node-ID: co_node_set_factory_id()'s, else the config's. */
+static inline uint8_t co_node_factory_id(const co_node_t *node)
+{
+    return node->factory_id != 0u ? node->factory_id : co_cfg(node)->default_node_id;
 }
 
 /* Reset at the next poll, after the answer to the current request went out. */

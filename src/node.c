@@ -79,7 +79,7 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
             /* Defaults always hold a good one: a stored node-ID out of 1..127. */
             co_store_mark_corrupt(node, CO_CLS_LSS);
         }
-        node->node_id = id_ok ? lss->node_id : co_cfg(node)->default_node_id;
+        node->node_id = id_ok ? lss->node_id : co_node_factory_id(node);
         node->bitrate = lss != NULL ? lss->bitrate : co_cfg(node)->default_bitrate;
     }
     co_sdo_init(&node->sdo);

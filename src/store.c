@@ -160,14 +160,23 @@ void co_store_init(co_node_t *node)
     }
 }
 
-/* Defaults: from the dictionary; the LSS struct's from the node config. */
+/* Defaults: from the dictionary; the LSS struct's from the node config and
+ * the node's factory node-ID; a product's own node-ID object (id_index)
+ * gets the factory node-ID when one was set for this node. */
 static void set_defaults(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)
 {
     co_od_defaults(node, cls, lo, hi);
     if (cls == CO_CLS_LSS) {
         co_lss_para_t *l = node->ram[CO_CLS_LSS];
-        l->node_id = co_cfg(node)->default_node_id;
+        l->node_id = co_node_factory_id(node);
         l->bitrate = co_cfg(node)->default_bitrate;
+    }
+    uint16_t ix = co_cfg(node)->id_index;
+    if (ix != 0u && node->factory_id != 0u && ix >= lo && ix <= hi) {
+        const co_od_entry_t *e = co_node_entry(node, ix, 0);
+        if (CO_CHECK(e != NULL && e->cls == CO_CLS_PARA) && cls == CO_CLS_PARA) {
+            (void)co_od_store(node, e, (uint32_t)(node->factory_id - co_cfg(node)->id_offset));
+        }
     }
 }
 

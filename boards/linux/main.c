@@ -1,6 +1,7 @@
 /*
- * main.c - canopen-sensor: runs one product of od/ as a process on a
- * SocketCAN interface. One event loop (epoll) over the CAN sockets,
+ * main.c - canopen-sensor: runs products of od/ as a process on SocketCAN
+ * interfaces: one (--product) or many instances (--node), each with its
+ * own nodes, inputs and EEPROM file. One event loop (epoll) over the CAN sockets,
  * standard input (the simulated physics) and a signalfd; the timeout is
  * the earliest deadline the nodes, the ports (link watch, simulated
  * bus-off), the sensor sampling and the LEDs ask for.
@@ -10,7 +11,8 @@
  * fails at start (no such CAN interface, not CAN, no CAN in the kernel, an
  * EEPROM file that cannot be read, GPIO) or the event loop fails; 2 for a
  * wrong command line (including an --nvm that is not a regular file or is
- * in a missing directory). Once running, nothing on the bus or the
+ * in a missing directory, a node-ID clash on one interface, more than 127
+ * nodes, a --control path that exists and is no stale socket). Once running, nothing on the bus or the
  * interface ends the process: a lost interface is a cable pull.
  */
 #include <errno.h>
@@ -22,10 +24,12 @@
 #include <string.h>
 #include <sys/epoll.h>
 #include <sys/signalfd.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "co_filter.h"
+#include "control.h"
 #include "eds.h"
 #include "leds.h"
 #include "port.h"
@@ -38,6 +42,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: canopen-sensor --product ID --iface IFACE [options]\n"
+            "       canopen-sensor --node PRODUCT[@NODEID][/IFACE] ... [--iface IFACE] [options]\n"
             "       canopen-sensor --product ID --eds\n"
             "       canopen-sensor --list-products [--json]\n"
             "\n"
@@ -46,6 +51,27 @@ static void usage(FILE *f)
             "  --product ID       product to run (see --list-products)\n"
             "  --iface IFACE      CAN interface, e.g. vcan0; A,B gives a two-node product\n"
             "                     one interface per node\n"
+            "  --node PRODUCT[@NODEID][/IFACE]\n"
+            "                     one more product instance in this process (repeat it; with\n"
+            "                     --product, that one is the first). NODEID (0x21 or 33) is its\n"
+            "                     factory node-ID: a blank EEPROM boots with it and restore\n"
+            "                     defaults (0x1011) returns to it; a two-node product's second\n"
+            "                     node takes NODEID+1. Without it: the product's default.\n"
+            "                     IFACE: its interface(s) (A or A,B), else --iface's first.\n"
+            "                     127 nodes at most; one factory node-ID twice on one\n"
+            "                     interface is refused\n"
+            "  --nvm-dir DIR      an EEPROM file per instance: DIR/PRODUCT-0xNN.nvm (NN: the\n"
+            "                     factory node-ID of its first node; a two-node product's\n"
+            "                     nodes share one file); --nvm, if given, stays --product's\n"
+            "  --control unix:PATH|tcp:PORT\n"
+            "                     take the standard-input commands from clients of a unix\n"
+            "                     socket or a TCP port on 127.0.0.1 too; each line may begin\n"
+            "                     with a node selector: 0xNN or NN (the node with that active\n"
+            "                     node-ID), @N (node index N, command-line order from 0), @all\n"
+            "                     (every instance); none: the first instance. Every line is\n"
+            "                     answered: ok, or error: <cause>. get answers the node's true\n"
+            "                     inputs and NMT state: ok x=10.000 y=0.000 nmt=operational.\n"
+            "                     PATH must not exist, or be a stale socket (replaced)\n"
             "  --nvm FILE         EEPROM file (a regular file, or a new one in an existing\n"
             "                     directory): parameters survive restarts (a restart is a\n"
             "                     power cycle); the first save creates it\n"
@@ -65,8 +91,11 @@ static void usage(FILE *f)
             "                     default_node_ids (one per node), default_bitrate_kbps,\n"
             "                     lss, inputs (name, unit, limit, initial), faults\n"
             "  --help             this text\n"
-            "\n"
-            "Standard input, one command a line (a bad line is rejected whole):\n"
+            "\n");
+    /* Two literals: C11 compilers need take only 4095 characters in one. */
+    fprintf(f,
+            "Standard input, one command a line (a bad line is rejected whole; set and\n"
+            "fault act on the first instance):\n"
             "  set NAME=VALUE ...         true value of the product's inputs (below)\n"
             "  ramp NAME=VALUE in DUR     linear from the value now to VALUE over DUR\n"
             "                             (e.g. 5s, 250ms), then held\n"
@@ -83,6 +112,7 @@ static void usage(FILE *f)
             "                             is back after 128 x 11 bits at its bit rate\n"
             "  can passive|warning|active the controller's error state\n"
             "  quit                       stop\n"
+            "  get                        (control socket only) true inputs and NMT state\n"
             "\n"
             "Exit status: 0 clean stop (quit, end of input, SIGINT, SIGTERM, SIGHUP);\n"
             "1 failure at start (interface, EEPROM read, GPIO) or of the event loop;\n"
@@ -144,18 +174,41 @@ static int parse_int(const char *s, int *out)
 /* Rejected input lines: at most this many logged a second, the rest counted. */
 #define IN_REJECT_LINES 5u
 
+/* Nodes in one process at most: one bus holds 127 node-IDs. */
+#define APP_MAX_NODES 127u
+
 /* epoll's tags: a node's socket is tagged with the node's index. */
-#define EV_SIGNAL 100u
-#define EV_STDIN 101u
+#define EV_SIGNAL 1000u
+#define EV_STDIN 1001u
+#define EV_CONTROL 1002u /* the control socket's listening socket */
+#define EV_CLIENT 2000u  /* + slot: a control client */
+
+/* One product instance (--product, or one --node): its nodes are
+ * app_t.nodes[first .. first + prod->nodes - 1]; its own inputs (sim), its
+ * own EEPROM file (both nodes of a two-node product share it, as they
+ * share the device). */
+typedef struct app_inst {
+    const product_t *prod;
+    unsigned first;
+    sim_t sim;
+    lp_nvm_t nvm;
+    uint8_t nvm_mem[PRODUCT_MAX_NODES * CO_STORE_NVM_SIZE];
+    _Alignas(max_align_t) unsigned char mem[sizeof(product_any_t)];
+} app_inst_t;
 
 typedef struct app {
-    const product_t *prod;
+    const product_t *prod; /* the first instance's */
     unsigned nnodes;
-    co_node_t *nodes[PRODUCT_MAX_NODES];
-    lp_port_t ports[PRODUCT_MAX_NODES];
-    leds_t leds[PRODUCT_MAX_NODES];
-    uint8_t last_state[PRODUCT_MAX_NODES];
-    sim_t sim;
+    unsigned ninst;
+    uint8_t node_inst[APP_MAX_NODES]; /* each node's instance */
+    co_node_t *nodes[APP_MAX_NODES];
+    lp_port_t ports[APP_MAX_NODES];
+    leds_t leds[APP_MAX_NODES];
+    uint8_t last_state[APP_MAX_NODES];
+    const char *ifn[APP_MAX_NODES]; /* each node's interface */
+    app_inst_t inst[APP_MAX_NODES];
+    sim_t sim; /* standard input's line assembly, quit and `can`; its
+                * set/fault lines go to the first instance (copied) */
     bool quit_on_eof;
     lp_rate_t in_rate;
     unsigned long in_held; /* rejected lines not logged yet */
@@ -163,11 +216,8 @@ typedef struct app {
     int sfd;               /* signalfd: SIGINT, SIGTERM, SIGHUP */
     int ep;                /* epoll over sfd, stdin and the CAN sockets */
     bool stdin_file;       /* stdin cannot be polled: read a block a pass */
-    uint32_t next_sample;  /* when the product samples its inputs next */
-    lp_nvm_t nvm;
-    uint8_t nvm_mem[PRODUCT_MAX_NODES * CO_STORE_NVM_SIZE];
-    /* The instance: in main's frame (app_t lives there), alive until main returns. */
-    _Alignas(max_align_t) unsigned char inst[sizeof(product_any_t)];
+    uint32_t next_sample;  /* when the products sample their inputs next */
+    ctl_t ctl;             /* --control (ctl.fd -1: none) */
 } app_t;
 
 /* The node sees the CAN state its port shows (link, error frames, simulator). */
@@ -179,23 +229,30 @@ static void sync_can_state(app_t *a, unsigned i)
     }
 }
 
-/* A `can` command from standard input: every node's simulated controller. */
-static void apply_can_command(app_t *a, uint32_t now)
+/* A `can` command of sim sm: the simulated controllers of nodes
+ * [first, end) (standard input: every node; control: the selected). */
+static void apply_can_nodes(app_t *a, sim_t *sm, unsigned first, unsigned end, uint32_t now)
 {
-    if (!a->sim.can_request) {
+    if (!sm->can_request) {
         return;
     }
-    a->sim.can_request = false;
-    for (unsigned i = 0; i < a->nnodes; i++) {
+    sm->can_request = false;
+    for (unsigned i = first; i < end; i++) {
         uint32_t kbps = a->ports[i].kbps;
         if (kbps == 0u) {
             kbps = 125u; /* a code the product does not define: the usual default */
         }
         /* 128 x 11 recessive bits at the node's bit rate, rounded up */
         uint32_t recovery_us = (LP_BUSOFF_RECOVERY_BITS * 1000u + kbps - 1u) / kbps;
-        lp_sim_can(&a->ports[i], a->sim.can_state, now, a->sim.can_hold_ms * 1000u, recovery_us);
+        lp_sim_can(&a->ports[i], sm->can_state, now, sm->can_hold_ms * 1000u, recovery_us);
         sync_can_state(a, i);
     }
+}
+
+/* A `can` command from standard input: every node's simulated controller. */
+static void apply_can_command(app_t *a, uint32_t now)
+{
+    apply_can_nodes(a, &a->sim, 0, a->nnodes, now);
 }
 
 static void log_held_input(app_t *a, uint32_t now)
@@ -256,14 +313,19 @@ static bool read_stdin(app_t *a)
     return true;
 }
 
-static void log_states(app_t *a)
+static const char *nmt_name(uint8_t s)
 {
     static const char *const names[] = {[0x00] = "initialising", [0x04] = "stopped",
                                         [0x05] = "operational", [0x7F] = "pre-operational"};
+    return (s < sizeof(names) / sizeof(names[0]) && names[s]) ? names[s] : "?";
+}
+
+static void log_states(app_t *a)
+{
     for (unsigned i = 0; i < a->nnodes; i++) {
         uint8_t s = (uint8_t)co_node_nmt_state(a->nodes[i]);
         if (s != a->last_state[i]) {
-            const char *name = (s < sizeof(names) / sizeof(names[0]) && names[s]) ? names[s] : "?";
+            const char *name = nmt_name(s);
             lp_log("node %u (ID 0x%02X): NMT %s", i, co_node_id(a->nodes[i]), name);
             a->last_state[i] = s;
         }
@@ -272,14 +334,15 @@ static void log_states(app_t *a)
 
 /* After the start: say which stored sets could not be used (the stack
  * flags them over CAN too, per product: 0x4001, EMCY, LEDs). */
-static void log_store_status(app_t *a, const lp_nvm_t *nvm)
+static void log_store_status(app_t *a)
 {
     static const struct {
         co_cls_t cls;
         const char *what;
     } sets[] = {{CO_CLS_PARA, "parameters"}, {CO_CLS_LSS, "node-ID and bit rate"}};
-    const char *file = nvm->path != NULL ? nvm->real : "(RAM)";
     for (unsigned i = 0; i < a->nnodes; i++) {
+        const lp_nvm_t *nvm = &a->inst[a->node_inst[i]].nvm;
+        const char *file = nvm->path != NULL ? nvm->real : "(RAM)";
         for (unsigned k = 0; k < sizeof(sets) / sizeof(sets[0]); k++) {
             if (co_cfg(a->nodes[i])->ram_size[sets[k].cls] == 0u) {
                 continue;
@@ -297,10 +360,26 @@ static void log_store_status(app_t *a, const lp_nvm_t *nvm)
 }
 
 /* The command line, as parse_options() leaves it. */
+/* One product instance the command line asks for (--product, --node). */
+typedef struct node_spec {
+    const product_t *prod;
+    uint8_t id;        /* factory node-ID of its first node (the next one +1), 0: product's */
+    const char *iface; /* its interfaces ("A" or "A,B"), NULL: --iface's first */
+    const char *arg;   /* the option's text, for messages */
+    /* the interfaces split at their commas (split_ifaces); ifn[] points into ifbuf */
+    char ifbuf[PRODUCT_MAX_NODES * IFNAMSIZ + 8];
+    const char *ifn[PRODUCT_MAX_NODES];
+} node_spec_t;
+
 typedef struct options {
     const product_t *prod;
     const char *iface;
     const char *nvm_path;
+    const char *nvm_dir;
+    const char *control; /* --control unix:PATH | tcp:PORT, or NULL */
+    node_spec_t spec[APP_MAX_NODES]; /* --product first (if given), then each --node */
+    unsigned nspec;
+    unsigned nnodes_total;
     const char *log_path;
     const char *led_chip;
     const char *led_line_opt; /* the last --led-green/--led-red given, or NULL */
@@ -308,11 +387,7 @@ typedef struct options {
     int led_red;
     bool eds;
     bool quit_on_eof;
-    uint64_t seed; /* --seed: the simulator's noise */
-    /* --iface split at its commas: one interface per node (the first one
-     * for every node when one is given); ifn[] points into ifbuf. */
-    char ifbuf[PRODUCT_MAX_NODES * IFNAMSIZ + 8];
-    const char *ifn[PRODUCT_MAX_NODES];
+    uint64_t seed; /* --seed: the simulator's noise (instance k: seed + k) */
 } options_t;
 
 /* Not an exit status: go on (parse_options, set_up). */
@@ -320,7 +395,7 @@ typedef struct options {
 
 /* --iface: one interface for all nodes, or one per node ("A,B"). Returns
  * GO_ON or the exit status of a wrong command line. */
-static int split_ifaces(options_t *o)
+static int split_ifaces(node_spec_t *o)
 {
     const product_t *prod = o->prod;
     const char *iface = o->iface;
@@ -354,6 +429,79 @@ static int split_ifaces(options_t *o)
     return GO_ON;
 }
 
+/* --node PRODUCT[@NODEID][/IFACE] into the next spec. Returns GO_ON or 2. */
+static int parse_node(options_t *o, const char *arg)
+{
+    if (o->nspec == APP_MAX_NODES) {
+        return USAGE_ERROR("more than %u nodes in one process", APP_MAX_NODES);
+    }
+    node_spec_t *n = &o->spec[o->nspec];
+    char name[64];
+    const char *slash = strchr(arg, '/');
+    size_t len = slash != NULL ? (size_t)(slash - arg) : strlen(arg);
+    if (len >= sizeof(name)) {
+        return USAGE_ERROR("--node %s: unknown product (see --list-products)", arg);
+    }
+    memcpy(name, arg, len);
+    name[len] = '\0';
+    char *at = strchr(name, '@');
+    if (at != NULL) {
+        *at = '\0';
+        char *end;
+        long id = strtol(at + 1, &end, 0);
+        if (at[1] == '\0' || *end != '\0' || id < 1 || id > 127) {
+            return USAGE_ERROR("--node %s: node-ID '%s' is not 1..127 (e.g. 0x21 or 33)", arg,
+                               at + 1);
+        }
+        n->id = (uint8_t)id;
+    }
+    n->prod = product_find(name);
+    if (n->prod == NULL) {
+        return USAGE_ERROR("--node %s: unknown product '%s' (see --list-products)", arg, name);
+    }
+    if (n->id != 0u && n->id + n->prod->nodes - 1u > 127u) {
+        return USAGE_ERROR("--node %s: %s has %u nodes, node-IDs 0x%02X.. pass 127", arg,
+                           n->prod->id, n->prod->nodes, n->id);
+    }
+    n->iface = slash != NULL ? slash + 1 : NULL;
+    n->arg = arg;
+    o->nspec++;
+    return GO_ON;
+}
+
+/* The specs' interfaces and node count, checked after the options. */
+static int check_specs(options_t *o)
+{
+    o->nnodes_total = 0;
+    for (unsigned k = 0; k < o->nspec; k++) {
+        node_spec_t *n = &o->spec[k];
+        if (n->iface == NULL) {
+            if (o->iface == NULL) {
+                return USAGE_ERROR("--node %s: no interface (give /IFACE or --iface)", n->arg);
+            }
+            size_t l = strcspn(o->iface, ",");
+            if (l >= IFNAMSIZ) {
+                return USAGE_ERROR("--iface %s: too long", o->iface);
+            }
+            memcpy(n->ifbuf, o->iface, l); /* the first of --iface's */
+            n->ifbuf[l] = '\0';
+            for (unsigned i = 0; i < PRODUCT_MAX_NODES; i++) {
+                n->ifn[i] = n->ifbuf;
+            }
+        } else {
+            int rc = split_ifaces(n);
+            if (rc != GO_ON) {
+                return rc;
+            }
+        }
+        o->nnodes_total += n->prod->nodes;
+    }
+    if (o->nnodes_total > APP_MAX_NODES) {
+        return USAGE_ERROR("%u nodes: at most %u in one process", o->nnodes_total, APP_MAX_NODES);
+    }
+    return GO_ON;
+}
+
 /* The command line into *o, checked: returns GO_ON, 0 after --help or
  * --list-products (printed), or 2 for a wrong command line (one line on
  * stderr). With --eds only the product is checked. Nothing is opened. */
@@ -383,6 +531,8 @@ static int parse_options(int argc, char **argv, options_t *o)
         {"eds", no_argument, NULL, 'E'},           {"on-eof", required_argument, NULL, 'o'},
         {"seed", required_argument, NULL, 's'},
         {"help", no_argument, NULL, 'h'},          {"json", no_argument, NULL, 'J'},
+        {"node", required_argument, NULL, 'N'},
+        {"nvm-dir", required_argument, NULL, 'D'}, {"control", required_argument, NULL, 'C'},
         {NULL, 0, NULL, 0},
     };
     opterr = 0; /* our own one-line messages */
@@ -392,6 +542,15 @@ static int parse_options(int argc, char **argv, options_t *o)
         case 'p': product = optarg; break;
         case 'i': o->iface = optarg; break;
         case 'n': o->nvm_path = optarg; break;
+        case 'D': o->nvm_dir = optarg; break;
+        case 'C': o->control = optarg; break;
+        case 'N': {
+            int rc = parse_node(o, optarg);
+            if (rc != GO_ON) {
+                return rc;
+            }
+            break;
+        }
         case 'l': o->log_path = optarg; break;
         case 'c': o->led_chip = optarg; break;
         case 'g':
@@ -449,18 +608,23 @@ static int parse_options(int argc, char **argv, options_t *o)
         }
         return 0;
     }
-    if (product == NULL) {
+    if (product == NULL && (o->nspec == 0u || o->eds)) {
         return USAGE_ERROR("--product is missing");
     }
-    o->prod = product_find(product);
-    if (o->prod == NULL) {
-        return USAGE_ERROR("unknown product '%s' (see --list-products)", product);
+    if (product != NULL) {
+        o->prod = product_find(product);
+        if (o->prod == NULL) {
+            return USAGE_ERROR("unknown product '%s' (see --list-products)", product);
+        }
     }
     if (o->eds) {
         return GO_ON;
     }
-    if (o->iface == NULL) {
+    if (o->iface == NULL && o->nspec == 0u) {
         return USAGE_ERROR("--iface is missing");
+    }
+    if (o->nvm_path != NULL && o->prod == NULL) {
+        return USAGE_ERROR("--nvm is the --product node's EEPROM file: use --nvm-dir with --node");
     }
     if (o->led_line_opt != NULL && o->led_chip == NULL) {
         return USAGE_ERROR("%s needs --led-chip", o->led_line_opt);
@@ -468,7 +632,18 @@ static int parse_options(int argc, char **argv, options_t *o)
     if (o->led_chip != NULL && o->led_green == o->led_red) {
         return USAGE_ERROR("--led-green and --led-red are the same line (%d)", o->led_green);
     }
-    return split_ifaces(o);
+    if (o->prod != NULL) { /* --product (and --iface "A,B") first: node 0 as before */
+        if (o->nspec == APP_MAX_NODES) {
+            return USAGE_ERROR("more than %u nodes in one process", APP_MAX_NODES);
+        }
+        memmove(&o->spec[1], &o->spec[0], o->nspec * sizeof(o->spec[0]));
+        memset(&o->spec[0], 0, sizeof(o->spec[0]));
+        o->spec[0].prod = o->prod;
+        o->spec[0].iface = o->iface;
+        o->spec[0].arg = o->prod->id;
+        o->nspec++;
+    }
+    return check_specs(o);
 }
 
 /* --eds: the product's EDS on stdout; returns the exit status. */
@@ -481,14 +656,139 @@ static int print_eds(const product_t *prod)
     return fflush(stdout) == 0 ? 0 : 1;
 }
 
+/* The EEPROM file of instance k: --nvm for the --product instance, else
+ * DIR/PRODUCT-0xID.nvm with --nvm-dir (ID: the factory node-ID of the
+ * instance's first node, from the command line or the product's default;
+ * a two-node product's both nodes share its file, as they share the
+ * device), else none (RAM). Returns 0, or -1 when the name is too long. */
+static int nvm_file(const options_t *o, unsigned k, uint8_t id, char *buf, size_t len,
+                    const char **path)
+{
+    *path = NULL;
+    if (k == 0u && o->prod != NULL && o->nvm_path != NULL) {
+        *path = o->nvm_path;
+    } else if (o->nvm_dir != NULL) {
+        if (snprintf(buf, len, "%s/%s-0x%02X.nvm", o->nvm_dir, o->spec[k].prod->id, id) >=
+            (int)len) {
+            return -1;
+        }
+        *path = buf;
+    }
+    return 0;
+}
+
+/* Two nodes with one factory node-ID on one interface: a usage error
+ * (checked before any node starts). Returns GO_ON or 2. */
+static int check_clashes(const app_t *a)
+{
+    for (unsigned i = 0; i < a->nnodes; i++) {
+        for (unsigned j = 0; j < i; j++) {
+            if (strcmp(a->ifn[i], a->ifn[j]) == 0 &&
+                co_node_factory_id(a->nodes[i]) == co_node_factory_id(a->nodes[j])) {
+                return USAGE_ERROR("node-ID 0x%02X twice on %s (%s and %s): give each node its "
+                                   "own with --node PRODUCT@ID",
+                                   co_node_factory_id(a->nodes[i]), a->ifn[i],
+                                   a->inst[a->node_inst[j]].prod->id,
+                                   a->inst[a->node_inst[i]].prod->id);
+            }
+        }
+    }
+    return GO_ON;
+}
+
+/* Create instance k and give its nodes their factory node-IDs (not
+ * started). Returns GO_ON or an exit status. */
+static int set_up_inst(app_t *a, const options_t *o, unsigned k, bool logf)
+{
+    const node_spec_t *n = &o->spec[k];
+    app_inst_t *in = &a->inst[k];
+    in->prod = n->prod;
+    in->first = a->nnodes;
+    sim_init(&in->sim, in->prod);
+    if (in->prod->inst_size > sizeof(in->mem)) {
+        return start_failure(logf, 1, "product instance too large");
+    }
+    void *ports[PRODUCT_MAX_NODES];
+    for (unsigned i = 0; i < in->prod->nodes; i++) {
+        unsigned g = in->first + i;
+        a->node_inst[g] = (uint8_t)k;
+        a->ifn[g] = n->ifn[i];
+        ports[i] = &a->ports[g];
+    }
+    /* create() only keeps the port pointers (co_node_init calls no board
+     * function): the factory node-IDs are checked for clashes and name the
+     * EEPROM files, which are looked at before any socket opens (a FIFO
+     * must not hang the start). */
+    in->prod->create(in->prod, in->mem, ports, &a->nodes[in->first]);
+    a->nnodes += in->prod->nodes;
+    for (unsigned i = 0; i < in->prod->nodes && n->id != 0u; i++) {
+        co_node_set_factory_id(a->nodes[in->first + i], (uint8_t)(n->id + i));
+    }
+    return GO_ON;
+}
+
+/* Open instance k's EEPROM file. Returns GO_ON or an exit status. */
+static int open_inst_nvm(app_t *a, const options_t *o, unsigned k, bool logf)
+{
+    app_inst_t *in = &a->inst[k];
+    char err[600];
+    char file[4096];
+    const char *path;
+    if (nvm_file(o, k, co_node_factory_id(a->nodes[in->first]), file, sizeof(file), &path) != 0) {
+        return USAGE_ERROR("--nvm-dir %s: too long", o->nvm_dir);
+    }
+    int r = lp_nvm_open(&in->nvm, path, in->nvm_mem,
+                        (uint32_t)(in->prod->nodes * CO_STORE_NVM_SIZE), err, sizeof(err));
+    if (r != 0) {
+        return start_failure(logf, r == -2 ? 2 : 1, err);
+    }
+    return GO_ON;
+}
+
+/* Open the sockets and LEDs of instance k's nodes. Returns GO_ON or 1. */
+static int open_inst_ports(app_t *a, const options_t *o, unsigned k, bool logf, uint32_t t)
+{
+    app_inst_t *in = &a->inst[k];
+    char err[600];
+    for (unsigned i = 0; i < in->prod->nodes; i++) {
+        unsigned g = in->first + i;
+        if (lp_open(&a->ports[g], a->ifn[g], g, &in->nvm, t, err, sizeof(err)) != 0) {
+            return start_failure(logf, 1, err);
+        }
+        if (leds_open(&a->leds[g], g == 0 ? o->led_chip : NULL, o->led_green, o->led_red, err,
+                      sizeof(err)) != 0) {
+            return start_failure(logf, 1, err);
+        }
+    }
+    return GO_ON;
+}
+
+/* The sim whose inputs instance k samples: standard input's for the
+ * first, each other its own. */
+static sim_t *inst_sim(app_t *a, unsigned k)
+{
+    return k == 0u ? &a->sim : &a->inst[k].sim;
+}
+
+/* Every instance's motion advances to t (sim_step), then it samples its inputs. */
+static void sample_all(app_t *a, uint32_t t)
+{
+    for (unsigned k = 0; k < a->ninst; k++) {
+        sim_t *sm = inst_sim(a, k);
+        sim_step(sm, t);
+        a->inst[k].prod->sample(a->inst[k].mem, sm->values, sm->faults);
+    }
+}
+
 /* Everything the loop needs, in the order a failure must be reported:
- * the log, the EEPROM file, the CAN sockets and LEDs, the signals and
- * epoll, then the instance, its first sample and the nodes' start.
+ * the log, the --nvm-dir, then per instance the CAN sockets and LEDs, the
+ * instance and its EEPROM file; the node-ID clash check; the signals and
+ * epoll; the first sample and the nodes' start.
  * Returns GO_ON, or the exit status of a failure at start (reported). */
 static int set_up(app_t *a, const options_t *o)
 {
     memset(a, 0, sizeof(*a));
-    a->prod = o->prod;
+    a->prod = o->spec[0].prod;
     a->quit_on_eof = o->quit_on_eof;
     if (o->log_path != NULL) {
         FILE *lf = fopen(o->log_path, "a");
@@ -498,26 +798,37 @@ static int set_up(app_t *a, const options_t *o)
         lp_log_open(lf);
     }
     bool logf = o->log_path != NULL;
-    a->nnodes = a->prod->nodes;
     sim_init(&a->sim, a->prod);
-    sim_seed(&a->sim, o->seed);
-
+    if (o->nvm_dir != NULL) {
+        struct stat st;
+        if (stat(o->nvm_dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
+            return USAGE_ERROR("--nvm-dir %s: not a directory", o->nvm_dir);
+        }
+    }
     char err[600];
-    int r = lp_nvm_open(&a->nvm, o->nvm_path, a->nvm_mem,
-                        (uint32_t)(a->nnodes * CO_STORE_NVM_SIZE), err, sizeof(err));
-    if (r != 0) {
-        return start_failure(logf, r == -2 ? 2 : 1, err);
+    for (unsigned k = 0; k < o->nspec; k++) {
+        a->ninst = k + 1u;
+        int r = set_up_inst(a, o, k, logf);
+        if (r != GO_ON) {
+            return r;
+        }
+        sim_seed(inst_sim(a, k), o->seed + k); /* each instance its own noise */
+    }
+    int rc = check_clashes(a);
+    if (rc != GO_ON) {
+        return rc;
+    }
+    for (unsigned k = 0; k < a->ninst; k++) {
+        rc = open_inst_nvm(a, o, k, logf);
+        if (rc != GO_ON) {
+            return rc;
+        }
     }
     uint32_t t = now_us();
-    void *ports[PRODUCT_MAX_NODES];
-    for (unsigned i = 0; i < a->nnodes; i++) {
-        if (lp_open(&a->ports[i], o->ifn[i], i, &a->nvm, t, err, sizeof(err)) != 0) {
-            return start_failure(logf, 1, err);
-        }
-        ports[i] = &a->ports[i];
-        if (leds_open(&a->leds[i], i == 0 ? o->led_chip : NULL, o->led_green, o->led_red, err,
-                      sizeof(err)) != 0) {
-            return start_failure(logf, 1, err);
+    for (unsigned k = 0; k < a->ninst; k++) {
+        rc = open_inst_ports(a, o, k, logf, t);
+        if (rc != GO_ON) {
+            return rc;
         }
     }
 
@@ -547,20 +858,28 @@ static int set_up(app_t *a, const options_t *o)
         epoll_ctl(a->ep, EPOLL_CTL_ADD, a->ports[i].fd, &ev);
     }
 
-    if (a->prod->inst_size > sizeof(a->inst)) {
-        return start_failure(logf, 1, "product instance too large");
+    a->ctl.fd = -1;
+    if (o->control != NULL) {
+        int r = ctl_open(&a->ctl, o->control, err, sizeof(err));
+        if (r != 0) {
+            return r == -2 ? USAGE_ERROR("%s", err) : start_failure(logf, 1, err);
+        }
+        ev.data.u32 = EV_CONTROL;
+        epoll_ctl(a->ep, EPOLL_CTL_ADD, ctl_fd(&a->ctl), &ev);
+        lp_log("control: listening on %s", o->control);
     }
-    a->prod->create(a->prod, a->inst, ports, a->nodes);
-    sim_step(&a->sim, t);
-    a->prod->sample(a->inst, a->sim.values, a->sim.faults);
+
+    sample_all(a, t);
     t = now_us();
     for (unsigned i = 0; i < a->nnodes; i++) {
+        const product_t *prod = a->inst[a->node_inst[i]].prod;
         co_node_start(a->nodes[i], t);
-        lp_log("node %u: %s, node-ID 0x%02X on %s, bit-rate code %u = %u kbit/s (vcan ignores it)",
-               i, a->prod->id, co_node_id(a->nodes[i]), o->ifn[i], co_node_bitrate(a->nodes[i]),
-               product_kbps(a->prod, co_node_bitrate(a->nodes[i])));
+        lp_log("node %u: %s, node-ID 0x%02X on %s, bit-rate code %u = %u kbit/s (vcan ignores "
+               "it); factory node-ID 0x%02X",
+               i, prod->id, co_node_id(a->nodes[i]), a->ifn[i], co_node_bitrate(a->nodes[i]),
+               product_kbps(prod, co_node_bitrate(a->nodes[i])), co_node_factory_id(a->nodes[i]));
     }
-    log_store_status(a, &a->nvm);
+    log_store_status(a);
     /* A regular file or a device never blocks: read one block a pass of the
      * loop, at most one a millisecond, so that the nodes run and signals
      * are heard however long (/dev/zero: endless) it is. */
@@ -602,6 +921,136 @@ static uint32_t poll_nodes(app_t *a, uint32_t t, uint32_t wait, bool *backlog)
     return wait;
 }
 
+/* The nodes a control line's selector names (control.h, README):
+ * none: the first instance; "@all": every instance; "@N": node index N
+ * (command-line order, from 0); a number (0x21, 33): the node whose active
+ * node-ID it is. Sets *first and *end to a node range ([0, nnodes) for @all)
+ * and returns the rest of the line, or NULL with the cause in err. */
+static const char *select_nodes(app_t *a, const char *line, unsigned *first, unsigned *end,
+                                char *err, size_t errlen)
+{
+    const char *p = line + strspn(line, " \t");
+    size_t n = strcspn(p, " \t");
+    char tok[32];
+    if (n == 0u || n >= sizeof(tok) || (p[0] != '@' && (p[0] < '0' || p[0] > '9'))) {
+        const app_inst_t *in = &a->inst[0];
+        *first = in->first;
+        *end = in->first + in->prod->nodes;
+        return p; /* no selector */
+    }
+    memcpy(tok, p, n);
+    tok[n] = '\0';
+    const char *rest = p + n;
+    if (strcmp(tok, "@all") == 0) {
+        *first = 0;
+        *end = a->nnodes;
+        return rest;
+    }
+    char *e;
+    long v = strtol(tok[0] == '@' ? tok + 1 : tok, &e, tok[0] == '@' ? 10 : 0);
+    bool num = e != (tok[0] == '@' ? tok + 1 : tok) && *e == '\0' && v >= 0;
+    if (tok[0] == '@') {
+        if (!num || v >= (long)a->nnodes) {
+            snprintf(err, errlen, "no node %s (@0..@%u, or @all)", tok, a->nnodes - 1u);
+            return NULL;
+        }
+        *first = (unsigned)v;
+        *end = *first + 1u;
+        return rest;
+    }
+    unsigned found = 0;
+    for (unsigned i = 0; num && i < a->nnodes; i++) {
+        if (co_node_id(a->nodes[i]) == v) {
+            *first = i;
+            found++;
+        }
+    }
+    if (found != 1u) {
+        snprintf(err, errlen, found == 0u ? "no node with node-ID %s" :
+                 "node-ID %s on several interfaces: select it by index (@N)", tok);
+        return NULL;
+    }
+    *end = *first + 1u;
+    return rest;
+}
+
+/* `get`: one node's true inputs (its instance's) and NMT state. */
+static void control_get(app_t *a, unsigned node, char *reply, size_t len)
+{
+    unsigned k = a->node_inst[node];
+    const sim_t *sm = inst_sim(a, k);
+    const product_t *prod = a->inst[k].prod;
+    size_t at = (size_t)snprintf(reply, len, "ok");
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && prod->inputs[i].name != NULL && at < len; i++) {
+        int32_t v = sm->values[i];
+        uint32_t m = v < 0 ? (uint32_t)0 - (uint32_t)v : (uint32_t)v;
+        at += (size_t)snprintf(reply + at, len - at, " %s=%s%u.%03u", prod->inputs[i].name,
+                               v < 0 ? "-" : "", m / 1000u, m % 1000u);
+    }
+    if (at < len) {
+        snprintf(reply + at, len - at, " nmt=%s",
+                 nmt_name((uint8_t)co_node_nmt_state(a->nodes[node])));
+    }
+}
+
+/* ctl_line_fn: one control line, answered "ok ..." or "error: <cause>". A
+ * line for several instances is checked on copies first and applied to
+ * all or none (a bad line changes nothing, as on standard input). */
+static void control_line(void *ctx, const char *line, char *reply, size_t len)
+{
+    app_t *a = ctx;
+    char err[256];
+    unsigned first = 0;
+    unsigned end = 0;
+    const char *cmd = select_nodes(a, line, &first, &end, err, sizeof(err));
+    if (cmd == NULL) {
+        snprintf(reply, len, "error: %s", err);
+        return;
+    }
+    cmd += strspn(cmd, " \t");
+    if (strncmp(cmd, "get", 3) == 0 && (cmd[3] == '\0' || strchr(" \t\r", cmd[3]) != NULL)) {
+        if (cmd[3 + strspn(cmd + 3, " \t\r")] != '\0') {
+            snprintf(reply, len, "error: get takes nothing after it");
+        } else if (end - first != 1u && a->inst[a->node_inst[first]].prod->nodes != end - first) {
+            snprintf(reply, len, "error: get needs one node (select it: 0xID or @N)");
+        } else {
+            control_get(a, first, reply, len);
+        }
+        return;
+    }
+    if (cmd[0] == '\0' || cmd[0] == '#') {
+        snprintf(reply, len, "error: no command (set, fault, can, get, quit)");
+        return;
+    }
+    unsigned k0 = a->node_inst[first];
+    unsigned k1 = a->node_inst[end - 1u];
+    for (unsigned k = k0; k <= k1; k++) {
+        sim_t trial = *inst_sim(a, k); /* checked on a copy first */
+        if (!sim_command(&trial, cmd, err, sizeof(err))) {
+            if (k1 > k0) {
+                snprintf(reply, len, "error: %s: %s", a->inst[k].prod->id, err);
+            } else {
+                snprintf(reply, len, "error: %s", err);
+            }
+            return;
+        }
+    }
+    uint32_t now = now_us();
+    for (unsigned k = k0; k <= k1; k++) {
+        sim_t *sm = inst_sim(a, k);
+        (void)sim_command(sm, cmd, err, sizeof(err)); /* as on the copy: it succeeds */
+        const app_inst_t *in = &a->inst[k];
+        unsigned lo = first > in->first ? first : in->first;
+        unsigned hi = co_min_u32(end, in->first + in->prod->nodes);
+        apply_can_nodes(a, sm, lo, hi, now);
+        if (sm->quit) {
+            a->sim.quit = true;
+        }
+    }
+    lp_log("control: %s", line);
+    snprintf(reply, len, "ok");
+}
+
 /* What epoll reported for src (EV_SIGNAL, EV_STDIN, or a node's socket). */
 static void handle_event(app_t *a, uint32_t src, uint32_t t)
 {
@@ -615,6 +1064,15 @@ static void handle_event(app_t *a, uint32_t src, uint32_t t)
         if (!read_stdin(a)) {
             epoll_ctl(a->ep, EPOLL_CTL_DEL, STDIN_FILENO, NULL);
         }
+    } else if (src == EV_CONTROL) {
+        int k = ctl_accept(&a->ctl);
+        if (k >= 0) {
+            struct epoll_event ev = {.events = EPOLLIN};
+            ev.data.u32 = EV_CLIENT + (uint32_t)k;
+            epoll_ctl(a->ep, EPOLL_CTL_ADD, a->ctl.cl[k].fd, &ev);
+        }
+    } else if (src >= EV_CLIENT && src < EV_CLIENT + CTL_CLIENTS) {
+        (void)ctl_read(&a->ctl, src - EV_CLIENT, control_line, a); /* a closed fd leaves epoll */
     } else if (src < a->nnodes) {
         co_frame_t f;
         /* At most 64 frames, then the timers again: a flooded bus
@@ -640,8 +1098,7 @@ static int run(app_t *a)
     while (!a->sim.quit) {
         uint32_t t = now_us();
         if (!co_time_before(t, a->next_sample)) {
-            sim_step(&a->sim, t);
-            a->prod->sample(a->inst, a->sim.values, a->sim.faults);
+            sample_all(a, t);
             a->next_sample += CO_FILTER_PERIOD_US;
             if (!co_time_before(t, a->next_sample)) {
                 a->next_sample = t + CO_FILTER_PERIOD_US; /* we slept too long: no burst */
@@ -692,12 +1149,13 @@ static void shut_down(app_t *a)
         }
         lp_close(p);
     }
+    ctl_close(&a->ctl);
     lp_log("stopped");
 }
 
 int main(int argc, char **argv)
 {
-    options_t o;
+    static options_t o;
     int rc = parse_options(argc, argv, &o);
     if (rc != GO_ON) {
         return rc;
@@ -705,7 +1163,9 @@ int main(int argc, char **argv)
     if (o.eds) {
         return print_eds(o.prod);
     }
-    app_t a;
+    /* static: 127 nodes' instances, sockets and EEPROM mirrors (about a
+     * megabyte) are better off the stack; main is the only user. */
+    static app_t a;
     rc = set_up(&a, &o);
     if (rc != GO_ON) {
         return rc;

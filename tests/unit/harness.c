@@ -102,6 +102,9 @@ static void create(h_dev_t *d)
     /* One sample before start, as a board reads its sensor before booting. */
     d->prod->sample(d->mem, d->truth, d->fault);
     for (unsigned i = 0; i < d->nnodes; i++) {
+        if (d->factory_id[i] != 0u) {
+            co_node_set_factory_id(d->nodes[i], d->factory_id[i]);
+        }
         co_node_start(d->nodes[i], d->now);
     }
     d->next_sample = d->now + CO_FILTER_PERIOD_US;
@@ -124,6 +127,18 @@ void h_boot(h_dev_t *d, const product_t *p, bool keep_nvm)
         abort();
     }
     create(d);
+}
+
+void h_boot_ids(h_dev_t *d, const product_t *p, const uint8_t ids[PRODUCT_MAX_NODES])
+{
+    memset(d, 0, sizeof(*d));
+    fake_port_init(&d->port);
+    d->now = 1000000u;
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
+        d->truth[i] = p->inputs[i].initial;
+    }
+    memcpy(d->factory_id, ids, sizeof(d->factory_id));
+    h_boot(d, p, true);
 }
 
 void h_power_cycle(h_dev_t *d)

@@ -129,6 +129,7 @@ typedef struct h_dev {
     uint32_t next_sample;  /* time of the next sensor sample */
     int32_t truth[PRODUCT_MAX_INPUTS]; /* true inputs, milli-units */
     uint32_t fault; /* bit i: the product's fault i */
+    uint8_t factory_id[PRODUCT_MAX_NODES]; /* co_node_set_factory_id() at each boot; 0: none */
 } h_dev_t;
 
 /* The product instance (aligned for any type: cast it to the family's type). */
@@ -139,6 +140,9 @@ static inline void *h_inst(h_dev_t *d)
 
 /* Create (port and NVM fresh unless keep_nvm) and power on. */
 void h_boot(h_dev_t *d, const product_t *p, bool keep_nvm);
+/* h_boot with fresh NVM, each node i given factory node-ID ids[i] (0: none)
+ * before its start, at this and every later power cycle. */
+void h_boot_ids(h_dev_t *d, const product_t *p, const uint8_t ids[PRODUCT_MAX_NODES]);
 /* Power cycle: keep the NVM, rebuild everything else. */
 void h_power_cycle(h_dev_t *d);
 

@@ -1,0 +1,214 @@
+/*
+ * control.c - the control socket (control.h).
+ */
+#include "control.h"
+
+#include <arpa/inet.h>
+#include <errno.h>
+#include <netinet/in.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+/* A unix path that exists: a socket that refuses connections is stale
+ * (its process died without removing it) and may go; anything else stays
+ * and the start is refused, so that a second program never steals a
+ * running one's socket nor a file is deleted. */
+static int unix_path_free(const char *path, char *err, size_t errlen)
+{
+    struct stat st;
+    if (lstat(path, &st) != 0) {
+        return 0;
+    }
+    if (!S_ISSOCK(st.st_mode)) {
+        snprintf(err, errlen, "--control unix:%s: the path exists and is not a socket", path);
+        return -2;
+    }
+    int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    struct sockaddr_un sa = {.sun_family = AF_UNIX};
+    snprintf(sa.sun_path, sizeof(sa.sun_path), "%s", path);
+    int r = fd < 0 ? -1 : connect(fd, (const struct sockaddr *)&sa, sizeof(sa));
+    int e = errno;
+    if (fd >= 0) {
+        close(fd);
+    }
+    if (r == 0 || e != ECONNREFUSED) {
+        snprintf(err, errlen, "--control unix:%s: a socket in use (another canopen-sensor?)", path);
+        return -2;
+    }
+    unlink(path); /* stale */
+    return 0;
+}
+
+static int open_unix(ctl_t *c, const char *path, char *err, size_t errlen)
+{
+    struct sockaddr_un sa = {.sun_family = AF_UNIX};
+    if (path[0] == '\0' || strlen(path) >= sizeof(sa.sun_path)) {
+        snprintf(err, errlen, "--control unix:%s: empty or longer than %zu bytes", path,
+                 sizeof(sa.sun_path) - 1u);
+        return -2;
+    }
+    int r = unix_path_free(path, err, errlen);
+    if (r != 0) {
+        return r;
+    }
+    snprintf(sa.sun_path, sizeof(sa.sun_path), "%s", path);
+    c->fd = socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    if (c->fd < 0 || bind(c->fd, (const struct sockaddr *)&sa, sizeof(sa)) != 0 ||
+        listen(c->fd, 8) != 0) {
+        snprintf(err, errlen, "--control unix:%s: %s", path, strerror(errno));
+        return errno == ENOENT || errno == EACCES || errno == EADDRINUSE ? -2 : -1;
+    }
+    snprintf(c->path, sizeof(c->path), "%s", path);
+    return 0;
+}
+
+static int open_tcp(ctl_t *c, const char *port, char *err, size_t errlen)
+{
+    char *end;
+    long p = strtol(port, &end, 10);
+    if (port[0] == '\0' || *end != '\0' || p < 1 || p > 65535) {
+        snprintf(err, errlen, "--control tcp:%s: not a port 1..65535", port);
+        return -2;
+    }
+    struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons((uint16_t)p)};
+    sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK); /* localhost only: no password */
+    c->fd = socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    int one = 1;
+    if (c->fd < 0 || setsockopt(c->fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one)) != 0 ||
+        bind(c->fd, (const struct sockaddr *)&sa, sizeof(sa)) != 0 || listen(c->fd, 8) != 0) {
+        snprintf(err, errlen, "--control tcp:%s: %s", port, strerror(errno));
+        return errno == EADDRINUSE || errno == EACCES ? -2 : -1;
+    }
+    return 0;
+}
+
+int ctl_open(ctl_t *c, const char *spec, char *err, size_t errlen)
+{
+    memset(c, 0, sizeof(*c));
+    c->fd = -1;
+    for (unsigned k = 0; k < CTL_CLIENTS; k++) {
+        c->cl[k].fd = -1;
+    }
+    if (strncmp(spec, "unix:", 5) == 0) {
+        return open_unix(c, spec + 5, err, errlen);
+    }
+    if (strncmp(spec, "tcp:", 4) == 0) {
+        return open_tcp(c, spec + 4, err, errlen);
+    }
+    snprintf(err, errlen, "--control %s: give unix:PATH or tcp:PORT", spec);
+    return -2;
+}
+
+/* One answer line; a client that cannot take it at once is dropped. */
+static bool reply(ctl_client_t *k, const char *text)
+{
+    char out[CTL_REPLY_MAX + 2u];
+    int n = snprintf(out, sizeof(out), "%s\n", text);
+    size_t len = n <= 0 ? 1u : (size_t)n >= sizeof(out) ? sizeof(out) - 1u : (size_t)n;
+    out[len - 1u] = '\n'; /* cut short or not, one line */
+    return send(k->fd, out, len, MSG_NOSIGNAL | MSG_DONTWAIT) == (ssize_t)len;
+}
+
+int ctl_accept(ctl_t *c)
+{
+    int fd = accept4(c->fd, NULL, NULL, SOCK_NONBLOCK | SOCK_CLOEXEC);
+    if (fd < 0) {
+        return -1;
+    }
+    for (unsigned k = 0; k < CTL_CLIENTS; k++) {
+        if (c->cl[k].fd < 0) {
+            memset(&c->cl[k], 0, sizeof(c->cl[k]));
+            c->cl[k].fd = fd;
+            return (int)k;
+        }
+    }
+    ctl_client_t tmp = {.fd = fd};
+    (void)reply(&tmp, "error: too many control clients");
+    close(fd);
+    return -1;
+}
+
+static void drop(ctl_client_t *k)
+{
+    close(k->fd);
+    k->fd = -1;
+    k->len = 0;
+}
+
+/* A complete line of client k: answered; false when the answer failed. */
+static bool line_done(ctl_client_t *k, ctl_line_fn fn, void *ctx)
+{
+    char out[CTL_REPLY_MAX + 1u];
+    if (k->overflow) {
+        snprintf(out, sizeof(out), "error: line longer than %u characters", CTL_LINE_MAX);
+    } else if (k->nul) {
+        snprintf(out, sizeof(out), "error: line holds a NUL byte");
+    } else {
+        k->line[k->len] = '\0';
+        if (k->len > 0u && k->line[k->len - 1u] == '\r') {
+            k->line[k->len - 1u] = '\0';
+        }
+        fn(ctx, k->line, out, sizeof(out));
+    }
+    k->len = 0;
+    k->overflow = false;
+    k->nul = false;
+    return reply(k, out);
+}
+
+bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx)
+{
+    if (k >= CTL_CLIENTS || c->cl[k].fd < 0) {
+        return false;
+    }
+    ctl_client_t *cl = &c->cl[k];
+    char buf[512];
+    ssize_t n = recv(cl->fd, buf, sizeof(buf), MSG_DONTWAIT);
+    if (n < 0 && (errno == EAGAIN || errno == EINTR)) {
+        return true;
+    }
+    if (n <= 0) {
+        drop(cl); /* gone: a partial line is discarded */
+        return false;
+    }
+    for (ssize_t i = 0; i < n; i++) {
+        char ch = buf[i];
+        if (ch == '\n') {
+            if (!line_done(cl, fn, ctx)) {
+                drop(cl);
+                return false;
+            }
+        } else if (ch == '\0') {
+            cl->nul = true;
+        } else if (cl->len < CTL_LINE_MAX) {
+            cl->line[cl->len++] = ch;
+        } else {
+            cl->overflow = true;
+        }
+    }
+    return true;
+}
+
+void ctl_close(ctl_t *c)
+{
+    if (c->fd < 0) {
+        return; /* never opened (the clients' slots may be all zero) */
+    }
+    for (unsigned k = 0; k < CTL_CLIENTS; k++) {
+        if (c->cl[k].fd >= 0) {
+            drop(&c->cl[k]);
+        }
+    }
+    if (c->fd >= 0) {
+        close(c->fd);
+        c->fd = -1;
+    }
+    if (c->path[0] != '\0') {
+        unlink(c->path);
+    }
+}

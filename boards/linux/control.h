@@ -1,0 +1,70 @@
+/*
+ * control.h - the control socket (--control unix:PATH | tcp:PORT): clients
+ * send the standard-input line language, one command a line, and get one
+ * answer line for each ("ok ..." or "error: <cause>"). This module owns
+ * the sockets and the line assembly; the program answers each line
+ * (ctl_line_fn). Everything runs in the program's one thread; nothing
+ * blocks: a client that does not read its answers loses them (a reply
+ * the kernel cannot take at once is dropped and the client closed).
+ */
+#ifndef LINUX_CONTROL_H
+#define LINUX_CONTROL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/* Clients at once; one more is accepted and told so, then closed. */
+#define CTL_CLIENTS 16u
+/* Longest line accepted, without its newline (the stdin limit). */
+#define CTL_LINE_MAX 255u
+/* Longest answer line, without its newline. */
+#define CTL_REPLY_MAX 511u
+
+/* Answer one complete line (no newline): write the answer into reply
+ * (len bytes) without its newline. */
+typedef void (*ctl_line_fn)(void *ctx, const char *line, char *reply, size_t len);
+
+typedef struct ctl_client {
+    int fd; /* -1: free */
+    char line[CTL_LINE_MAX + 1u];
+    size_t len;
+    bool overflow; /* longer than CTL_LINE_MAX: answered with an error at its end */
+    bool nul;      /* held a NUL byte: answered with an error at its end */
+} ctl_client_t;
+
+typedef struct ctl {
+    int fd;              /* listening socket, -1: none */
+    char path[108];      /* unix socket path to remove at close, "" for tcp */
+    ctl_client_t cl[CTL_CLIENTS];
+} ctl_t;
+
+/*
+ * Listen on spec ("unix:PATH" or "tcp:PORT", 127.0.0.1 only). A unix PATH
+ * that exists is refused, unless it is a socket nobody listens on (a stale
+ * socket a killed run left: connect() refused), which is replaced.
+ * Returns 0; -2 with a one-line cause in err for a spec that cannot be
+ * used (wrong form, path exists, port in use); -1 for another failure.
+ */
+int ctl_open(ctl_t *c, const char *spec, char *err, size_t errlen);
+
+/* The listening socket's fd (for epoll), -1 when closed. */
+static inline int ctl_fd(const ctl_t *c)
+{
+    return c->fd;
+}
+
+/* Accept what waits on the listening socket; returns the new client's slot
+ * (its fd is c->cl[slot].fd, for epoll), or -1 when none was added. */
+int ctl_accept(ctl_t *c);
+
+/* Read what client slot k has; each complete line is answered through fn.
+ * Returns false when the client is gone (closed here; a partial line is
+ * discarded). */
+bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx);
+
+/* Close every client and the listening socket (a unix path is removed);
+ * nothing when ctl_open() was not called or failed (c->fd -1). */
+void ctl_close(ctl_t *c);
+
+#endif /* LINUX_CONTROL_H */

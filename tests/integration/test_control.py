@@ -1,0 +1,165 @@
+"""The control socket (--control unix:PATH | tcp:PORT): the stdin line
+language with a node selector, one answer line per line, several clients,
+bad input answered with `error:` and disturbing nothing."""
+import os
+import socket
+import subprocess
+import time
+
+import can
+import pytest
+
+from conftest import BINARY, IFACE
+
+NODES = [("dst-x730-xy30", 0x21), ("jd2xxx", 0x22), ("inx360d", 0x23)]
+
+
+class Client:
+    def __init__(self, addr):
+        fam = socket.AF_UNIX if isinstance(addr, str) else socket.AF_INET
+        self.s = socket.socket(fam, socket.SOCK_STREAM)
+        for _ in range(50):
+            try:
+                self.s.connect(addr)
+                break
+            except (FileNotFoundError, ConnectionRefusedError):
+                time.sleep(0.05)
+        self.s.settimeout(3)
+        self.f = self.s.makefile("rb")
+
+    def ask(self, line):
+        self.s.sendall(line.encode() + b"\n")
+        return self.f.readline().decode().rstrip("\n")
+
+    def close(self):
+        self.f.close()
+        self.s.close()
+
+
+@pytest.fixture(params=["unix", "tcp"])
+def sim(request, tmp_path):
+    if not os.path.exists(f"/sys/class/net/{IFACE}"):
+        pytest.fail(f"{IFACE} is not up: run these tests through tools/vcan-run")
+    if request.param == "unix":
+        spec, addr = f"unix:{tmp_path}/ctl.sock", str(tmp_path / "ctl.sock")
+    else:
+        spec, addr = "tcp:47321", ("127.0.0.1", 47321)
+    cmd = [BINARY, "--iface", IFACE, "--log", str(tmp_path / "log"), "--control", spec]
+    for p, i in NODES:
+        cmd += ["--node", f"{p}@{i:#x}"]
+    proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    clients = []
+
+    def client():
+        c = Client(addr)
+        clients.append(c)
+        return c
+
+    yield proc, client
+    for c in clients:
+        c.close()
+    proc.terminate()
+    assert proc.wait(timeout=5) == 0
+    if request.param == "unix":
+        assert not os.path.exists(addr)  # removed at exit
+
+
+def test_set_get_selectors_and_nmt(sim):
+    proc, client = sim
+    c = client()
+    assert c.ask("0x22 set x=10 y=-2.5") == "ok"
+    assert c.ask("0x22 get") == "ok x=10.000 y=-2.500 temp=25.000 nmt=pre-operational"
+    assert c.ask("@1 get").startswith("ok x=10.000 y=-2.500")  # index 1: the JD too
+    assert c.ask("get") == "ok x=0.000 y=0.000 nmt=pre-operational"  # no selector: the first
+    assert c.ask("35 set x=90") == "ok"  # decimal node-ID
+    assert c.ask("@2 get") == "ok x=90.000 nmt=pre-operational"
+    with can.Bus(interface="socketcan", channel=IFACE) as bus:
+        bus.send(can.Message(arbitration_id=0, data=[1, 0x21], is_extended_id=False))
+    time.sleep(0.1)
+    assert c.ask("0x21 get").endswith("nmt=operational")
+    assert c.ask("0x22 get").endswith("nmt=pre-operational")
+    # @all: every instance or none: the JD and the P+F have no `sensor` fault
+    assert c.ask("@all fault sensor on").startswith("error: jd2xxx: ")
+    assert c.ask("@all set x=1") == "ok"
+    assert c.ask("@2 get") == "ok x=1.000 nmt=pre-operational"
+    assert c.ask("@all get").startswith("error: get needs one node")
+    # standard input keeps working (the first instance)
+    proc.stdin.write("set y=7\n")
+    proc.stdin.flush()
+    time.sleep(0.2)
+    assert c.ask("@0 get") == "ok x=1.000 y=7.000 nmt=operational"
+
+
+def test_bad_lines_get_an_error_and_change_nothing(sim):
+    _, client = sim
+    c = client()
+    assert c.ask("0x22 set x=3") == "ok"
+    for line, cause in [("@7 get", "error: no node @7 (@0..@2, or @all)"),
+                        ("@x get", "error: no node @x"),
+                        ("0x55 get", "error: no node with node-ID 0x55"),
+                        ("0x22", "error: no command"),
+                        ("0x22 frobnicate", "error: "),
+                        ("0x22 set nope=1", "error: "),
+                        ("0x22 set x=1 nope=2", "error: "),
+                        ("0x22 get now", "error: get takes nothing after it"),
+                        ("0x22 set x=" + "1" * 300, "error: line longer than 255"),
+                        ("0x22 set\0 x=1", "error: line holds a NUL byte")]:
+        assert c.ask(line).startswith(cause), line
+    assert c.ask("0x22 get").startswith("ok x=3.000 ")
+
+
+def test_clients_at_once_and_one_leaving_mid_line(sim):
+    _, client = sim
+    a, b = client(), client()
+    a.s.sendall(b"0x22 set x=")          # half a line ...
+    assert b.ask("0x21 set x=4") == "ok"  # ... another client goes on
+    a.close()                             # ... and the half is dropped with its client
+    time.sleep(0.1)
+    assert b.ask("0x22 get").startswith("ok x=0.000 ")
+    c = client()
+    assert c.ask("0x21 get").startswith("ok x=4.000 ")
+    assert b.ask("0x23 set x=2") == "ok"
+
+
+def test_quit_through_control(tmp_path):
+    path = str(tmp_path / "q.sock")
+    proc = subprocess.Popen([BINARY, "--iface", IFACE, "--node", "jd2xxx@5", "--control",
+                             f"unix:{path}", "--on-eof", "run"], stdin=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    c = Client(path)
+    assert c.ask("quit") == "ok"
+    assert proc.wait(timeout=5) == 0
+    c.close()
+
+
+def run(*args):
+    return subprocess.run([BINARY, "--iface", IFACE, "--node", "jd2xxx@5", *args],
+                          capture_output=True, text=True, timeout=10, stdin=subprocess.DEVNULL)
+
+
+def test_control_path_that_exists(tmp_path):
+    f = tmp_path / "file"
+    f.write_text("x")
+    r = run("--control", f"unix:{f}")
+    assert r.returncode == 2 and "the path exists and is not a socket" in r.stderr
+    assert f.read_text() == "x"
+    r = run("--control", "udp:4")
+    assert r.returncode == 2 and "give unix:PATH or tcp:PORT" in r.stderr
+    r = run("--control", "tcp:0")
+    assert r.returncode == 2 and "not a port 1..65535" in r.stderr
+    # a live socket: refused; a stale one (nobody listening): replaced
+    live = str(tmp_path / "live.sock")
+    s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    s.bind(live)
+    s.listen(1)
+    r = run("--control", f"unix:{live}")
+    assert r.returncode == 2 and "a socket in use" in r.stderr
+    s.close()  # the path stays: stale now
+    proc = subprocess.Popen([BINARY, "--iface", IFACE, "--node", "jd2xxx@5", "--control",
+                             f"unix:{live}", "--on-eof", "run"], stdin=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    c = Client(live)
+    assert c.ask("get").startswith("ok ")
+    c.close()
+    proc.terminate()
+    assert proc.wait(timeout=5) == 0

@@ -1,0 +1,177 @@
+"""Many nodes in one canopen-sensor process (--node PRODUCT[@ID][/IFACE],
+--nvm-dir): each answers on its own node-ID, has its own stored set, and a
+node-ID given on the command line is its factory default (what a blank
+EEPROM boots with and what 0x1011 "restore defaults" returns to). The
+usage errors need no CAN: they are refused before any socket opens."""
+import signal
+import socket
+import subprocess
+import time
+
+import canopen
+import pytest
+
+from conftest import BINARY, IFACE, eds_od
+
+
+def run(*args):
+    return subprocess.run([BINARY, *args], capture_output=True, text=True, timeout=10,
+                          stdin=subprocess.DEVNULL)
+
+
+def refused(r, text):
+    assert r.returncode == 2, (r.returncode, r.stderr)
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and text in lines[0], r.stderr
+
+
+def test_usage_errors(tmp_path):
+    refused(run("--node", "jd2xxx@0x21", "--node", "dst-x730-xy30@33", "--iface", "vcan0"),
+            "node-ID 0x21 twice on vcan0 (jd2xxx and dst-x730-xy30)")
+    # Without @ID each takes its product's default: two GSH-A (0x13) clash.
+    refused(run("--node", "gsh-a", "--node", "gsh-a-redundant", "--iface", "vcan0"),
+            "node-ID 0x13 twice on vcan0")
+    refused(run("--product", "jd2xxx", "--node", "jd1xxx", "--iface", "vcan0"),
+            "node-ID 0x0A twice on vcan0 (jd2xxx and jd1xxx)")
+    refused(run("--node", "nope@3", "--iface", "vcan0"), "--node nope@3: unknown product 'nope'")
+    refused(run("--node", "jd2xxx@128", "--iface", "vcan0"), "node-ID '128' is not 1..127")
+    refused(run("--node", "jd2xxx@", "--iface", "vcan0"), "node-ID '' is not 1..127")
+    refused(run("--node", "gsh-a-redundant@127", "--iface", "vcan0"), "pass 127")
+    refused(run("--node", "jd2xxx@5"), "--node jd2xxx@5: no interface (give /IFACE or --iface)")
+    refused(run("--node", "jd2xxx@5/vcan0,vcan1"), "jd2xxx has one node")
+    many = [a for i in range(1, 129) for a in ("--node", f"jd2xxx@{min(i, 127)}")]
+    refused(run(*many, "--iface", "vcan0"), "more than 127 nodes in one process")
+    many = [a for i in range(1, 65) for a in ("--node", f"gsh-a-redundant@1/vcan{i}")]
+    refused(run(*many), "128 nodes: at most 127 in one process")
+    refused(run("--node", "jd2xxx@5", "--iface", "vcan0", "--nvm", str(tmp_path / "e")),
+            "use --nvm-dir with --node")
+    refused(run("--node", "jd2xxx@5", "--iface", "vcan0", "--nvm-dir", str(tmp_path / "no")),
+            "not a directory")
+
+
+def test_the_same_id_on_two_interfaces_is_no_clash():
+    r = run("--node", "jd2xxx@5/vcan-nope0", "--node", "jd2xxx@5/vcan-nope1")
+    assert r.returncode == 1 and "vcan-nope0" in r.stderr  # past the clash check
+
+
+PRODUCTS = [("dst-x730-xy30", 0x21), ("jd2xxx", 0x22), ("inx360d", 0x23)]
+
+
+class Bench:
+    """One process with several --node options, and a master on vcan0."""
+
+    def __init__(self, tmp_path, network, bus, extra=()):
+        self.tmp, self.network, self.bus, self.extra = tmp_path, network, bus, list(extra)
+        self.nvm = tmp_path / "nvm"
+        self.nvm.mkdir(exist_ok=True)
+        self.proc = None
+
+    def start(self, expect_ids):
+        self.bus.clear()
+        cmd = [BINARY, "--iface", IFACE, "--nvm-dir", str(self.nvm), "--log",
+               str(self.tmp / "sensor.log"), "--on-eof", "run"]
+        for p, i in PRODUCTS:
+            cmd += ["--node", f"{p}@{i:#x}"]
+        self.proc = subprocess.Popen(cmd + self.extra, stdin=subprocess.DEVNULL)
+        seen = set()
+        for m in self.bus.frames(4):
+            if 0x701 <= m.arbitration_id <= 0x77F and bytes(m.data) == b"\0":
+                seen.add(m.arbitration_id - 0x700)
+            if seen >= set(expect_ids):
+                break
+        assert seen >= set(expect_ids), f"boot-ups {sorted(seen)}, expected {expect_ids}"
+
+    def node(self, product, node_id):
+        n = canopen.RemoteNode(node_id, eds_od(product, self.tmp, node_id))
+        self.network.add_node(n)
+        return n
+
+    def stop(self):
+        self.proc.send_signal(signal.SIGTERM)
+        assert self.proc.wait(timeout=5) == 0
+
+
+def test_three_products_in_one_process(tmp_path, network, bus):
+    b = Bench(tmp_path, network, bus)
+    b.start([i for _, i in PRODUCTS])
+    try:
+        nodes = [b.node(p, i) for p, i in PRODUCTS]
+        for n in nodes:
+            assert n.sdo.upload(0x1000, 0)  # each answers SDO on its own ID
+            n.sdo.download(0x1017, 0, (100).to_bytes(2, "little"))
+        bus.clear()
+        beats = {}
+        for m in bus.frames(1.0):
+            if 0x721 <= m.arbitration_id <= 0x723:
+                beats[m.arbitration_id] = beats.get(m.arbitration_id, 0) + 1
+        for _, i in PRODUCTS:
+            assert 8 <= beats.get(0x700 + i, 0) <= 12, beats  # 100 ms each
+    finally:
+        b.stop()
+    names = sorted(f.name for f in b.nvm.iterdir())
+    # Only the P+F stores every write by itself (autonomous store): its own file.
+    assert names == ["inx360d-0x23.nvm"], names
+
+
+def test_own_stored_sets_and_restore_defaults_to_the_command_line_id(tmp_path, network, bus):
+    b = Bench(tmp_path, network, bus)
+    b.start([0x21, 0x22, 0x23])
+    try:
+        jd = b.node("jd2xxx", 0x22)
+        assert jd.sdo.upload(0x3000, 0) == bytes([0x21])  # node number = ID - 1
+        jd.sdo.download(0x3000, 0, bytes([0x3F]))          # node-ID 0x40 ...
+        jd.sdo.download(0x1010, 1, b"save")                # ... stored
+    finally:
+        b.stop()
+    assert sorted(f.name for f in b.nvm.iterdir()) == ["jd2xxx-0x22.nvm"]
+    b.start([0x21, 0x40, 0x23])  # a power cycle: the stored ID; the others as they were
+    try:
+        jd = b.node("jd2xxx", 0x40)
+        jd.sdo.download(0x1011, 1, b"load")
+    finally:
+        b.stop()
+    b.start([0x21, 0x22, 0x23])  # restore defaults: the command line's node-ID again
+    b.stop()
+
+
+def test_two_node_product_and_two_interfaces(tmp_path, network, bus):
+    """gsh-a-redundant@0x30 is nodes 0x30 and 0x31; /vcan1 puts one on vcan1."""
+    b = Bench(tmp_path, network, bus, ["--node", "gsh-a-redundant@0x30",
+                                        "--node", "jd1xxx@0x21/vcan1"])
+    b.start([0x21, 0x22, 0x23, 0x30, 0x31])
+    b.stop()
+    log = (tmp_path / "sensor.log").read_text()
+    assert "jd1xxx, node-ID 0x21 on vcan1" in log
+    assert "gsh-a-redundant, node-ID 0x31 on vcan0" in log
+
+
+def test_127_nodes_in_one_process(tmp_path, bus):
+    """The most one bus holds: every node boots on its command-line ID and
+    the last one answers through the control socket."""
+    sock = str(tmp_path / "ctl.sock")
+    cmd = [BINARY, "--iface", IFACE, "--on-eof", "run", "--log", str(tmp_path / "log"),
+           "--control", f"unix:{sock}"]
+    products = ["jd2xxx", "dst-x730-xy30", "inx360d", "gsh-a"]
+    for i in range(1, 128):
+        cmd += ["--node", f"{products[i % 4]}@{i}"]
+    bus.clear()
+    proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL)
+    try:
+        seen = set()
+        for m in bus.frames(10):
+            if 0x701 <= m.arbitration_id <= 0x77F and bytes(m.data) == b"\0":
+                seen.add(m.arbitration_id - 0x700)
+            if len(seen) == 127:
+                break
+        assert seen == set(range(1, 128))
+        s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        s.connect(sock)
+        s.sendall(b"@125 get\n126 set x=1.5\n126 get\n")  # ID 126: inx360d
+        f = s.makefile("rb")
+        assert f.readline().startswith(b"ok x=0.000 ")
+        assert f.readline() == b"ok\n"
+        assert f.readline().startswith(b"ok x=1.500 ")
+        s.close()
+    finally:
+        proc.terminate()
+        assert proc.wait(timeout=10) == 0
