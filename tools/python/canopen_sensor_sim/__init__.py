@@ -91,7 +91,8 @@ class SimBus:
         args = [self.program, "--iface", self.interface]
         for n in self.nodes:
             args += ["--node", n]
-        args += ["--nvm-dir", str(self.nvm_dir), "--control", f"unix:{self.control_path}",
+        # Standard input is not used (DEVNULL): run on at its end.
+        args += ["--on-eof", "run", "--nvm-dir", str(self.nvm_dir), "--control", f"unix:{self.control_path}",
                  "--log", str(self.log_path)]
         if self.seed is not None:
             args += ["--seed", str(self.seed)]

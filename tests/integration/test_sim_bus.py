@@ -1,0 +1,52 @@
+"""The Python helper for machine tests (tools/python/canopen_sensor_sim,
+installed into the venv by tools/setup): its pytest fixture starts a
+simulated bus of several nodes in one canopen-sensor process and drives
+them through the control socket, while the canopen master sees them on
+vcan0 - the way a machine builder's own test would use it."""
+import time
+
+import canopen
+import pytest
+
+from canopen_sensor_sim import SimError
+
+
+def test_two_sensors_driven_from_the_test(sensor_bus, sensor_interface):
+    sim = sensor_bus(["inx360d@0x30", "jd2xxx@0x31"])
+    net = canopen.Network()
+    net.connect(interface="socketcan", channel=sensor_interface)
+    try:
+        inx = net.add_node(0x30)
+        jd = net.add_node(0x31)
+        assert int.from_bytes(inx.sdo.upload(0x1000, 0), "little") & 0xFFFF == 410
+        assert int.from_bytes(jd.sdo.upload(0x1000, 0), "little") & 0xFFFF == 410
+        sim.set(0x30, x=12.5)
+        time.sleep(0.1)
+        # P+F: 0.1 deg a unit, no filter: the slope follows the input at once.
+        assert int.from_bytes(inx.sdo.upload(0x6010, 0), "little", signed=True) == 125
+        assert sim.get(0x30)["x"] == pytest.approx(12.5)
+        assert sim.get(0x31)["nmt"] == "pre-operational"
+        net.nmt.send_command(0x01)  # start every node
+        time.sleep(0.1)
+        assert sim.get(0x31)["nmt"] == "operational"
+        with pytest.raises(SimError):
+            sim.set(0x30, nosuchinput=1)
+        with pytest.raises(SimError):
+            sim.get(0x55)  # no such node
+    finally:
+        net.disconnect()
+
+
+def test_restart_keeps_the_stored_set(sensor_bus, sensor_interface):
+    sim = sensor_bus(["inx360d@0x30"])
+    net = canopen.Network()
+    net.connect(interface="socketcan", channel=sensor_interface)
+    try:
+        node = net.add_node(0x30)
+        node.sdo.download(0x1017, 0, (250).to_bytes(2, "little"))  # P+F: stored at once
+        sim.stop()
+        sim.start()
+        time.sleep(0.2)
+        assert int.from_bytes(node.sdo.upload(0x1017, 0), "little") == 250
+    finally:
+        net.disconnect()
