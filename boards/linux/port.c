@@ -394,6 +394,111 @@ unsigned lp_flush(lp_port_t *p)
     return p->txn;
 }
 
+int lp_tx_open(lp_tx_t *tx, char *err, unsigned errlen)
+{
+    memset(tx, 0, sizeof(*tx));
+    tx->addressed = true;
+    tx->fd = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
+    if (tx->fd < 0) {
+        snprintf(err, errlen, "CAN socket: %s (is CAN supported by this kernel? see tools/vcan-run)",
+                 strerror(errno));
+        return -1;
+    }
+    /* Never bound: it receives nothing (the empty filter says so twice);
+     * each message carries its interface. */
+    (void)setsockopt(tx->fd, SOL_CAN_RAW, CAN_RAW_FILTER, NULL, 0);
+    return 0;
+}
+
+void lp_tx_close(lp_tx_t *tx)
+{
+    if (tx->fd >= 0) {
+        close(tx->fd);
+        tx->fd = -1;
+    }
+}
+
+/* The first frame of p's queue leaves it (sent, or lost for good). */
+static void txq_pop(lp_port_t *p)
+{
+    p->txh = (p->txh + 1u) % LP_TXQ;
+    p->txn--;
+}
+
+/* Frames queued in all n ports. */
+static unsigned txq_total(const lp_port_t *ports, unsigned n)
+{
+    unsigned total = 0;
+    for (unsigned i = 0; i < n; i++) {
+        total += ports[i].txn;
+    }
+    return total;
+}
+
+unsigned lp_tx_flush(lp_tx_t *tx, lp_port_t *ports, unsigned n)
+{
+    struct can_frame cf[LP_TXB];
+    struct iovec iov[LP_TXB];
+    struct sockaddr_can to[LP_TXB];
+    struct mmsghdr mm[LP_TXB];
+    lp_port_t *from[LP_TXB];
+    for (;;) {
+        /* Gather: each port's queue from its head, ports in order. */
+        unsigned cnt = 0;
+        for (unsigned i = 0; i < n && cnt < LP_TXB; i++) {
+            lp_port_t *p = &ports[i];
+            if (p->txn != 0u && lp_can_state(p) == CO_CAN_BUSOFF) {
+                drop_txq(p); /* off the bus since it queued them */
+            }
+            for (unsigned k = 0; k < p->txn && cnt < LP_TXB; k++, cnt++) {
+                const co_frame_t *f = &p->txq[(p->txh + k) % LP_TXQ];
+                memset(&cf[cnt], 0, sizeof(cf[cnt]));
+                cf[cnt].can_id = f->id | (f->rtr ? CAN_RTR_FLAG : 0u);
+                cf[cnt].len = f->dlc;
+                memcpy(cf[cnt].data, f->data, f->dlc);
+                iov[cnt].iov_base = &cf[cnt];
+                iov[cnt].iov_len = sizeof(cf[cnt]);
+                memset(&mm[cnt], 0, sizeof(mm[cnt]));
+                mm[cnt].msg_hdr.msg_iov = &iov[cnt];
+                mm[cnt].msg_hdr.msg_iovlen = 1;
+                if (tx->addressed) {
+                    memset(&to[cnt], 0, sizeof(to[cnt]));
+                    to[cnt].can_family = AF_CAN;
+                    to[cnt].can_ifindex = p->ifindex;
+                    mm[cnt].msg_hdr.msg_name = &to[cnt];
+                    mm[cnt].msg_hdr.msg_namelen = sizeof(to[cnt]);
+                }
+                from[cnt] = p;
+            }
+        }
+        if (cnt == 0u) {
+            return 0;
+        }
+        int r = sendmmsg(tx->fd, mm, cnt, MSG_DONTWAIT);
+        if (r > 0) {
+            /* A port's frames are consecutive from its head: pop in order. */
+            for (int k = 0; k < r; k++) {
+                txq_pop(from[k]);
+            }
+            tx->calls++;
+            tx->frames += (unsigned long)r;
+            continue; /* the rest, or the error of the first not sent */
+        }
+        int e = errno;
+        if (r < 0 && (e == EAGAIN || e == ENOBUFS || e == EINTR)) {
+            return txq_total(ports, n); /* the kernel's queue is full: later */
+        }
+        lp_port_t *p = from[0];
+        txq_pop(p); /* refused for good: lost (its link, or logged below) */
+        if (r < 0 && link_errno(e)) {
+            link_check(p, p->now, true);
+        } else if (lp_rate_allow(&p->err_rate, p->now, 3u)) {
+            lp_log("node %u: CAN write on %s failed: %s", p->node, p->iface,
+                   r < 0 ? strerror(e) : "nothing sent");
+        }
+    }
+}
+
 /* vcan has no bit rate: the rate is kept (bus-off recovery time) and a
  * change after the start (reset node with a new code, LSS activate bit
  * timing) is logged. */
@@ -418,9 +523,11 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
         p->tx_off++; /* a controller off the bus sends nothing */
         return false;
     }
-    if (p->txn == 0u && write_frame(p, frame) != 0) {
+    if (p->tx == NULL && p->txn == 0u && write_frame(p, frame) != 0) {
         return true; /* sent (or a hard error, already logged) */
     }
+    /* With the shared socket every frame waits for the pass's end
+     * (lp_tx_flush): microseconds, and one system call for all nodes. */
     if (p->txn >= LP_TXQ) {
         if (p->tx_lost++ % 100u == 0u) {
             lp_log("node %u: transmit queue full, frame %03X dropped (%lu so far)", p->node,

@@ -24,6 +24,8 @@
 #include "co_node.h"
 
 #define LP_TXQ 64u
+/* Frames handed to the kernel in one system call (sendmmsg, lp_tx_flush). */
+#define LP_TXB 128u
 /* Frames taken from the kernel in one system call (recvmmsg). */
 #define LP_RXB 32u
 /* While the interface is down or missing, look at it this often. */
@@ -58,8 +60,29 @@ typedef enum lp_link {
     LP_LINK_ABSENT,  /* no such interface (deleted), or not a CAN interface */
 } lp_link_t;
 
+/*
+ * The process's sending socket (lp_tx_open), shared by every node: each
+ * node's frames wait in its port's queue until the pass ends, and then go
+ * to the kernel together, one sendmmsg() for all nodes and interfaces
+ * (lp_tx_flush), each message addressed to its node's interface. 127
+ * nodes at a 10 ms TPDO made 12 700 write() calls a second, one socket
+ * each; a pass now makes one call for what its nodes sent (tools/busbench).
+ * The kernel loops each frame back to every other CAN socket on the host,
+ * the nodes' receiving sockets included (as a bus does), never to the one
+ * that sent it: a node does not hear itself. It receives nothing.
+ */
+typedef struct lp_tx {
+    int fd;                /* CAN_RAW socket bound to no interface, receiving nothing */
+    bool addressed;        /* each message names its port's interface (false: fd is a
+                            * connected socket, the unit tests') */
+    unsigned long calls;   /* sendmmsg() calls that sent something */
+    unsigned long frames;  /* frames sent */
+} lp_tx_t;
+
 typedef struct lp_port {
-    int fd;               /* CAN_RAW socket, non-blocking; kept across link changes */
+    int fd;               /* CAN_RAW socket, non-blocking; kept across link changes;
+                           * receives, and sends when tx is NULL */
+    lp_tx_t *tx;          /* the shared sending socket (NULL: write() on fd at once) */
     const char *iface;
     unsigned node;        /* index, for log lines */
     uint16_t kbps;        /* the node's bit rate (co_port_can_bitrate; vcan has none) */
@@ -163,8 +186,26 @@ void lp_report_drops(lp_port_t *p);
  */
 void lp_filter(lp_port_t *p, const co_node_t *node);
 
-/* Try to hand queued frames to the kernel. Returns frames still queued. */
+/* Try to hand queued frames to the kernel. Returns frames still queued.
+ * For a port with a shared sending socket, lp_tx_flush() does this. */
 unsigned lp_flush(lp_port_t *p);
+
+/*
+ * Open the shared sending socket (lp_tx_t). Returns 0, or -1 with a
+ * one-line cause in err (errlen bytes).
+ */
+int lp_tx_open(lp_tx_t *tx, char *err, unsigned errlen);
+void lp_tx_close(lp_tx_t *tx);
+
+/*
+ * Hand what the n ports (an array) queued to the kernel through tx, in as
+ * few sendmmsg() calls as the kernel allows (LP_TXB frames a call), each
+ * port's frames in their order. A port off the bus loses its queue; a
+ * frame the interface refuses for good (went down or away: the port's
+ * link watch takes note) is lost with it; a full kernel queue keeps the
+ * rest for the next call. Returns the frames still queued.
+ */
+unsigned lp_tx_flush(lp_tx_t *tx, lp_port_t *ports, unsigned n);
 
 /*
  * Read one frame. Returns 1 with *f filled, 0 when nothing (more) is
