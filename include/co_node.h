@@ -431,8 +431,8 @@ co_res_t co_node_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *b
 /* One CAN-ID a node consumes (co_node_rx_ids). */
 typedef struct co_rx_id {
     uint16_t id; /* 11-bit CAN-ID */
-    bool rtr;    /* true: only remote frames on it serve the node; false: any frame
-                  * on it may (the service looks at the RTR bit itself) */
+    bool rtr;    /* true: remote frames on it serve the node; false: data frames do
+                  * (every service that takes data frames ignores remote ones) */
 } co_rx_id_t;
 
 /* Entries co_node_rx_ids() may fill: NMT, SYNC, SDO, LSS, guarding,
@@ -452,7 +452,10 @@ typedef struct co_rx_id {
  * board may drop it. The list follows every change of a COB-ID or the
  * node-ID (SDO write, reset, LSS): a board asks again after each
  * co_node_receive() or co_node_poll() and compares. Writes up to max
- * entries to ids (owned by the caller) in a fixed order, no duplicates;
+ * entries to ids (owned by the caller) in a fixed order, no duplicates
+ * (a CAN-ID with a data and a remote use, say a heartbeat consumed from
+ * the node's own guarding ID, is there twice, once per kind: a board can
+ * match each exactly, which a SocketCAN filter does in constant time);
  * returns the count (at most CO_NODE_RX_IDS_MAX: more than max means
  * the list was cut at max). Reads the node only, never blocks. In its own
  * file (node_rx.c), so that an image that does not call it does not link it.

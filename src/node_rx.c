@@ -19,9 +19,7 @@
 static unsigned add(co_rx_id_t *ids, unsigned n, unsigned max, uint16_t id, bool rtr)
 {
     for (unsigned k = 0; k < n && k < max; k++) {
-        if (ids[k].id == id) {
-            /* One CAN-ID, two uses: any frame serves (the wider match). */
-            ids[k].rtr = ids[k].rtr && rtr;
+        if (ids[k].id == id && ids[k].rtr == rtr) {
             return n;
         }
     }

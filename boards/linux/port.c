@@ -298,14 +298,16 @@ uint32_t lp_poll(lp_port_t *p, uint32_t now)
 
 /* ---- CAN: frames -------------------------------------------------------- */
 
-/* The kernel's filter from the list: a classic frame on the CAN-ID (data
- * or remote, the node's service tells), or only remote frames on it. */
+/* The kernel's filter from the list: data frames on the CAN-ID, or remote
+ * frames on it, each an exact match. The RTR bit in the mask puts a data
+ * entry in the kernel's table indexed by CAN-ID (constant time); without
+ * it every entry of every socket was tried on every frame on the bus. */
 static void filter_install(lp_port_t *p)
 {
     struct can_filter cf[CO_NODE_RX_IDS_MAX];
     for (unsigned k = 0; k < p->nfilt; k++) {
         cf[k].can_id = p->filt[k].id | (p->filt[k].rtr ? CAN_RTR_FLAG : 0u);
-        cf[k].can_mask = CAN_SFF_MASK | CAN_EFF_FLAG | (p->filt[k].rtr ? CAN_RTR_FLAG : 0u);
+        cf[k].can_mask = CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG;
     }
     p->filt_changes++;
     if (setsockopt(p->fd, SOL_CAN_RAW, CAN_RAW_FILTER, cf,

@@ -27,11 +27,11 @@ static unsigned list(co_node_t *node, co_rx_id_t ids[CO_NODE_RX_IDS_MAX])
     return n < CO_NODE_RX_IDS_MAX ? n : CO_NODE_RX_IDS_MAX;
 }
 
-/* 1: (id, rtr) passes the list (an entry with rtr passes remote frames only). */
+/* 1: (id, rtr) passes the list (an entry passes the frames of its kind only). */
 static bool passes(const co_rx_id_t *ids, unsigned n, uint16_t id, bool rtr)
 {
     for (unsigned k = 0; k < n; k++) {
-        if (ids[k].id == id && (!ids[k].rtr || rtr)) {
+        if (ids[k].id == id && ids[k].rtr == rtr) {
             return true;
         }
     }
@@ -104,7 +104,7 @@ static void test_rx_ids_every_product(void)
             for (unsigned a = 0; a < n; a++) {
                 CHECK(ids[a].id <= 0x7FFu);
                 for (unsigned b = a + 1u; b < n; b++) {
-                    CHECK(ids[a].id != ids[b].id);
+                    CHECK(ids[a].id != ids[b].id || ids[a].rtr != ids[b].rtr);
                 }
             }
             CHECK(dropped_frames_unused(node) > 4000u);
@@ -147,9 +147,16 @@ static void test_rx_ids_follow_changes(void)
     n = list(d->node, ids);
     CHECK(has(ids, n, 0x081, false));
     CHECK(!passes(ids, n, 0x080, false));
+    SDO(d, "23 16 10 01 64 00 0A 00", "60 16 10 01 00 00 00 00"); /* watch 0x0A: its own ID */
+    n = list(d->node, ids);
+    CHECK(has(ids, n, 0x70A, false)); /* one CAN-ID, both kinds: two entries */
+    CHECK(has(ids, n, 0x70A, true));
+    CHECK(dropped_frames_unused(d->node) > 4000u);
     SDO(d, "23 16 10 01 64 00 05 00", "60 16 10 01 00 00 00 00"); /* watch node 5 */
     n = list(d->node, ids);
     CHECK(has(ids, n, 0x705, false));
+    CHECK(!passes(ids, n, 0x705, true));
+    CHECK(!passes(ids, n, 0x70A, false));
     SDO(d, "23 00 18 01 8A 01 00 C0", "60 00 18 01 00 00 00 00"); /* TPDO 1: no RTR */
     n = list(d->node, ids);
     CHECK(!passes(ids, n, 0x18A, true));
