@@ -266,6 +266,23 @@ static void log_held_input(app_t *a, uint32_t now)
     }
 }
 
+static void control_get(app_t *a, unsigned node, char *reply, size_t len);
+
+/* A `get` on standard input: the first node's answer, as the control
+ * socket gives it, on standard output (the program writes nothing else
+ * there while it runs), one line, flushed. */
+static void answer_get(app_t *a)
+{
+    if (!a->sim.get_request) {
+        return;
+    }
+    a->sim.get_request = false;
+    char reply[CTL_REPLY_MAX + 1u];
+    control_get(a, 0, reply, sizeof(reply));
+    printf("%s\n", reply);
+    fflush(stdout);
+}
+
 /* sim_report_fn: the log (and stderr for rejections, rate-limited). */
 static void report_line(void *ctx, const char *line, const char *error)
 {
@@ -273,6 +290,7 @@ static void report_line(void *ctx, const char *line, const char *error)
     if (error == NULL) {
         lp_log("stdin: %s", line);
         apply_can_command(a, now_us()); /* each `can` line when it comes */
+        answer_get(a);
         return;
     }
     uint32_t now = now_us();

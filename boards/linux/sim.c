@@ -522,6 +522,14 @@ bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
         s->quit = true;
         return true;
     }
+    if (strcmp(cmd, "get") == 0) {
+        if (strtok_r(NULL, " \t\r", &save) != NULL) {
+            snprintf(err, errlen, "get takes nothing after it");
+            return false;
+        }
+        s->get_request = true;
+        return true;
+    }
     if (strcmp(cmd, "fault") == 0) {
         char *what = strtok_r(NULL, " \t\r", &save);
         char *onoff = strtok_r(NULL, " \t\r", &save);
@@ -606,7 +614,7 @@ bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
         return can_command(s, &save, err, errlen);
     }
     snprintf(err, errlen,
-             "unknown command '%s' (set, ramp, sine, noise, replay, fault, can, quit)", cmd);
+             "unknown command '%s' (set, ramp, sine, noise, replay, fault, can, get, quit)", cmd);
     return false;
 }
 

@@ -102,6 +102,10 @@ typedef struct sim {
     bool stepped;     /* sim_step was called */
     uint32_t faults; /* bit i: the product's faults[i] is on */
     bool quit;
+    /* A `get` line (nothing after it) for the board to answer, then clear:
+     * standard input's answer goes to standard output (control.h for the
+     * socket's). */
+    bool get_request;
     /* A `can` command for the board to apply (to every node), then clear. */
     bool can_request;
     co_can_state_t can_state;

@@ -77,6 +77,11 @@ static void test_sim_commands(void)
     CHECK(sim_command(&s, "fault sensor off", err, sizeof(err)) && s.faults == 0u);
     CHECK(sim_command(&s, "", err, sizeof(err)));
     CHECK(sim_command(&s, "# comment", err, sizeof(err)));
+    CHECK(!s.get_request);
+    CHECK(sim_command(&s, "get", err, sizeof(err)) && s.get_request); /* the board answers */
+    s.get_request = false;
+    CHECK(!sim_command(&s, "get x", err, sizeof(err)) && !s.get_request);
+    CHECK(strstr(err, "get takes nothing after it") != NULL);
     CHECK(sim_command(&s, "quit", err, sizeof(err)) && s.quit);
     sim_t z;
     sim_init(&z, &dst_x730_z360);

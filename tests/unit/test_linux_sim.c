@@ -483,7 +483,7 @@ static void test_motion_lines(void)
     CHECK(strstr(last, "usage: sine") != NULL);
     static const char unknown[] = "wobble x\n";
     sim_feed(&s, unknown, sizeof(unknown) - 1u, report, last);
-    CHECK(strstr(last, "(set, ramp, sine, noise, replay, fault, can, quit)") != NULL);
+    CHECK(strstr(last, "(set, ramp, sine, noise, replay, fault, can, get, quit)") != NULL);
     sim_step(&s, at(2500000));
     CHECK_EQ(s.values[0], 15000);
 }
