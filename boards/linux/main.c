@@ -206,6 +206,7 @@ typedef struct app {
     lp_port_t ports[APP_MAX_NODES];
     leds_t leds[APP_MAX_NODES];
     uint8_t last_state[APP_MAX_NODES];
+    uint8_t last_id[APP_MAX_NODES]; /* active node-IDs last looked at (log_states) */
     const char *ifn[APP_MAX_NODES]; /* each node's interface */
     app_inst_t inst[APP_MAX_NODES];
     sim_t sim; /* standard input's line assembly, quit and `can`; its
@@ -341,8 +342,32 @@ static const char *nmt_name(uint8_t s)
     return (s < sizeof(names) / sizeof(names[0]) && names[s]) ? names[s] : "?";
 }
 
+/*
+ * Two nodes of this process with one active node-ID on one interface:
+ * logged (a warning each time the node-IDs change into a clash), nothing
+ * else. The command line's factory node-IDs are checked at start (exit
+ * 2), but a stored node-ID, an SDO write or LSS can make a clash later;
+ * the nodes run on, as real devices would, and their frames collide on
+ * the bus: the log says why.
+ */
+static void log_id_clashes(const app_t *a)
+{
+    for (unsigned i = 0; i < a->nnodes; i++) {
+        uint8_t id = co_node_id(a->nodes[i]);
+        for (unsigned j = 0; j < i && id >= 1u && id <= 127u; j++) {
+            if (co_node_id(a->nodes[j]) == id && strcmp(a->ifn[i], a->ifn[j]) == 0) {
+                lp_log("warning: node %u (%s) and node %u (%s) both have node-ID 0x%02X on %s: "
+                       "their frames collide", j, a->inst[a->node_inst[j]].prod->id, i,
+                       a->inst[a->node_inst[i]].prod->id, id, a->ifn[i]);
+            }
+        }
+    }
+}
+
+/* NMT state changes in the log; node-ID changes checked for clashes. */
 static void log_states(app_t *a)
 {
+    bool ids_changed = false;
     for (unsigned i = 0; i < a->nnodes; i++) {
         uint8_t s = (uint8_t)co_node_nmt_state(a->nodes[i]);
         if (s != a->last_state[i]) {
@@ -350,6 +375,14 @@ static void log_states(app_t *a)
             lp_log("node %u (ID 0x%02X): NMT %s", i, co_node_id(a->nodes[i]), name);
             a->last_state[i] = s;
         }
+        uint8_t id = co_node_id(a->nodes[i]);
+        if (id != a->last_id[i]) {
+            a->last_id[i] = id;
+            ids_changed = true;
+        }
+    }
+    if (ids_changed) {
+        log_id_clashes(a);
     }
 }
 

@@ -134,6 +134,28 @@ def test_own_stored_sets_and_restore_defaults_to_the_command_line_id(tmp_path, n
     b.stop()
 
 
+def test_a_clash_made_over_can_is_logged(tmp_path, network, bus):
+    """A node-ID clash the command line did not have, made later over CAN
+    (the JD's 3000h, then reset node): both nodes run on (as devices
+    would), and the log says which two collide; a new ID ends it."""
+    b = Bench(tmp_path, network, bus)
+    b.start([0x21, 0x22, 0x23])
+    try:
+        jd = b.node("jd2xxx", 0x22)
+        jd.sdo.download(0x3000, 0, bytes([0x20]))  # node number 0x20: node-ID 0x21, the DST's
+        jd.sdo.download(0x1010, 1, b"save")        # reset node loads the stored set
+        bus.clear()
+        network.send_message(0x000, bytes([0x81, 0x22]))  # reset node
+        assert bus.wait_for(0x721, timeout=3, pred=lambda m: bytes(m.data) == b"\0")
+        time.sleep(0.2)
+        log = (tmp_path / "sensor.log").read_text()
+        assert ("warning: node 0 (dst-x730-xy30) and node 1 (jd2xxx) both have node-ID 0x21 "
+                "on vcan0: their frames collide") in log
+        assert b.proc.poll() is None  # running on
+    finally:
+        b.stop()
+
+
 def test_two_node_product_and_two_interfaces(tmp_path, network, bus):
     """gsh-a-redundant@0x30 is nodes 0x30 and 0x31; /vcan1 puts one on vcan1."""
     b = Bench(tmp_path, network, bus, ["--node", "gsh-a-redundant@0x30",
