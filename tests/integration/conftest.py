@@ -74,6 +74,12 @@ class Sensor:
             cmd += ["--nvm", self.nvm]
         if self.control_path.exists():
             self.control_path.unlink()  # a power cut's stale socket
+        # Decision: standard input is /dev/null and --on-eof run, so the
+        # program's input is the control socket alone. The cost: the pipe no
+        # longer ties it to pytest, so a pytest killed outright leaves it
+        # running until tools/vcan-run tears User-Mode Linux down (on a host
+        # vcan, VCAN_RUN_MODE=host, until killed by hand); stop() at teardown
+        # ends it in every other case.
         self.proc = subprocess.Popen(cmd, stdin=subprocess.PIPE if self.stdin else subprocess.DEVNULL,
                                      stderr=subprocess.PIPE, text=True)
         try:
