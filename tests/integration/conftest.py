@@ -13,6 +13,7 @@ import time
 import can
 import canopen
 import pytest
+from canopen_sensor_sim import ControlClient, SimError
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 BINARY = os.environ.get("CANOPEN_SENSOR", str(ROOT / "build" / "bin" / "canopen-sensor"))
@@ -41,28 +42,99 @@ def pytest_sessionstart(session):
 
 class Sensor:
     """One canopen-sensor process. stop() + start() with the same --nvm file
-    is a power cycle; kill() is a power cut."""
+    is a power cycle; kill() is a power cut.
 
-    def __init__(self, product, tmp_path, nvm=True, iface=IFACE):
+    Its inputs are driven through its control socket (--control unix:PATH in
+    the test's directory, the package's ControlClient): send() for lines that
+    must be taken, command() for the raw answer of a line a test expects to be
+    refused, get() for the node's true inputs. Standard input is /dev/null
+    (--on-eof run) unless stdin=True: then write_stdin() types on it, for the
+    tests of standard input itself."""
+
+    def __init__(self, product, tmp_path, nvm=True, iface=IFACE, stdin=False):
         self.product = product
         self.iface = iface
         self.nvm = str(tmp_path / "eeprom.bin") if nvm else None
         self.log = tmp_path / "sensor.log"
+        self.control_path = tmp_path / "control.sock"
+        # sun_path holds 108 bytes with its NUL (Linux): a longer path cannot
+        # be bound, and the program would refuse it at start.
+        assert len(os.fsencode(self.control_path)) < 108, \
+            f"{self.control_path}: too long for a unix socket (give pytest a shorter --basetemp)"
+        self.stdin = stdin
         self.proc = None
+        self.control = None
+        self.stderr = ""
 
     def start(self):
-        cmd = [BINARY, "--product", self.product, "--iface", self.iface, "--log", str(self.log)]
+        """Power on; returns once the control socket answers."""
+        cmd = [BINARY, "--product", self.product, "--iface", self.iface, "--log", str(self.log),
+               "--control", f"unix:{self.control_path}", "--on-eof", "run"]
         if self.nvm:
             cmd += ["--nvm", self.nvm]
-        self.proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE,
-                                     text=True)
+        if self.control_path.exists():
+            self.control_path.unlink()  # a power cut's stale socket
+        # Decision: standard input is /dev/null and --on-eof run, so the
+        # program's input is the control socket alone. The cost: the pipe no
+        # longer ties it to pytest, so a pytest killed outright leaves it
+        # running until tools/vcan-run tears User-Mode Linux down (on a host
+        # vcan, VCAN_RUN_MODE=host, until killed by hand); stop() at teardown
+        # ends it in every other case.
+        self.proc = subprocess.Popen(cmd, stdin=subprocess.PIPE if self.stdin else subprocess.DEVNULL,
+                                     stderr=subprocess.PIPE, text=True)
+        try:
+            self.control = ControlClient.connect(self.control_path, proc=self.proc)
+        except SimError as e:
+            self.stop(signal.SIGKILL)
+            pytest.fail(f"{self.product}: {e}")
         return self
 
+    def command(self, line):
+        """One control line; its answer as it came: "ok ..." or "error: ..."."""
+        if self.control is None:
+            pytest.fail(f"{line!r}: canopen-sensor is not running")
+        return self.control.ask(line)
+
     def send(self, line):
+        """One control line that must be taken: an "error: ..." answer fails
+        the test; a `set` is then read back (check_taken). Returns the text
+        after "ok"."""
+        answer = self.command(line)
+        if answer != "ok" and not answer.startswith("ok "):
+            pytest.fail(f"{self.product}: {line!r} answered {answer!r}")
+        self.check_taken(line)
+        return answer[3:]
+
+    def check_taken(self, line):
+        """After a `set` line was answered "ok": every value it gave must be
+        the node's true input now, as `get` says (to the thousandth it
+        prints). Other lines: nothing to read back (`get` shows no faults)."""
+        words = line.split()
+        if not words or words[0] != "set":
+            return
+        now = self.get()
+        for token in words[1:]:
+            name, _, value = token.partition("=")
+            assert now.get(name) == pytest.approx(float(value), abs=0.0005), \
+                f"{line!r} answered ok, but get says {now}"
+
+    def get(self):
+        """The node's true inputs and NMT state from the control socket:
+        {"x": 12.5, ..., "nmt": "operational"}."""
+        if self.control is None:
+            pytest.fail("get: canopen-sensor is not running")
+        return self.control.get()
+
+    def write_stdin(self, line):
+        """One line on standard input (a Sensor made with stdin=True)."""
+        assert self.stdin, "write_stdin needs Sensor(..., stdin=True)"
         self.proc.stdin.write(line + "\n")
         self.proc.stdin.flush()
 
     def stop(self, sig=signal.SIGTERM):
+        if self.control is not None:
+            self.control.close()
+            self.control = None
         if self.proc is None:
             return None
         if self.proc.poll() is None:
@@ -70,7 +142,8 @@ class Sensor:
         try:
             rc = self.proc.wait(timeout=5)
         finally:
-            self.proc.stdin.close()
+            if self.proc.stdin:
+                self.proc.stdin.close()
             self.stderr = self.proc.stderr.read()
             self.proc.stderr.close()
             self.proc = None

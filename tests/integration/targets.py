@@ -3,7 +3,8 @@ product runs and how a test powers it, cuts its power, types on its input
 lines and reaches its bus.
 
 - linux: the canopen-sensor program on SocketCAN vcan0 (run the tests
-  through tools/vcan-run); the simulated input language on its stdin;
+  through tools/vcan-run); the simulated input language on its control
+  socket (--control unix:PATH), answered there ("ok" / "error: ...");
   --nvm FILE is its EEPROM.
 - rv32-virt, microbit: the bare-metal image build-<board>/bin/fw-<ID>.elf in
   qemu, started by tools/emu; the bus is python-can's slcan interface on
@@ -115,22 +116,16 @@ class LinuxTarget(Target):
     def kill(self):
         return self.sensor.kill()
 
-    def inject(self, line, timeout=1.0):
-        """Writes the line on its standard input and waits for its log to take
-        it ("stdin: LINE") or to reject it, which fails the test."""
+    def inject(self, line):
+        """Sends the line through the control socket; anything but "ok" fails
+        the test. A `set` is read back with `get` (Sensor.check_taken): the
+        node's input itself, not the log line the program writes for it."""
         if not self.sensor.alive():
             raise TargetError(f"inject {line!r}: canopen-sensor is not running")
-        seen = len(self.sensor.log_text())
-        self.sensor.send(line)
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            for entry in self.sensor.log_text()[seen:].splitlines():
-                if entry.endswith(f"stdin: {line}"):
-                    return
-                if "stdin rejected: " in entry:
-                    raise TargetError(f"linux: {line!r} rejected: {entry}")
-            time.sleep(0.01)
-        raise TargetError(f"linux: {line!r} not in canopen-sensor's log within {timeout} s")
+        answer = self.sensor.command(line)
+        if answer != "ok":
+            raise TargetError(f"linux: {line!r} answered {answer!r}")
+        self.sensor.check_taken(line)
 
     def close(self):
         self.sensor.stop()

@@ -163,3 +163,19 @@ def test_control_path_that_exists(tmp_path):
     c.close()
     proc.terminate()
     assert proc.wait(timeout=5) == 0
+
+
+def test_stdin_beside_the_control_socket_of_a_product(sensor_factory):
+    """The integration tests' Sensor (--product, --control) with its standard
+    input kept (stdin=True): a line typed there reaches the same node the
+    control socket reads back, and the socket's lines reach it too."""
+    sensor = sensor_factory("jd2xxx", stdin=True).start()
+    sensor.write_stdin("set x=7 y=-3")
+    deadline = time.monotonic() + 2
+    while sensor.get()["x"] != 7.0:
+        assert time.monotonic() < deadline, f"stdin's set not taken: {sensor.get()}"
+        time.sleep(0.02)
+    assert sensor.get()["y"] == -3.0
+    sensor.send("set y=4")
+    assert sensor.get()["x"] == 7.0
+    assert sensor.stop() == 0

@@ -20,6 +20,7 @@ import time
 
 import can
 import pytest
+from canopen_sensor_sim import ControlClient
 
 from conftest import BINARY
 
@@ -97,14 +98,20 @@ def sdo_write(b, node, index, sub, value, size=4):
 
 
 class Proc:
-    """canopen-sensor with its standard input a pipe, the log a file."""
+    """canopen-sensor with its standard input a pipe (the tests of standard
+    input write on it), the log a file; control=True adds a control socket
+    (.control, a ControlClient) for the tests that inject input."""
 
-    def __init__(self, tmp_path, product, iface="vcan0", nvm=None, extra=()):
+    def __init__(self, tmp_path, product, iface="vcan0", nvm=None, extra=(), control=False):
         self.log = tmp_path / f"{product}.log"
         cmd = [BINARY, "--product", product, "--iface", iface, "--log", str(self.log), *extra]
         if nvm is not None:
             cmd += ["--nvm", str(nvm)]
+        if control:
+            sock = tmp_path / f"{product}.sock"
+            cmd += ["--control", f"unix:{sock}"]
         self.p = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+        self.control = ControlClient.connect(sock, proc=self.p) if control else None
 
     def send(self, data):
         self.p.stdin.write(data)
@@ -122,6 +129,9 @@ class Proc:
         return False
 
     def stop(self, sig=signal.SIGTERM):
+        if self.control is not None:
+            self.control.close()
+            self.control = None
         if self.p.poll() is None:
             self.p.send_signal(sig)
         try:
@@ -413,13 +423,13 @@ def test_jd_bus_off_sends_nothing_then_8140(tmp_path, procs):
     the controller recovers (128 x 11 bits at 125 kbit/s = 11.3 ms); then
     EMCY 8140h "recovered from bus-off" and the heartbeat again."""
     node = 10
-    p, b = boot(procs, tmp_path, "jd2xxx", node)
+    p, b = boot(procs, tmp_path, "jd2xxx", node, control=True)
     assert sdo_write(b, node, 0x1017, 0, 20, 2) == 0
     b.shutdown()
     b = bus()  # everything on the bus: only the node sends
     frames(b, 0.1)
     t0 = time.time()
-    p.send(b"can bus-off 0.5\n")
+    assert p.control.ask("can bus-off 0.5") == "ok"
     seen = frames(b, 0.8)
     during = [m for m in seen if t0 + 0.05 < m.timestamp < t0 + 0.48]
     assert during == [], during
@@ -430,7 +440,7 @@ def test_jd_bus_off_sends_nothing_then_8140(tmp_path, procs):
     assert len(hb) >= 5
     # Without a hold the recovery alone: back within milliseconds.
     t0 = time.time()
-    p.send(b"can bus-off\n")
+    assert p.control.ask("can bus-off") == "ok"
     m = wait_for(b, 0x80 + node, 1, lambda m: m.data[0:2] == b"\x40\x81")
     assert m is not None and m.timestamp - t0 < 0.2
     b.shutdown()

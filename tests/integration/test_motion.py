@@ -1,4 +1,4 @@
-"""The simulator's motion end to end: a `ramp` typed on standard input moves
+"""The simulator's motion end to end: a `ramp` sent through the control socket moves
 the slope a DST X730 puts in its TPDO over time, at the ramp's rate; bad
 motion lines are answered and change nothing; --seed is checked."""
 import struct
@@ -22,14 +22,18 @@ def test_ramp_moves_the_tpdo_slope(sensor_factory, network, bus):
     node.sdo.download(0x6000, 0, struct.pack("<H", 10))  # 0.01 deg
     node.nmt.state = "OPERATIONAL"
     time.sleep(3)  # the angle filter settles at 0
-    # Malformed lines first: rejected whole, the slope stays where it is.
-    sensor.send("ramp x=30 in 0s")
-    sensor.send("ramp x=30 in 4")
-    sensor.send("sine x amp=5")
-    sensor.send("ramp q=30 in 4s")
+    # Malformed lines first: each refused with its cause, the input and the
+    # slope stay where they are.
+    for line, cause in [("ramp x=30 in 0s", "'0s': not a duration"),
+                        ("ramp x=30 in 4", "'4': not a duration"),
+                        ("sine x amp=5", "usage: sine x|y amp=A"),
+                        ("ramp q=30 in 4s", "usage: ramp x|y=VALUE in DURATION")]:
+        answer = sensor.command(line)
+        assert answer.startswith("error: ") and cause in answer, (line, answer)
     bus.clear()
     still = bus.collect(COB_TPDO1, 1.0)
     assert len(still) >= 8 and all(slope(f) == 0 for f in still), [slope(f) for f in still]
+    assert sensor.get()["x"] == 0.0
     # 0 -> 30 deg in 4 s: 750 (0.01 deg) a second, then held at 3000.
     sensor.send("ramp x=30 in 4s")
     frames = bus.collect(COB_TPDO1, 7.0)
@@ -48,10 +52,8 @@ def test_ramp_moves_the_tpdo_slope(sensor_factory, network, bus):
     rate = sum((t - mt) * (v - mv) for t, v in mid) / sum((t - mt) ** 2 for t, _ in mid)
     print(f"ramp rate seen in the TPDO: {rate:.0f} (0.01 deg)/s over {len(mid)} frames")
     assert 650 <= rate <= 850, rate
+    assert sensor.get()["x"] == 30.0  # the ramp's end, held
     assert sensor.stop() == 0
-    for cause in ("'0s': not a duration", "'4': not a duration", "usage: sine x|y amp=A",
-                  "usage: ramp x|y=VALUE in DURATION"):
-        assert cause in sensor.stderr, sensor.stderr
 
 
 def test_seed_option():

@@ -11,6 +11,11 @@ input, one command a line, answered ``ok ...`` or ``error: <cause>``.
         bus.ramp(0x21, "x", 30, seconds=5)
         assert bus.get(0x20)["nmt"] == "pre-operational"
 
+``ControlClient`` is the line client alone, for a process started some other
+way (with ``--control``): ``ControlClient.connect(path, proc=p)``, then
+``ask(line)`` (the raw answer), ``command(line)`` (raises on ``error:``) and
+``get()``.
+
 The program is found in ``$CANOPEN_SENSOR``, else on ``PATH``, else in the
 repository's ``build/bin`` (when this package runs from a checkout).
 """
@@ -22,7 +27,7 @@ import subprocess
 import tempfile
 import time
 
-__all__ = ["SimBus", "SimError", "find_program"]
+__all__ = ["ControlClient", "SimBus", "SimError", "find_program"]
 
 
 class SimError(RuntimeError):
@@ -59,6 +64,90 @@ def _value(v):
     return f"{v:.3f}" if isinstance(v, float) else str(v)
 
 
+def parse_get(answer):
+    """The text after ``ok`` of a ``get`` answer as a dict: numbers as
+    floats, the rest (``nmt``) as text."""
+    out = {}
+    for token in answer.split():
+        key, _, value = token.partition("=")
+        try:
+            out[key] = float(value)
+        except ValueError:
+            out[key] = value
+    return out
+
+
+class ControlClient:
+    """One connection to a control socket (``--control unix:PATH`` or
+    ``tcp:PORT``): one line out, one answer line back."""
+
+    def __init__(self, sock):
+        self._sock = sock
+        self._rx = b""
+
+    @classmethod
+    def connect(cls, address, proc=None, timeout=10.0):
+        """Connect to address (a unix socket path, or ``(host, port)``),
+        retrying until the program listens. proc (a ``subprocess.Popen``):
+        stop early, with its stderr, if it ends meanwhile. Raises SimError
+        when nothing answers within timeout seconds."""
+        family = socket.AF_INET if isinstance(address, tuple) else socket.AF_UNIX
+        target = address if family == socket.AF_INET else str(address)
+        deadline = time.monotonic() + timeout
+        while True:
+            if proc is not None and proc.poll() is not None:
+                err = proc.stderr.read() if proc.stderr else ""
+                if isinstance(err, bytes):
+                    err = err.decode(errors="replace")
+                raise SimError(f"canopen-sensor exited with {proc.returncode}: {err.strip()}")
+            s = socket.socket(family, socket.SOCK_STREAM)
+            try:
+                s.connect(target)
+                return cls(s)
+            except OSError:
+                s.close()
+                if time.monotonic() > deadline:
+                    raise SimError(f"no control socket at {address} after {timeout} s") from None
+                time.sleep(0.05)
+
+    def close(self):
+        if self._sock is not None:
+            self._sock.close()
+            self._sock = None
+
+    def ask(self, line, timeout=5.0):
+        """Send one line; return its answer line as it came (``ok ...`` or
+        ``error: ...``), without the newline."""
+        if self._sock is None:
+            raise SimError("the control connection is closed")
+        if "\n" in line:
+            raise SimError("one command a line")
+        self._sock.sendall((line + "\n").encode())
+        self._sock.settimeout(timeout)
+        while b"\n" not in self._rx:
+            chunk = self._sock.recv(4096)
+            if not chunk:
+                raise SimError(f"control socket closed while waiting for the answer to {line!r}")
+            self._rx += chunk
+        answer, self._rx = self._rx.split(b"\n", 1)
+        return answer.decode(errors="replace").strip()
+
+    def command(self, line, timeout=5.0):
+        """Send one line; return the text after ``ok``; raise SimError with
+        the cause on ``error: ...``."""
+        text = self.ask(line, timeout)
+        if text == "ok" or text.startswith("ok "):
+            return text[3:]
+        if text.startswith("error:"):
+            raise SimError(text[6:].strip())
+        raise SimError(f"unexpected answer {text!r} to {line!r}")
+
+    def get(self, selector=""):
+        """The node's true inputs and NMT state (see ``parse_get``); selector:
+        the line's node selector, empty for the first instance."""
+        return parse_get(self.command(f"{selector} get".strip()))
+
+
 class SimBus:
     """One canopen-sensor process with its nodes; a context manager.
 
@@ -82,8 +171,7 @@ class SimBus:
         self.control_path = pathlib.Path(self._tmp.name) / "control.sock"
         self.log_path = pathlib.Path(self._tmp.name) / "sensor.log"
         self.proc = None
-        self._sock = None
-        self._rx = b""
+        self._client = None
 
     # ---- the process ---------------------------------------------------
     def command_line(self):
@@ -102,32 +190,21 @@ class SimBus:
         """Power on every node; returns once the control socket answers."""
         if self.control_path.exists():
             self.control_path.unlink()
-        self._rx = b""
         self.proc = subprocess.Popen(self.command_line(), stdin=subprocess.DEVNULL,
                                      stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-        deadline = time.monotonic() + self.start_timeout
-        while True:
-            if self.proc.poll() is not None:
-                err = self.proc.stderr.read().decode(errors="replace").strip()
-                raise SimError(f"canopen-sensor exited with {self.proc.returncode}: {err}")
-            try:
-                s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-                s.connect(str(self.control_path))
-                self._sock = s
-                return self
-            except OSError:
-                s.close()
-                if time.monotonic() > deadline:
-                    self.stop()
-                    raise SimError(f"no control socket at {self.control_path} after "
-                                   f"{self.start_timeout} s")
-                time.sleep(0.05)
+        try:
+            self._client = ControlClient.connect(self.control_path, proc=self.proc,
+                                                 timeout=self.start_timeout)
+        except SimError:
+            self.stop()
+            raise
+        return self
 
     def stop(self, timeout=5.0):
         """Power off cleanly (SIGTERM); returns the exit status."""
-        if self._sock is not None:
-            self._sock.close()
-            self._sock = None
+        if self._client is not None:
+            self._client.close()
+            self._client = None
         if self.proc is None:
             return None
         if self.proc.poll() is None:
@@ -166,24 +243,9 @@ class SimBus:
     def command(self, line, node=None, timeout=5.0):
         """Send one control line (with node's selector); return the text after
         ``ok``; raise SimError with the cause on ``error: ...``."""
-        if self._sock is None:
+        if self._client is None:
             raise SimError("the bus is not started")
-        if "\n" in line:
-            raise SimError("one command a line")
-        self._sock.sendall((_selector(node) + line + "\n").encode())
-        self._sock.settimeout(timeout)
-        while b"\n" not in self._rx:
-            chunk = self._sock.recv(4096)
-            if not chunk:
-                raise SimError(f"control socket closed while waiting for the answer to {line!r}")
-            self._rx += chunk
-        answer, self._rx = self._rx.split(b"\n", 1)
-        text = answer.decode(errors="replace").strip()
-        if text == "ok" or text.startswith("ok "):
-            return text[3:]
-        if text.startswith("error:"):
-            raise SimError(text[6:].strip())
-        raise SimError(f"unexpected answer {text!r} to {line!r}")
+        return self._client.command(_selector(node) + line, timeout)
 
     def set(self, node, **values):
         """True input values (the input's unit): ``bus.set(0x20, x=12.5)``."""
@@ -207,11 +269,4 @@ class SimBus:
     def get(self, node):
         """The node's true inputs and NMT state: ``{"x": 12.5, "nmt": "operational"}``
         (numbers as floats, the rest as text)."""
-        out = {}
-        for token in self.command("get", node).split():
-            key, _, value = token.partition("=")
-            try:
-                out[key] = float(value)
-            except ValueError:
-                out[key] = value
-        return out
+        return parse_get(self.command("get", node))
