@@ -79,12 +79,28 @@ def test_ten_processes_keep_their_timing(raw, tmp_path):
         assert all(s.alive() for s in sensors)
         u0 = utime_ticks(sensors[0].proc.pid)
         seen = {}
-        end = time.monotonic() + SECONDS
-        while time.monotonic() < end:
-            m = raw.recv(0.1)
-            if m is not None and not m.is_remote_frame:
-                seen.setdefault(m.arbitration_id, []).append(m.timestamp)
-        ticks = utime_ticks(sensors[0].proc.pid) - u0
+        # The window in the kernel's receive time stamps: the socket still
+        # holds the frames of the set-up (the configuration runs, seconds
+        # before), which once made a "silence" of 3 s at the window's start;
+        # and a reader that lags reads the window's end after it.
+        t_open = time.time()
+        t_close = t_open + SECONDS
+        ticks = None
+        while True:
+            m = raw.recv(0.5)
+            if ticks is None and time.time() >= t_close:
+                ticks = utime_ticks(sensors[0].proc.pid) - u0
+            if m is None:
+                if time.time() > t_close + 0.5:
+                    break
+                continue
+            if m.timestamp < t_open or m.is_remote_frame:
+                continue
+            if m.timestamp > t_close:
+                break
+            seen.setdefault(m.arbitration_id, []).append(m.timestamp)
+        if ticks is None:
+            ticks = utime_ticks(sensors[0].proc.pid) - u0
         hz = os.sysconf("SC_CLK_TCK")
         print(f"\nnode 0x20 among {NODES}: user CPU {ticks / hz / SECONDS * 100:.2f} % "
               f"({ticks} ticks of 1/{hz} s in {SECONDS} s)")
@@ -110,9 +126,13 @@ def test_ten_processes_keep_their_timing(raw, tmp_path):
                         "stalled, not a node); run on a less loaded machine")
         span = every[-1] - every[0]
         bad = []
+        outside = {TPDO_MS: [0, 0], HB_MS: [0, 0]}  # intervals outside +-10 %, all intervals
         for i in ids:
             for cob, period_ms in ((0x180 + i, TPDO_MS), (0x700 + i, HB_MS)):
                 ts = seen.get(cob, [])
+                for a, b in zip(ts, ts[1:]):
+                    outside[period_ms][0] += abs((b - a) * 1000 - period_ms) > period_ms * TOLERANCE
+                    outside[period_ms][1] += 1
                 want = span * 1000 / period_ms
                 if abs(len(ts) - want) > want * TOLERANCE:
                     bad.append(f"{cob:03X}: {len(ts)} frames in {span:.2f} s, {want:.0f} expected")
@@ -121,6 +141,8 @@ def test_ten_processes_keep_their_timing(raw, tmp_path):
                 median = gaps[len(gaps) // 2]
                 if abs(median - period_ms) > period_ms * TOLERANCE:
                     bad.append(f"{cob:03X}: median interval {median:.2f} ms, {period_ms} ms wanted")
+        for period_ms, (n_out, n_all) in outside.items():
+            print(f"{period_ms} ms: {n_out} of {n_all} intervals outside +-10 %")
         assert not bad, "\n".join(bad)
     finally:
         for s in sensors:
