@@ -478,12 +478,14 @@ unsigned lp_tx_flush(lp_tx_t *tx, lp_port_t *ports, unsigned n)
         }
         int r = sendmmsg(tx->fd, mm, cnt, MSG_DONTWAIT);
         if (r > 0) {
-            /* A port's frames are consecutive from its head: pop in order. */
-            for (int k = 0; k < r; k++) {
+            /* A port's frames are consecutive from its head: pop in order.
+             * (The kernel never reports more than it was given.) */
+            unsigned sent = co_min_u32((unsigned)r, cnt);
+            for (unsigned k = 0; k < sent; k++) {
                 txq_pop(from[k]);
             }
             tx->calls++;
-            tx->frames += (unsigned long)r;
+            tx->frames += sent;
             continue; /* the rest, or the error of the first not sent */
         }
         int e = errno;
