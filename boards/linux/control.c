@@ -69,9 +69,9 @@ static int open_unix(ctl_t *c, const char *path, char *err, size_t errlen)
 
 static int open_tcp(ctl_t *c, const char *port, char *err, size_t errlen)
 {
-    char *end;
-    long p = strtol(port, &end, 10);
-    if (port[0] == '\0' || *end != '\0' || p < 1 || p > 65535) {
+    size_t digits = strspn(port, "0123456789"); /* no sign, no blanks */
+    long p = digits == 0u || digits > 5u || port[digits] != '\0' ? 0 : strtol(port, NULL, 10);
+    if (p < 1 || p > 65535) {
         snprintf(err, errlen, "--control tcp:%s: not a port 1..65535", port);
         return -2;
     }

@@ -161,11 +161,31 @@ static uint32_t now_us(void)
     return (uint32_t)((uint64_t)ts.tv_sec * 1000000u + (uint64_t)ts.tv_nsec / 1000u);
 }
 
+/*
+ * A number as the command line and the control lines write it: decimal
+ * digits ("33", "033" is 33 too: no octal), or 0x and hex digits ("0x21").
+ * No sign, no blanks. True with *out (at most max), false otherwise.
+ */
+static bool parse_number(const char *s, long max, long *out)
+{
+    bool hex = s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
+    const char *d = hex ? s + 2 : s;
+    size_t n = strspn(d, hex ? "0123456789abcdefABCDEF" : "0123456789");
+    if (n == 0u || d[n] != '\0' || n > 9u) {
+        return false;
+    }
+    long v = strtol(d, NULL, hex ? 16 : 10);
+    if (v > max) {
+        return false;
+    }
+    *out = v;
+    return true;
+}
+
 static int parse_int(const char *s, int *out)
 {
-    char *end;
-    long v = strtol(s, &end, 0);
-    if (end == s || *end != '\0' || v < 0 || v > 4096) {
+    long v;
+    if (!parse_number(s, 4096, &v)) {
         return -1;
     }
     *out = (int)v;
@@ -501,9 +521,8 @@ static int parse_node(options_t *o, const char *arg)
     char *at = strchr(name, '@');
     if (at != NULL) {
         *at = '\0';
-        char *end;
-        long id = strtol(at + 1, &end, 0);
-        if (at[1] == '\0' || *end != '\0' || id < 1 || id > 127) {
+        long id = 0;
+        if (!parse_number(at + 1, 127, &id) || id < 1) {
             return USAGE_ERROR("--node %s: node-ID '%s' is not 1..127 (e.g. 0x21 or 33)", arg,
                                at + 1);
         }
@@ -722,8 +741,10 @@ static int nvm_file(const options_t *o, unsigned k, uint8_t id, char *buf, size_
     if (k == 0u && o->prod != NULL && o->nvm_path != NULL) {
         *path = o->nvm_path;
     } else if (o->nvm_dir != NULL) {
-        if (snprintf(buf, len, "%s/%s-0x%02X.nvm", o->nvm_dir, o->spec[k].prod->id, id) >=
-            (int)len) {
+        /* The interface is in the name: the same product at the same
+         * node-ID on two buses is two devices, two files. */
+        if (snprintf(buf, len, "%s/%s-0x%02X-%s.nvm", o->nvm_dir, o->spec[k].prod->id, id,
+                     o->spec[k].ifn[0]) >= (int)len) {
             return -1;
         }
         *path = buf;
@@ -1012,9 +1033,8 @@ static const char *select_nodes(app_t *a, const char *line, unsigned *first, uns
         *end = a->nnodes;
         return rest;
     }
-    char *e;
-    long v = strtol(tok[0] == '@' ? tok + 1 : tok, &e, tok[0] == '@' ? 10 : 0);
-    bool num = e != (tok[0] == '@' ? tok + 1 : tok) && *e == '\0' && v >= 0;
+    long v = -1;
+    bool num = parse_number(tok[0] == '@' ? tok + 1 : tok, 100000, &v);
     if (tok[0] == '@') {
         if (!num || v >= (long)a->nnodes) {
             snprintf(err, errlen, "no node %s (@0..@%u, or @all)", tok, a->nnodes - 1u);

@@ -110,7 +110,7 @@ def test_three_products_in_one_process(tmp_path, network, bus):
         b.stop()
     names = sorted(f.name for f in b.nvm.iterdir())
     # Only the P+F stores every write by itself (autonomous store): its own file.
-    assert names == ["inx360d-0x23.nvm"], names
+    assert names == ["inx360d-0x23-vcan0.nvm"], names
 
 
 def test_own_stored_sets_and_restore_defaults_to_the_command_line_id(tmp_path, network, bus):
@@ -123,7 +123,7 @@ def test_own_stored_sets_and_restore_defaults_to_the_command_line_id(tmp_path, n
         jd.sdo.download(0x1010, 1, b"save")                # ... stored
     finally:
         b.stop()
-    assert sorted(f.name for f in b.nvm.iterdir()) == ["jd2xxx-0x22.nvm"]
+    assert sorted(f.name for f in b.nvm.iterdir()) == ["jd2xxx-0x22-vcan0.nvm"]
     b.start([0x21, 0x40, 0x23])  # a power cycle: the stored ID; the others as they were
     try:
         jd = b.node("jd2xxx", 0x40)
@@ -154,6 +154,46 @@ def test_a_clash_made_over_can_is_logged(tmp_path, network, bus):
         assert b.proc.poll() is None  # running on
     finally:
         b.stop()
+
+
+def sdo_on(channel, node_id, request, timeout=2.0):
+    """One SDO request on a bus of its own; the answer's 8 bytes."""
+    import can
+    with can.Bus(interface="socketcan", channel=channel) as b:
+        b.send(can.Message(arbitration_id=0x600 + node_id, data=bytes.fromhex(request),
+                           is_extended_id=False))
+        end = time.monotonic() + timeout
+        while (left := end - time.monotonic()) > 0:
+            m = b.recv(left)
+            if m is not None and m.arbitration_id == 0x580 + node_id:
+                return bytes(m.data)
+    return None
+
+
+def test_one_id_on_two_buses_is_two_devices_with_two_files(tmp_path):
+    """jd2xxx@0x21 on vcan0 and on vcan1: each saves into its own file
+    (the interface is in the name), and each reads its own value back
+    after a power cycle."""
+    nvm = tmp_path / "nvm"
+    nvm.mkdir()
+    cmd = [BINARY, "--on-eof", "run", "--nvm-dir", str(nvm), "--log", str(tmp_path / "log"),
+           "--node", "jd2xxx@0x21/vcan0", "--node", "jd2xxx@0x21/vcan1"]
+    for run_no in range(2):
+        proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL)
+        try:
+            time.sleep(0.5)
+            if run_no == 0:
+                for ch, hb in (("vcan0", "3412"), ("vcan1", "7707")):
+                    assert sdo_on(ch, 0x21, f"2B171000{hb}0000")[0] == 0x60
+                    assert sdo_on(ch, 0x21, "2310100173617665")[0] == 0x60  # save
+            else:
+                assert sdo_on("vcan0", 0x21, "4017100000000000")[4:6] == bytes.fromhex("3412")
+                assert sdo_on("vcan1", 0x21, "4017100000000000")[4:6] == bytes.fromhex("7707")
+        finally:
+            proc.terminate()
+            assert proc.wait(timeout=5) == 0
+    assert sorted(f.name for f in nvm.iterdir()) == ["jd2xxx-0x21-vcan0.nvm",
+                                                     "jd2xxx-0x21-vcan1.nvm"]
 
 
 def test_two_node_product_and_two_interfaces(tmp_path, network, bus):
