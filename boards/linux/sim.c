@@ -4,10 +4,13 @@
 #include "sim.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 static int input_index(const product_t *p, const char *name, size_t len)
 {
@@ -370,13 +373,29 @@ static unsigned csv_fields(char *line, char *field[], unsigned max)
     }
 }
 
-/* Read and check a replay file into *r (col[] set). False with the cause. */
-static bool replay_load(const sim_t *s, const char *file, sim_replay_t *r, char *err,
-                        unsigned errlen)
+bool sim_replay_load(const product_t *prod, const char *file, sim_replay_t *r, char *err,
+                     unsigned errlen)
 {
-    FILE *f = fopen(file, "r");
+    /* Opened without waiting (a FIFO with no writer would block the
+     * whole program, every node), and only a regular file is read. */
+    int fd = open(file, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    struct stat st;
+    if (fd < 0 || fstat(fd, &st) != 0) {
+        snprintf(err, errlen, "replay %s: %s", file, strerror(errno));
+        if (fd >= 0) {
+            close(fd);
+        }
+        return false;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        snprintf(err, errlen, "replay %s: not a regular file", file);
+        close(fd);
+        return false;
+    }
+    FILE *f = fdopen(fd, "r");
     if (f == NULL) {
         snprintf(err, errlen, "replay %s: %s", file, strerror(errno));
+        close(fd);
         return false;
     }
     char line[SIM_LINE_MAX + 2u];
@@ -417,7 +436,7 @@ static bool replay_load(const sim_t *s, const char *file, sim_replay_t *r, char 
                 break;
             }
             for (unsigned k = 1; k < n && ok; k++) {
-                int i = input_index(s->prod, field[k], strlen(field[k]));
+                int i = input_index(prod, field[k], strlen(field[k]));
                 if (i < 0 || r->col[i] >= 0) {
                     snprintf(err, errlen, "replay %s: line %u: '%s' is %s", file, no, field[k],
                              i < 0 ? "not one of the product's inputs" : "named twice");
@@ -459,7 +478,7 @@ static bool replay_load(const sim_t *s, const char *file, sim_replay_t *r, char 
         }
         r->t_us[r->rows] = tu;
         for (unsigned k = 1; k < n && ok; k++) {
-            double lim = s->prod->inputs[input_of[k - 1u]].limit;
+            double lim = prod->inputs[input_of[k - 1u]].limit;
             if (!parse_value(field[k], lim, &r->v[r->rows][k - 1u])) {
                 snprintf(err, errlen, "replay %s: line %u: '%s' not a number within +-%.0f",
                          file, no, field[k], lim);
@@ -480,13 +499,8 @@ static bool replay_load(const sim_t *s, const char *file, sim_replay_t *r, char 
     return ok;
 }
 
-/* `replay FILE`: the former replay stops, the file's inputs follow it. */
-static bool replay_command(sim_t *s, const char *file, char *err, unsigned errlen)
+void sim_replay_start(sim_t *s, const sim_replay_t *table)
 {
-    sim_replay_t r;
-    if (!replay_load(s, file, &r, err, errlen)) {
-        return false;
-    }
     int32_t now[PRODUCT_MAX_INPUTS];
     for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
         now[i] = motion_value(s, i, s->t_us);
@@ -496,13 +510,15 @@ static bool replay_command(sim_t *s, const char *file, char *err, unsigned errle
             start_motion(s, i, SIM_HOLD, now[i]); /* the former replay stops */
         }
     }
-    s->replay = r;
+    if (table != &s->replay) {
+        s->replay = *table;
+    }
     for (unsigned i = 0; i < PRODUCT_MAX_INPUTS; i++) {
-        if (r.col[i] >= 0) {
+        if (s->replay.col[i] >= 0) {
             start_motion(s, i, SIM_REPLAY, now[i]);
         }
     }
-    return true;
+    compute(s);
 }
 
 bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
@@ -604,10 +620,11 @@ bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
             snprintf(err, errlen, "usage: replay FILE.csv (no spaces in FILE)");
             return false;
         }
-        if (!replay_command(s, file, err, errlen)) {
+        sim_replay_t r;
+        if (!sim_replay_load(s->prod, file, &r, err, errlen)) {
             return false;
         }
-        compute(s);
+        sim_replay_start(s, &r);
         return true;
     }
     if (strcmp(cmd, "can") == 0) {

@@ -149,6 +149,17 @@ typedef void (*sim_report_fn)(void *ctx, const char *line, const char *error);
  */
 void sim_feed(sim_t *s, const char *data, size_t n, sim_report_fn report, void *ctx);
 
+/*
+ * `replay FILE` in two steps, so that one file serves many instances of a
+ * product read once (the control socket's @all): load FILE's table for
+ * prod (a regular file only, opened without waiting; false with the cause
+ * in err, *r then unusable), then start it on a sim of that product (its
+ * former replay stops, the file's inputs follow the table from now).
+ */
+bool sim_replay_load(const product_t *prod, const char *file, sim_replay_t *r, char *err,
+                     unsigned errlen);
+void sim_replay_start(sim_t *s, const sim_replay_t *r);
+
 /* End of input: a last line without its newline is applied like any other. */
 void sim_feed_end(sim_t *s, sim_report_fn report, void *ctx);
 

@@ -179,3 +179,27 @@ def test_stdin_beside_the_control_socket_of_a_product(sensor_factory):
     sensor.send("set y=4")
     assert sensor.get()["x"] == 7.0
     assert sensor.stop() == 0
+
+
+def test_replay_reads_regular_files_once_for_all(sim, tmp_path):
+    """A FIFO (or any file that is not regular) is refused at once: opening
+    it used to block the whole program; @all starts one table on every
+    instance that has its inputs, or on none."""
+    proc, client = sim
+    c = client()
+    fifo = tmp_path / "f.csv"
+    os.mkfifo(fifo)
+    assert c.ask(f"replay {fifo}") == f"error: replay {fifo}: not a regular file"
+    assert c.ask(f"replay {tmp_path}") == f"error: replay {tmp_path}: not a regular file"
+    assert c.ask("get").startswith("ok x=0.000")  # still answering
+    table = tmp_path / "t.csv"
+    table.write_text("t,x\n0,12\n1000,12\n")
+    # inx360d's x is 0..360 as well: every instance has an x.
+    assert c.ask(f"@all replay {table}") == "ok"
+    time.sleep(0.1)
+    for sel in ("0x21", "0x22", "0x23"):
+        assert c.ask(f"{sel} get").startswith("ok x=12.000"), sel
+    bad = tmp_path / "b.csv"
+    bad.write_text("t,y\n0,5\n")  # the INX has no y: refused for all, nothing changes
+    assert c.ask(f"@all replay {bad}").startswith("error: inx360d: replay")
+    assert c.ask("0x21 get").startswith("ok x=12.000 y=0.000")
