@@ -17,6 +17,7 @@
  */
 #include <errno.h>
 #include <getopt.h>
+#include <poll.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -242,6 +243,7 @@ typedef struct app {
     ctl_t ctl;             /* --control (ctl.fd -1: none) */
     lp_tx_t tx;            /* the one sending socket (port.h) */
     sim_replay_t replay;   /* a control line's replay table (control_replay) */
+    unsigned long out_dropped; /* answers to get that standard output could not take */
     bool no_pwait2;        /* the kernel has no epoll_pwait2: epoll_wait */
 } app_t;
 
@@ -293,17 +295,29 @@ static void control_get(app_t *a, unsigned node, char *reply, size_t len);
 
 /* A `get` on standard input: the first node's answer, as the control
  * socket gives it, on standard output (the program writes nothing else
- * there while it runs), one line, flushed. */
+ * there while it runs), one line. Never waits: when standard output
+ * cannot take the line at once (a pipe nobody reads), the answer is
+ * dropped and counted in the log, and the nodes run on. */
 static void answer_get(app_t *a)
 {
     if (!a->sim.get_request) {
         return;
     }
     a->sim.get_request = false;
-    char reply[CTL_REPLY_MAX + 1u];
-    control_get(a, 0, reply, sizeof(reply));
-    printf("%s\n", reply);
-    fflush(stdout);
+    char reply[CTL_REPLY_MAX + 2u];
+    control_get(a, 0, reply, sizeof(reply) - 1u);
+    size_t n = strlen(reply);
+    reply[n++] = '\n';
+    struct pollfd pf = {.fd = STDOUT_FILENO, .events = POLLOUT};
+    /* A pipe with room takes a line of this size whole (atomic below PIPE_BUF). */
+    if (poll(&pf, 1, 0) == 1 && (pf.revents & POLLOUT) != 0 &&
+        write(STDOUT_FILENO, reply, n) == (ssize_t)n) {
+        return;
+    }
+    if (a->out_dropped++ % 100u == 0u) {
+        lp_log("standard output cannot take the answer to get: dropped (%lu so far)",
+               a->out_dropped);
+    }
 }
 
 /* sim_report_fn: the log (and stderr for rejections, rate-limited). */

@@ -203,3 +203,27 @@ def test_replay_reads_regular_files_once_for_all(sim, tmp_path):
     bad.write_text("t,y\n0,5\n")  # the INX has no y: refused for all, nothing changes
     assert c.ask(f"@all replay {bad}").startswith("error: inx360d: replay")
     assert c.ask("0x21 get").startswith("ok x=12.000 y=0.000")
+
+
+def test_a_full_standard_output_holds_nothing_up(tmp_path):
+    """`get` on standard input answers on standard output; a pipe nobody
+    reads fills up, and the answers are then dropped (counted in the log)
+    while the nodes and the control socket carry on."""
+    sock = str(tmp_path / "ctl.sock")
+    proc = subprocess.Popen([BINARY, "--iface", IFACE, "--product", "dst-x730-xy30", "--log",
+                             str(tmp_path / "log"), "--control", f"unix:{sock}"],
+                            stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+    try:
+        c = Client(sock)
+        proc.stdin.write(b"get\n" * 5000)  # about 200 kB of answers: more than a pipe holds
+        proc.stdin.flush()
+        time.sleep(1.0)
+        assert c.ask("get").startswith("ok x=0.000"), "the loop is held up"
+        c.close()
+        assert "standard output cannot take the answer to get: dropped" in \
+            (tmp_path / "log").read_text()
+        first = proc.stdout.readline()
+        assert first.startswith(b"ok x=0.000 y=0.000 ")
+    finally:
+        proc.terminate()
+        assert proc.wait(timeout=5) == 0
