@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/epoll.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
@@ -140,8 +141,17 @@ static void drop(ctl_client_t *k)
     k->len = 0;
 }
 
-/* A complete line of client k: answered; false when the answer failed. */
-static bool line_done(ctl_client_t *k, ctl_line_fn fn, void *ctx)
+/* Append one answer line to client k's buffer (room was checked). */
+static void queue_reply(ctl_client_t *k, const char *text)
+{
+    size_t n = strnlen(text, CTL_REPLY_MAX);
+    memcpy(k->out + k->olen, text, n);
+    k->olen += n;
+    k->out[k->olen++] = '\n';
+}
+
+/* A complete line of client k: answered into its buffer. */
+static void line_done(ctl_client_t *k, ctl_line_fn fn, void *ctx)
 {
     char out[CTL_REPLY_MAX + 1u];
     if (k->overflow) {
@@ -153,36 +163,45 @@ static bool line_done(ctl_client_t *k, ctl_line_fn fn, void *ctx)
         if (k->len > 0u && k->line[k->len - 1u] == '\r') {
             k->line[k->len - 1u] = '\0';
         }
+        out[0] = '\0';
         fn(ctx, k->line, out, sizeof(out));
     }
     k->len = 0;
     k->overflow = false;
     k->nul = false;
-    return reply(k, out);
+    queue_reply(k, out);
 }
 
-bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx)
+/* Hand waiting answers to the kernel; false when the client is gone. */
+static bool flush_out(ctl_client_t *k)
 {
-    if (k >= CTL_CLIENTS || c->cl[k].fd < 0) {
-        return false;
+    while (k->olen > 0u) {
+        ssize_t n = send(k->fd, k->out, k->olen, MSG_NOSIGNAL | MSG_DONTWAIT);
+        if (n < 0 && (errno == EAGAIN || errno == EINTR)) {
+            return true;
+        }
+        if (n <= 0) {
+            return false;
+        }
+        memmove(k->out, k->out + n, k->olen - (size_t)n);
+        k->olen -= (size_t)n;
     }
-    ctl_client_t *cl = &c->cl[k];
-    char buf[512];
-    ssize_t n = recv(cl->fd, buf, sizeof(buf), MSG_DONTWAIT);
-    if (n < 0 && (errno == EAGAIN || errno == EINTR)) {
-        return true;
-    }
-    if (n <= 0) {
-        drop(cl); /* gone: a partial line is discarded */
-        return false;
-    }
-    for (ssize_t i = 0; i < n; i++) {
-        char ch = buf[i];
+    return true;
+}
+
+/* Room for one more answer. */
+static bool out_room(const ctl_client_t *k)
+{
+    return CTL_OUT - k->olen >= CTL_REPLY_MAX + 1u;
+}
+
+/* Look at the read bytes while their answers fit. */
+static void take_input(ctl_client_t *cl, ctl_line_fn fn, void *ctx)
+{
+    while (cl->ipos < cl->ilen && out_room(cl)) {
+        char ch = cl->in[cl->ipos++];
         if (ch == '\n') {
-            if (!line_done(cl, fn, ctx)) {
-                drop(cl);
-                return false;
-            }
+            line_done(cl, fn, ctx);
         } else if (ch == '\0') {
             cl->nul = true;
         } else if (cl->len < CTL_LINE_MAX) {
@@ -191,7 +210,61 @@ bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx)
             cl->overflow = true;
         }
     }
+}
+
+bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx)
+{
+    if (k >= CTL_CLIENTS || c->cl[k].fd < 0) {
+        return false;
+    }
+    ctl_client_t *cl = &c->cl[k];
+    if (!flush_out(cl)) {
+        drop(cl);
+        return false;
+    }
+    take_input(cl, fn, ctx); /* what an earlier call left */
+    if (cl->ipos >= cl->ilen && out_room(cl)) {
+        ssize_t n = recv(cl->fd, cl->in, sizeof(cl->in), MSG_DONTWAIT);
+        if (n < 0 && (errno == EAGAIN || errno == EINTR)) {
+            n = -1;
+        } else if (n <= 0) {
+            drop(cl); /* gone: a partial line is discarded */
+            return false;
+        }
+        if (n > 0) {
+            cl->ipos = 0;
+            cl->ilen = (size_t)n;
+            take_input(cl, fn, ctx);
+        }
+    }
+    if (!flush_out(cl)) {
+        drop(cl);
+        return false;
+    }
+    /* The kernel took answers: the lines that waited for room go on
+     * (at most the CTL_IN bytes read; the loop ends when those are done
+     * or the kernel is full, then EPOLLOUT brings the client back). */
+    while (cl->ipos < cl->ilen && out_room(cl)) {
+        take_input(cl, fn, ctx);
+        if (!flush_out(cl)) {
+            drop(cl);
+            return false;
+        }
+    }
     return true;
+}
+
+uint32_t ctl_events(const ctl_t *c, unsigned k)
+{
+    const ctl_client_t *cl = &c->cl[k];
+    uint32_t ev = 0;
+    if (cl->ipos >= cl->ilen && out_room(cl)) {
+        ev |= EPOLLIN;
+    }
+    if (cl->olen > 0u) {
+        ev |= EPOLLOUT;
+    }
+    return ev;
 }
 
 void ctl_close(ctl_t *c)

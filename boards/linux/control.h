@@ -4,8 +4,10 @@
  * answer line for each ("ok ..." or "error: <cause>"). This module owns
  * the sockets and the line assembly; the program answers each line
  * (ctl_line_fn). Everything runs in the program's one thread; nothing
- * blocks: a client that does not read its answers loses them (a reply
- * the kernel cannot take at once is dropped and the client closed).
+ * blocks: answers the kernel cannot take at once wait in the client's
+ * buffer, and while it is full the client's further lines wait unread
+ * (in the kernel), so a client that sends faster than it reads is slowed
+ * down, never cut off, and one that stops reading only holds its slot.
  */
 #ifndef LINUX_CONTROL_H
 #define LINUX_CONTROL_H
@@ -20,6 +22,11 @@
 #define CTL_LINE_MAX 255u
 /* Longest answer line, without its newline. */
 #define CTL_REPLY_MAX 511u
+/* Answers waiting for the kernel, per client: lines are taken while one
+ * more answer fits. */
+#define CTL_OUT (8u * (CTL_REPLY_MAX + 1u))
+/* Bytes read from a client in one call. */
+#define CTL_IN 512u
 
 /* Answer one complete line (no newline): write the answer into reply
  * (len bytes) without its newline. */
@@ -31,6 +38,11 @@ typedef struct ctl_client {
     size_t len;
     bool overflow; /* longer than CTL_LINE_MAX: answered with an error at its end */
     bool nul;      /* held a NUL byte: answered with an error at its end */
+    char in[CTL_IN]; /* read, not looked at yet (the answers' buffer was full) */
+    size_t ipos, ilen;
+    char out[CTL_OUT]; /* answers the kernel has not taken yet */
+    size_t olen;
+    uint32_t events; /* epoll events registered for fd (the caller keeps it, ctl_events) */
 } ctl_client_t;
 
 typedef struct ctl {
@@ -58,10 +70,15 @@ static inline int ctl_fd(const ctl_t *c)
  * (its fd is c->cl[slot].fd, for epoll), or -1 when none was added. */
 int ctl_accept(ctl_t *c);
 
-/* Read what client slot k has; each complete line is answered through fn.
- * Returns false when the client is gone (closed here; a partial line is
+/* Serve client slot k (it is readable or writable): send what waits, read
+ * and answer complete lines through fn while their answers fit. Returns
+ * false when the client is gone (closed here; a partial line is
  * discarded). */
 bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx);
+
+/* The epoll events client k needs now: EPOLLIN while it may send more
+ * lines, EPOLLOUT while answers wait for the kernel. */
+uint32_t ctl_events(const ctl_t *c, unsigned k);
 
 /* Close every client and the listening socket (a unix path is removed);
  * nothing when ctl_open() was not called or failed (c->fd -1). */

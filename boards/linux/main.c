@@ -1215,9 +1215,20 @@ static void handle_event(app_t *a, uint32_t src, uint32_t t)
             struct epoll_event ev = {.events = EPOLLIN};
             ev.data.u32 = EV_CLIENT + (uint32_t)k;
             epoll_ctl(a->ep, EPOLL_CTL_ADD, a->ctl.cl[k].fd, &ev);
+            a->ctl.cl[k].events = EPOLLIN;
         }
     } else if (src >= EV_CLIENT && src < EV_CLIENT + CTL_CLIENTS) {
-        (void)ctl_read(&a->ctl, src - EV_CLIENT, control_line, a); /* a closed fd leaves epoll */
+        unsigned k = src - EV_CLIENT;
+        if (ctl_read(&a->ctl, k, control_line, a)) { /* a closed fd leaves epoll */
+            /* Reading waits while answers wait (control.h). */
+            uint32_t want = ctl_events(&a->ctl, k);
+            if (want != a->ctl.cl[k].events) {
+                struct epoll_event ev = {.events = want};
+                ev.data.u32 = src;
+                epoll_ctl(a->ep, EPOLL_CTL_MOD, a->ctl.cl[k].fd, &ev);
+                a->ctl.cl[k].events = want;
+            }
+        }
     } else if (src < a->nnodes) {
         co_frame_t f;
         /* At most 64 frames, then the timers again: a flooded bus

@@ -227,3 +227,22 @@ def test_a_full_standard_output_holds_nothing_up(tmp_path):
     finally:
         proc.terminate()
         assert proc.wait(timeout=5) == 0
+
+
+def test_a_client_faster_than_it_reads_is_slowed_down_not_cut_off(sim):
+    """3000 lines in one go: every answer comes, in order (the program
+    stops reading the client while its answers wait for the kernel); a
+    client that never reads only holds its own slot."""
+    proc, client = sim
+    lazy = client()
+    lazy.s.sendall(b"get\n" * 20000)  # never reads a byte of its answers
+    c = client()
+    lines = [f"0x22 set x={i % 90}" if i % 2 else "0x22 get" for i in range(3000)]
+    c.s.sendall(("\n".join(lines) + "\n").encode())
+    for i, line in enumerate(lines):
+        answer = c.f.readline().decode().rstrip("\n")
+        if i % 2:
+            assert answer == "ok", (i, answer)
+        else:
+            assert answer.startswith(f"ok x={(i - 1) % 90 if i else 0}.000 "), (i, answer)
+    assert client().ask("get").startswith("ok x=0.000")  # others served meanwhile
