@@ -8,7 +8,7 @@ import time
 import canopen
 import pytest
 
-from canopen_sensor_sim import SimError
+from canopen_sensor_sim import SimBus, SimError
 
 
 def test_two_sensors_driven_from_the_test(sensor_bus, sensor_interface):
@@ -50,3 +50,18 @@ def test_restart_keeps_the_stored_set(sensor_bus, sensor_interface):
         assert int.from_bytes(node.sdo.upload(0x1017, 0), "little") == 250
     finally:
         net.disconnect()
+
+
+def test_misuse_is_refused(sensor_interface):
+    with pytest.raises(SimError, match="a list of"):
+        SimBus("jd1xxx@0x42", interface=sensor_interface)
+    bus = SimBus(["jd1xxx@0x41"], interface=sensor_interface)
+    try:
+        bus.start()
+        first = bus.proc
+        with pytest.raises(SimError, match="running already"):
+            bus.start()
+        assert bus.proc is first and first.poll() is None
+    finally:
+        bus.close()
+    assert first.poll() is not None  # no orphan left

@@ -159,6 +159,9 @@ class SimBus:
 
     def __init__(self, nodes, interface="vcan0", nvm_dir=None, seed=None, program=None,
                  extra=(), start_timeout=10.0):
+        if isinstance(nodes, (str, bytes)):
+            raise SimError(f"nodes: a list of 'PRODUCT[@NODEID][/IFACE]' strings, not {nodes!r} "
+                           "alone (write [" + repr(nodes) + "])")
         self.nodes = list(nodes)
         self.interface = interface
         self.seed = seed
@@ -188,6 +191,8 @@ class SimBus:
 
     def start(self):
         """Power on every node; returns once the control socket answers."""
+        if self.proc is not None and self.proc.poll() is None:
+            raise SimError("the bus is running already: stop() it first")
         if self.control_path.exists():
             self.control_path.unlink()
         self.proc = subprocess.Popen(self.command_line(), stdin=subprocess.DEVNULL,
