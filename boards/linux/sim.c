@@ -83,6 +83,18 @@ static int64_t div_round(int64_t num, int64_t den)
     return num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
 }
 
+/* a * b / c rounded (b >= 0, c > 0). Exact in 64 bits while a * b fits;
+ * beyond (the GSH-A's +-100 000 mm ramped over a day: 2e8 x 8.6e10), in
+ * double, whose error there is far below a thousandth. */
+static int64_t scale_round(int64_t a, int64_t b, int64_t c)
+{
+    int64_t mag = a >= 0 ? a : -a;
+    if (b == 0 || mag <= INT64_MAX / b) {
+        return div_round(a * b, c);
+    }
+    return (int64_t)llround((double)a * (double)b / (double)c);
+}
+
 /* The motion's value of input i at simulated time t (noise left out). */
 static int32_t motion_value(const sim_t *s, unsigned i, uint64_t t)
 {
@@ -93,8 +105,8 @@ static int32_t motion_value(const sim_t *s, unsigned i, uint64_t t)
         if (el >= m->dur_us) {
             return m->to;
         }
-        return m->from + (int32_t)div_round(((int64_t)m->to - m->from) * (int64_t)el,
-                                            (int64_t)m->dur_us);
+        return m->from + (int32_t)scale_round((int64_t)m->to - m->from, (int64_t)el,
+                                              (int64_t)m->dur_us);
     case SIM_SINE: {
         double phase = (double)(el % m->dur_us) / (double)m->dur_us;
         return m->from + (int32_t)lround((double)m->amp * sin(6.283185307179586 * phase));
@@ -114,7 +126,7 @@ static int32_t motion_value(const sim_t *s, unsigned i, uint64_t t)
         }
         int64_t v0 = r->v[k - 1u][c];
         int64_t dt = (int64_t)(r->t_us[k] - r->t_us[k - 1u]);
-        return (int32_t)(v0 + div_round((r->v[k][c] - v0) * (int64_t)(el - r->t_us[k - 1u]), dt));
+        return (int32_t)(v0 + scale_round(r->v[k][c] - v0, (int64_t)(el - r->t_us[k - 1u]), dt));
     }
     case SIM_HOLD:
     default:

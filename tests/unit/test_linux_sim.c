@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "dst.h"
+#include "gsh.h"
 #include "sim.h"
 
 #include "harness.h"
@@ -514,9 +515,32 @@ static void test_clock(void)
     CHECK_EQ(s.values[1], 1000);
 }
 
+/* The widest ramp: the GSH-A's length from -100 000 to +100 000 mm over a
+ * day. (to - from) x elapsed passes 2^63 after 12.8 h (undefined
+ * behaviour before the fix, UBSan says so); the value stays on the line. */
+static void test_ramp_wide(void)
+{
+    sim_t s;
+    sim_init(&s, &gsh_a);
+    sim_step(&s, T0);
+    CHECK(cmd(&s, "set length=-100000"));
+    CHECK(cmd(&s, "ramp length=100000 in 86400s"));
+    uint64_t t = 0;
+    for (unsigned h = 1; h <= 24u; h++) {
+        for (unsigned q = 0; q < 4u; q++) { /* quarter hours: the board clock wraps hourly */
+            t += 900000000u;
+            sim_step(&s, at(t));
+        }
+        double want = -100000.0 + 200000.0 * h / 24.0; /* mm */
+        CHECK(fabs(s.values[0] / 1000.0 - want) < 0.001);
+    }
+    CHECK_EQ(s.values[0], 100000000); /* the end, held */
+}
+
 int main(void)
 {
     RUN(test_ramp);
+    RUN(test_ramp_wide);
     RUN(test_ramp_rejected);
     RUN(test_sine);
     RUN(test_noise);
