@@ -418,19 +418,26 @@ bool sim_replay_load(const product_t *prod, const char *file, sim_replay_t *r, c
     bool ok = true;
     memset(r, 0, sizeof(*r));
     memset(r->col, -1, sizeof(r->col));
+    long before = ftell(f);
     while (ok && fgets(line, sizeof(line), f) != NULL) {
         no++;
         size_t len = strlen(line);
+        long after = ftell(f);
+        /* fgets stops at nothing but a newline or the buffer's end: fewer
+         * characters than it consumed means a NUL byte (a regular file:
+         * ftell counts). */
+        bool nul = before >= 0 && after > before && (size_t)(after - before) != len;
+        before = after;
+        if (nul) {
+            snprintf(err, errlen, "replay %s: line %u: holds a NUL byte", file, no);
+            ok = false;
+            break;
+        }
         if (len > 0u && line[len - 1u] == '\n') {
             line[--len] = '\0';
         } else if (!feof(f)) {
             snprintf(err, errlen, "replay %s: line %u: longer than %u characters", file, no,
                      SIM_LINE_MAX);
-            ok = false;
-            break;
-        }
-        if (strlen(line) != len) {
-            snprintf(err, errlen, "replay %s: line %u: holds a NUL byte", file, no);
             ok = false;
             break;
         }

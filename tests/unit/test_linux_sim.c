@@ -425,6 +425,33 @@ static void test_replay_bad_files(void)
         }
         CHECK(memcmp(&s, &before, sizeof(s)) == 0); /* nothing changed */
     }
+    /* NUL bytes, in a middle line and in a last line without its newline:
+     * named as such (they were "longer than 255 characters", and the
+     * last line was cut at the NUL and taken). */
+    static const struct {
+        const char bytes[24];
+        size_t len;
+        const char *error;
+    } nul[] = {
+        {"t,x\n0,1\n1,2\0junk", 16, "line 3: holds a NUL byte"},
+        {"t,x\n0,1\0x\n1,2\n", 14, "line 2: holds a NUL byte"},
+    };
+    for (size_t k = 0; k < sizeof(nul) / sizeof(nul[0]); k++) {
+        snprintf(path, sizeof(path), "%s/nul.csv", dir);
+        FILE *f = fopen(path, "wb");
+        CHECK(f != NULL);
+        if (f != NULL) {
+            CHECK_EQ(fwrite(nul[k].bytes, 1, nul[k].len, f), nul[k].len);
+            fclose(f);
+        }
+        snprintf(line, sizeof(line), "replay %s", path);
+        CHECK(!sim_command(&s, line, err, sizeof(err)));
+        if (strstr(err, nul[k].error) == NULL) {
+            FAIL(err);
+        }
+        CHECK(memcmp(&s, &before, sizeof(s)) == 0);
+        unlink(path);
+    }
     /* A line longer than SIM_LINE_MAX, more rows than SIM_REPLAY_ROWS. */
     char big[400];
     memset(big, '1', sizeof(big));
