@@ -631,7 +631,12 @@ static int parse_options(int argc, char **argv, options_t *o)
         case 'i': o->iface = optarg; break;
         case 'n': o->nvm_path = optarg; break;
         case 'D': o->nvm_dir = optarg; break;
-        case 'C': o->control = optarg; break;
+        case 'C':
+            if (o->control != NULL) {
+                return USAGE_ERROR("--control given twice (one control socket a process)");
+            }
+            o->control = optarg;
+            break;
         case 'N': {
             int rc = parse_node(o, optarg);
             if (rc != GO_ON) {
@@ -1068,7 +1073,8 @@ static const char *select_nodes(app_t *a, const char *line, unsigned *first, uns
     }
     if (found != 1u) {
         snprintf(err, errlen, found == 0u ? "no node with node-ID %s" :
-                 "node-ID %s on several interfaces: select it by index (@N)", tok);
+                 "node-ID %s is held by more than one node (several interfaces, or a clash): "
+                 "select it by index (@N)", tok);
         return NULL;
     }
     *end = *first + 1u;
