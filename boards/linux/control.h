@@ -24,7 +24,7 @@
 #define CTL_REPLY_MAX 511u
 /* Answers waiting for the kernel, per client: lines are taken while one
  * more answer fits. */
-#define CTL_OUT (8u * (CTL_REPLY_MAX + 1u))
+#define CTL_OUT ((size_t)8 * (CTL_REPLY_MAX + 1u))
 /* Bytes read from a client in one call. */
 #define CTL_IN 512u
 

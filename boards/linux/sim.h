@@ -158,7 +158,7 @@ void sim_feed(sim_t *s, const char *data, size_t n, sim_report_fn report, void *
  */
 bool sim_replay_load(const product_t *prod, const char *file, sim_replay_t *r, char *err,
                      unsigned errlen);
-void sim_replay_start(sim_t *s, const sim_replay_t *r);
+void sim_replay_start(sim_t *s, const sim_replay_t *table);
 
 /* End of input: a last line without its newline is applied like any other. */
 void sim_feed_end(sim_t *s, sim_report_fn report, void *ctx);
