@@ -61,9 +61,10 @@ static void usage(FILE *f)
             "                     IFACE: its interface(s) (A or A,B), else --iface's first.\n"
             "                     127 nodes at most; one factory node-ID twice on one\n"
             "                     interface is refused\n"
-            "  --nvm-dir DIR      an EEPROM file per instance: DIR/PRODUCT-0xNN.nvm (NN: the\n"
-            "                     factory node-ID of its first node; a two-node product's\n"
-            "                     nodes share one file); --nvm, if given, stays --product's\n"
+            "  --nvm-dir DIR      an EEPROM file per instance: DIR/PRODUCT-0xNN-IFACE.nvm\n"
+            "                     (NN: the factory node-ID of its first node, IFACE its\n"
+            "                     interface; a two-node product's nodes share one file);\n"
+            "                     --nvm, if given, stays --product's\n"
             "  --control unix:PATH|tcp:PORT\n"
             "                     take the standard-input commands from clients of a unix\n"
             "                     socket or a TCP port on 127.0.0.1 too; each line may begin\n"
@@ -750,10 +751,11 @@ static int print_eds(const product_t *prod)
 }
 
 /* The EEPROM file of instance k: --nvm for the --product instance, else
- * DIR/PRODUCT-0xID.nvm with --nvm-dir (ID: the factory node-ID of the
- * instance's first node, from the command line or the product's default;
- * a two-node product's both nodes share its file, as they share the
- * device), else none (RAM). Returns 0, or -1 when the name is too long. */
+ * DIR/PRODUCT-0xID-IFACE.nvm with --nvm-dir (ID: the factory node-ID of
+ * the instance's first node, from the command line or the product's
+ * default; IFACE: its interface; a two-node product's both nodes share
+ * its file, as they share the device), else none (RAM). Returns 0, or -1
+ * when the name is too long. */
 static int nvm_file(const options_t *o, unsigned k, uint8_t id, char *buf, size_t len,
                     const char **path)
 {
@@ -829,8 +831,24 @@ static int open_inst_nvm(app_t *a, const options_t *o, unsigned k, bool logf)
     char err[600];
     char file[4096];
     const char *path;
-    if (nvm_file(o, k, co_node_factory_id(a->nodes[in->first]), file, sizeof(file), &path) != 0) {
+    uint8_t id = co_node_factory_id(a->nodes[in->first]);
+    if (nvm_file(o, k, id, file, sizeof(file), &path) != 0) {
         return USAGE_ERROR("--nvm-dir %s: too long", o->nvm_dir);
+    }
+    /* The name before the interface was in it (DIR/PRODUCT-0xID.nvm):
+     * taken over, renamed, when the new name does not exist yet, so that
+     * a stored set saved by an earlier version is not silently left behind. */
+    char former[4096];
+    if (path == file && access(file, F_OK) != 0 &&
+        snprintf(former, sizeof(former), "%s/%s-0x%02X.nvm", o->nvm_dir, in->prod->id, id) <
+            (int)sizeof(former) &&
+        access(former, F_OK) == 0) {
+        if (rename(former, file) == 0) {
+            lp_log("EEPROM file %s renamed %s (the interface is in the name now)", former, file);
+        } else {
+            lp_log("warning: EEPROM file %s (the former name) not renamed %s: %s: this run "
+                   "starts from defaults", former, file, strerror(errno));
+        }
     }
     int r = lp_nvm_open(&in->nvm, path, in->nvm_mem,
                         (uint32_t)(in->prod->nodes * CO_STORE_NVM_SIZE), err, sizeof(err));

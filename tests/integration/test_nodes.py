@@ -196,6 +196,27 @@ def test_one_id_on_two_buses_is_two_devices_with_two_files(tmp_path):
                                                      "jd2xxx-0x21-vcan1.nvm"]
 
 
+def test_a_file_of_the_former_name_is_taken_over(tmp_path, network, bus):
+    """DIR/PRODUCT-0xNN.nvm (before the interface was in the name) is
+    renamed to the new name at start, its stored set kept."""
+    b = Bench(tmp_path, network, bus)
+    b.start([0x21, 0x22, 0x23])
+    try:
+        jd = b.node("jd2xxx", 0x22)
+        jd.sdo.download(0x1017, 0, (0x1234).to_bytes(2, "little"))
+        jd.sdo.download(0x1010, 1, b"save")
+    finally:
+        b.stop()
+    (b.nvm / "jd2xxx-0x22-vcan0.nvm").rename(b.nvm / "jd2xxx-0x22.nvm")
+    b.start([0x21, 0x22, 0x23])
+    try:
+        assert jd.sdo.upload(0x1017, 0) == (0x1234).to_bytes(2, "little")
+    finally:
+        b.stop()
+    assert not (b.nvm / "jd2xxx-0x22.nvm").exists()
+    assert "jd2xxx-0x22.nvm renamed" in (tmp_path / "sensor.log").read_text()
+
+
 def test_two_node_product_and_two_interfaces(tmp_path, network, bus):
     """gsh-a-redundant@0x30 is nodes 0x30 and 0x31; /vcan1 puts one on vcan1."""
     b = Bench(tmp_path, network, bus, ["--node", "gsh-a-redundant@0x30",
