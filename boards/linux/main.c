@@ -949,9 +949,6 @@ static int set_up(app_t *a, const options_t *o)
     if (lp_tx_open(&a->tx, err, sizeof(err)) != 0) {
         return start_failure(logf, 1, err);
     }
-    for (unsigned i = 0; i < a->nnodes; i++) {
-        a->ports[i].tx = &a->tx;
-    }
 
     sigset_t sigs;
     sigemptyset(&sigs);
@@ -1158,6 +1155,13 @@ static void control_replay(app_t *a, const char *args, unsigned k0, unsigned k1,
     snprintf(reply, len, "ok");
 }
 
+/* Whether the line's first word is word. */
+static bool is_command(const char *cmd, const char *word)
+{
+    size_t n = strlen(word);
+    return strncmp(cmd, word, n) == 0 && (cmd[n] == '\0' || strchr(" \t\r", cmd[n]) != NULL);
+}
+
 /* ctl_line_fn: one control line, answered "ok ..." or "error: <cause>". A
  * line for several instances is checked on copies first and applied to
  * all or none (a bad line changes nothing, as on standard input). */
@@ -1173,7 +1177,7 @@ static void control_line(void *ctx, const char *line, char *reply, size_t len)
         return;
     }
     cmd += strspn(cmd, " \t");
-    if (strncmp(cmd, "get", 3) == 0 && (cmd[3] == '\0' || strchr(" \t\r", cmd[3]) != NULL)) {
+    if (is_command(cmd, "get")) {
         if (cmd[3 + strspn(cmd + 3, " \t\r")] != '\0') {
             snprintf(reply, len, "error: get takes nothing after it");
         } else if (end - first != 1u && a->inst[a->node_inst[first]].prod->nodes != end - first) {
@@ -1189,7 +1193,7 @@ static void control_line(void *ctx, const char *line, char *reply, size_t len)
     }
     unsigned k0 = a->node_inst[first];
     unsigned k1 = a->node_inst[end - 1u];
-    if (strncmp(cmd, "replay", 6) == 0 && (cmd[6] == '\0' || strchr(" \t\r", cmd[6]) != NULL)) {
+    if (is_command(cmd, "replay")) {
         control_replay(a, cmd + 6, k0, k1, line, reply, len);
         return;
     }

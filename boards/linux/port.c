@@ -178,6 +178,17 @@ static void link_check(lp_port_t *p, uint32_t now, bool lost)
     p->link = (int)l;
 }
 
+/* A raw CAN socket, non-blocking; -1 with the cause in err. */
+static int can_socket(char *err, unsigned errlen)
+{
+    int fd = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
+    if (fd < 0) {
+        snprintf(err, errlen, "CAN socket: %s (is CAN supported by this kernel? see tools/vcan-run)",
+                 strerror(errno));
+    }
+    return fd;
+}
+
 int lp_open(lp_port_t *p, const char *iface, unsigned node, lp_nvm_t *nvm, uint32_t now,
             char *err, unsigned errlen)
 {
@@ -186,10 +197,8 @@ int lp_open(lp_port_t *p, const char *iface, unsigned node, lp_nvm_t *nvm, uint3
     p->node = node;
     p->nvm = nvm;
     p->now = now;
-    p->fd = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
+    p->fd = can_socket(err, errlen);
     if (p->fd < 0) {
-        snprintf(err, errlen, "CAN socket: %s (is CAN supported by this kernel? see tools/vcan-run)",
-                 strerror(errno));
         return -1;
     }
     can_err_mask_t mask = CAN_ERR_MASK;
@@ -354,56 +363,12 @@ static bool link_errno(int e)
     return e == ENETDOWN || e == ENODEV || e == ENXIO || e == ENETUNREACH;
 }
 
-static int write_frame(lp_port_t *p, const co_frame_t *f)
-{
-    struct can_frame cf;
-    memset(&cf, 0, sizeof(cf));
-    cf.can_id = f->id | (f->rtr ? CAN_RTR_FLAG : 0u);
-    cf.len = f->dlc;
-    memcpy(cf.data, f->data, f->dlc);
-    ssize_t n = write(p->fd, &cf, sizeof(cf));
-    if (n == (ssize_t)sizeof(cf)) {
-        return 1;
-    }
-    if (n < 0 && (errno == EAGAIN || errno == ENOBUFS)) {
-        return 0; /* the kernel's queue is full: keep it for later */
-    }
-    if (n < 0 && link_errno(errno)) {
-        link_check(p, p->now, true); /* the frame is lost with the link */
-        return -1;
-    }
-    if (lp_rate_allow(&p->err_rate, p->now, 3u)) {
-        lp_log("node %u: CAN write on %s failed: %s", p->node, p->iface,
-               n < 0 ? strerror(errno) : "short write");
-    }
-    return -1;
-}
-
-unsigned lp_flush(lp_port_t *p)
-{
-    while (p->txn > 0u && lp_can_state(p) != CO_CAN_BUSOFF) {
-        int r = write_frame(p, &p->txq[p->txh]);
-        if (r == 0) {
-            break;
-        }
-        /* sent, or failed for good (logged): either way it leaves the queue */
-        p->txh = (p->txh + 1u) % LP_TXQ;
-        p->txn--;
-    }
-    if (lp_can_state(p) == CO_CAN_BUSOFF) {
-        drop_txq(p);
-    }
-    return p->txn;
-}
-
 int lp_tx_open(lp_tx_t *tx, char *err, unsigned errlen)
 {
     memset(tx, 0, sizeof(*tx));
     tx->addressed = true;
-    tx->fd = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
+    tx->fd = can_socket(err, errlen);
     if (tx->fd < 0) {
-        snprintf(err, errlen, "CAN socket: %s (is CAN supported by this kernel? see tools/vcan-run)",
-                 strerror(errno));
         return -1;
     }
     /* Never bound: it receives nothing (the empty filter says so twice);
@@ -527,11 +492,8 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
         p->tx_off++; /* a controller off the bus sends nothing */
         return false;
     }
-    if (p->tx == NULL && p->txn == 0u && write_frame(p, frame) != 0) {
-        return true; /* sent (or a hard error, already logged) */
-    }
-    /* With the shared socket every frame waits for the pass's end
-     * (lp_tx_flush): microseconds, and one system call for all nodes. */
+    /* Every frame waits for the pass's end (lp_tx_flush): microseconds,
+     * and one system call for all nodes. */
     if (p->txn >= LP_TXQ) {
         if (p->tx_lost++ % 100u == 0u) {
             lp_log("node %u: transmit queue full, frame %03X dropped (%lu so far)", p->node,

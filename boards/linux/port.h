@@ -81,8 +81,7 @@ typedef struct lp_tx {
 
 typedef struct lp_port {
     int fd;               /* CAN_RAW socket, non-blocking; kept across link changes;
-                           * receives, and sends when tx is NULL */
-    lp_tx_t *tx;          /* the shared sending socket (NULL: write() on fd at once) */
+                           * receives (frames go out through an lp_tx_t) */
     const char *iface;
     unsigned node;        /* index, for log lines */
     uint16_t kbps;        /* the node's bit rate (co_port_can_bitrate; vcan has none) */
@@ -185,10 +184,6 @@ void lp_report_drops(lp_port_t *p);
  * filters existed. node is only read.
  */
 void lp_filter(lp_port_t *p, const co_node_t *node);
-
-/* Try to hand queued frames to the kernel. Returns frames still queued.
- * For a port with a shared sending socket, lp_tx_flush() does this. */
-unsigned lp_flush(lp_port_t *p);
 
 /*
  * Open the shared sending socket (lp_tx_t). Returns 0, or -1 with a
