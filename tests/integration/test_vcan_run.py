@@ -126,14 +126,35 @@ def test_command_ignoring_the_signal_gets_the_grace_time(tmp_path):
     assert_torn_down(f"vcanrun{p.pid}", tmp_path)
 
 
-def test_sigkill_of_vcan_run_leaves_no_uml(tmp_path):
-    """Nothing can be trapped: UML's parent-death signal ends it."""
-    p = start(tmp_path, "echo ready > $D/ready; sleep 60")
-    wait_file(tmp_path / "ready", p)
+def test_sigkill_of_vcan_run_leaves_nothing(tmp_path):
+    """Nothing can be trapped: UML's parent-death signal ends it, and
+    vcan-run's janitor removes its work directory, copy of the caller's
+    environment and all. That copy is its owner's alone while it exists
+    (mode 0600; the command inside removes it once read)."""
+    p = start(tmp_path, "echo ready > $D/ready; sleep 60", VCAN_RUN_SECRET="s3cret")
+    modes = set()
+    end = time.monotonic() + BOOT
+    while not (tmp_path / "ready").exists():
+        assert p.poll() is None, p.communicate()
+        assert time.monotonic() < end, "the command did not start inside User-Mode Linux"
+        for f in (tmp_path / "tmp").glob("vcan-run.*/*"):
+            try:
+                modes.add((f.name, f.stat().st_mode & 0o777))
+            except FileNotFoundError:
+                pass
+        time.sleep(0.005)
+    assert ("env", 0o600) in modes, modes
+    # What vcan-run writes there (the command's words, directory and the
+    # scripts too); User-Mode Linux's own files (its pid, its mconsole
+    # socket) take the caller's umask, as the command's files do.
+    ours = {"env", "cmd", "cwd", "init", "run"}
+    assert all(m & 0o077 == 0 for name, m in modes if name in ours), modes
+    envs = list((tmp_path / "tmp").glob("vcan-run.*/env"))
+    assert envs == [], "the environment's copy is still there while the command runs"
     umid = f"vcanrun{p.pid}"
     p.kill()
     p.communicate(timeout=30)
     end = time.monotonic() + PROMPT
-    while uml_pids(umid) and time.monotonic() < end:
+    while (uml_pids(umid) or list((tmp_path / "tmp").iterdir())) and time.monotonic() < end:
         time.sleep(0.1)
-    assert uml_pids(umid) == [], f"linux.uml processes of {umid} left running"
+    assert_torn_down(umid, tmp_path)
