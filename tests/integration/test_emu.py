@@ -538,3 +538,32 @@ def test_flash_file_of_zeros_takes_saves(board, emus, tmp_path):
     # The PARA set is whole; the DST's LSS set (slots 2 and 3) still holds
     # zeros, and is reported by the same bit until it is stored too.
     assert slots(flash, board)[:2].count("valid") == 1
+
+
+def ask(bus, line, timeout=5):
+    """One input line on the serial line, its answer (frames meanwhile read
+    and dropped)."""
+    while not bus.answers.empty():
+        bus.answers.get_nowait()
+    bus.write_line(line)
+    end = time.monotonic() + timeout
+    while bus.answers.empty():
+        assert time.monotonic() < end, f"no answer to {line!r}"
+        bus.recv(timeout=0.05)
+    return bus.answers.get_nowait()
+
+
+def test_get_and_the_commands_not_on_this_target(board, emus):
+    """The image takes `get` as the Linux program does (the true inputs,
+    without its nmt= word), and answers the Linux program's commands it does
+    not have by name, not as unknown ones."""
+    e = emus(None, board)
+    e.start()
+    assert ask(e.bus, "set x=12.5 y=-3") == "ok"
+    assert ask(e.bus, "get") == "ok x=12.500 y=-3.000"
+    for word, line in (("ramp", "ramp x=30 in 5s"), ("sine", "sine x amp=1 period=2s"),
+                       ("noise", "noise x sd=0.1"), ("replay", "replay motion.csv"),
+                       ("quit", "quit")):
+        assert ask(e.bus, line) == f"error: '{word}' is not on this target (set, fault, can, get)"
+    assert ask(e.bus, "get") == "ok x=12.500 y=-3.000"  # nothing of them changed anything
+    assert e.stop() == 0
