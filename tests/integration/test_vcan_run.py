@@ -7,7 +7,6 @@ VCAN_RUN_MODE=uml: the path taken where the kernel has no CAN."""
 import os
 import pathlib
 import pty
-import random
 import select
 import shutil
 import signal
@@ -206,7 +205,9 @@ def test_shell_next_to_a_sensor_on_a_terminal(tmp_path):
     The port is not reachable from this machine. Ctrl-C stops the shell's
     foreground job, not the session; exit ends it, and nothing of it is
     left."""
-    port = random.randrange(20000, 30000)
+    with socket.socket() as s:  # a port nothing listens on here
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
     t = Terminal(tmp_path, [BINARY, "--product", "dst-x730-xy30", "--iface", "vcan0",
                             "--on-eof", "run", "--control", f"tcp:{port}"])
     try:
