@@ -20,6 +20,7 @@
 #ifndef PRODUCT_EDS_H
 #define PRODUCT_EDS_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 /* One EDS entry whose DefaultValue differs from the device's default. */
@@ -27,6 +28,10 @@ typedef struct product_eds_override {
     uint16_t index;     /* dictionary entry, which must exist; 0 ends a list */
     uint8_t sub;
     uint32_t value;     /* the EDS's DefaultValue (numeric entries only) */
+    /* The value is node-relative: DefaultValue=$NODEID+value (CiA 306),
+     * for a default that is each node's own node-ID, so that one EDS
+     * describes every node of a device with several. */
+    bool nodeid;
     const char *reason; /* one line, no line break: the EDS comment */
 } product_eds_override_t;
 

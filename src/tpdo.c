@@ -166,8 +166,13 @@ co_res_t co_tpdo_write_map(co_node_t *node, const co_od_entry_t *e, uint32_t val
         return CO_E_UNSUPP; /* CiA 301: invalidate the PDO first */
     }
     if (e->sub == 0u) {
-        if (value > CO_PDO_MAP_MAX || co_node_entry(node, mapi, (uint8_t)value) == NULL) {
-            return CO_E_VAL_HIGH; /* more entries than the mapping has */
+        /* CiA 301: sub 0 is 0..64. Each of the first value entries must
+         * name a mappable object: one that names none (0, or a sub-index
+         * the mapping does not have, read as 0) is "object does not
+         * exist" (0x06020000), one that cannot be mapped 0x06040041,
+         * more than 8 bytes in all 0x06040042. */
+        if (value > 64u) {
+            return CO_E_VAL_HIGH;
         }
         uint32_t bytes = 0;
         for (unsigned i = 1; i <= value; i++) {
@@ -175,12 +180,12 @@ co_res_t co_tpdo_write_map(co_node_t *node, const co_od_entry_t *e, uint32_t val
             uint8_t b;
             co_res_t r = resolve_map(node, get_or(node, mapi, (uint8_t)i, 0), &m, &b);
             if (r != CO_OK) {
-                return CO_E_NO_MAP;
+                return r;
             }
             bytes += b;
-        }
-        if (bytes > 8u) {
-            return CO_E_MAP_LEN;
+            if (bytes > 8u) {
+                return CO_E_MAP_LEN; /* also every count beyond CO_PDO_MAP_MAX */
+            }
         }
     } else {
         if (!checking && get_or(node, mapi, 0, 0) != 0u) {

@@ -79,7 +79,12 @@ static void entry_body(FILE *f, const product_t *p, const co_od_entry_t *e, cons
     } else if ((e->attr & CO_A_NODEID) != 0u) {
         fprintf(f, "DefaultValue=$NODEID+0x%lX\n", (unsigned long)e->def);
     } else if (co_od_read_hook(e) != NULL) {
-        fprintf(f, "DefaultValue=0\n"); /* computed at run time */
+        /* Computed at run time (a live input, an error state): no
+         * DefaultValue (CiA 306: optional), so that a master that compares
+         * or writes defaults finds none that the device does not read. */
+    } else if (o != NULL && o->nodeid) {
+        fprintf(f, "; the device's default is each node's own node-ID: %s\n", o->reason);
+        fprintf(f, "DefaultValue=$NODEID+0x%lX\n", (unsigned long)o->value);
     } else if (o != NULL) {
         /* The manual asks the EDS for another value than the device's:
          * an EDS comment line says so (CiA 306: lines starting with ';'). */

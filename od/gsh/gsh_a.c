@@ -8,7 +8,6 @@
 
 #define RO (CO_A_R)
 #define RW (CO_A_RW)
-#define WO (CO_A_W)
 #define CONST (CO_A_R | CO_A_CONST)
 #define PARA(f) CO_AT(CO_CLS_PARA, gsh_para_t, f)
 #define LSS(f) CO_AT(CO_CLS_LSS, co_lss_para_t, f)
@@ -25,8 +24,10 @@
     {.index = 0x1009, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, CO_NAME("Manufacturer hardware version")}, \
     {.index = 0x100A, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, CO_NAME("Manufacturer software version")}, \
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 4, CO_NAME("Store parameters")}, \
-    /* wo as the manual says (C-08); subs 2-4 per CiA 301 (C-07). */ \
-    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = WO, CO_EXT(.write = co_store_write_save), CO_NAME("Save all parameters")}, \
+    /* The manual's table says wo (C-08) and prints no read of it: CiA \
+     * 301's rw, a read answers the storage capability (1 = saves on \
+     * command), as subs 2-4 (C-07) do. */ \
+    {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_save), CO_NAME("Save all parameters")}, \
     {.index = 0x1010, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_save), CO_NAME("Save communication parameters")}, \
     {.index = 0x1010, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_save), CO_NAME("Save application parameters")}, \
     {.index = 0x1010, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_save), CO_NAME("Save manufacturer parameters")}, \
@@ -74,8 +75,13 @@ static const co_od_t ch2_od = {.entries = ch2_entries, .count = sizeof(ch2_entri
 
 _Static_assert(sizeof(gsh_para_t) <= CO_STORE_MAX_DATA, "PARA set must fit one store slot");
 
+/* Remote requests on the TPDO are answered: 0x1800 sub 1 has bit 30
+ * clear (RTR allowed, CiA 301); the manual says nothing of RTR. The
+ * answer is the fixed layout with the next counter (gsh_tpdo_fill). */
+static const co_service_t *const gsh_services[] = {&co_rtr_service, NULL};
+
 #define GSH_CFG(odp, id)                                                             \
-    {.od = (odp), .ops = &gsh_ops, .led = NULL,                                        \
+    {.od = (odp), .ops = &gsh_ops, .led = NULL, .services = gsh_services,              \
      .sdo_segmented = co_sdo_segmented, .sdo_block = co_sdo_block,                     \
      .ram_size = {0, 0, sizeof(gsh_para_t), sizeof(co_lss_para_t)},                    \
      .default_node_id = (id), .default_bitrate = 3, .tpdo_dlc = 8,                     \
@@ -100,6 +106,9 @@ static const product_eds_override_t gsh_eds_overrides[] = {
     {.index = 0x1800, .sub = 5, .value = 0,
      .reason = "GSH-A manual (0x1800 sub 5): \"In the EDS file this default value must be set to 0, "
                "otherwise errors will be generated.\""},
+    /* Channel 1 0x13, channel 2 0x14: one EDS for both nodes (R-27). */
+    {.index = 0x3001, .sub = 0, .value = 0, .nodeid = true,
+     .reason = "0x13 on channel 1, 0x14 on channel 2 (GSH-A manual, 0x3001)"},
     {.index = 0},
 };
 #endif

@@ -108,6 +108,9 @@ class Facts:
     corrupt: Corrupt
     node_id_change: NodeIdChange
     tpdo_cob: ID = ID(0x180)
+    sdo_segmented: bool = True   # SDO segmented and block download (CiA 301)
+    sync_cobid_writable: bool = True  # 1005h rw (where the product has SYNC types)
+    dynamic_mapping: bool = False  # 0x1A00.. writable (CiA 301 dynamic mapping)
 
 
 # Heartbeat and event timer: every product has a rw 0x1017 and 0x1800:5.
@@ -129,11 +132,11 @@ DST = Facts(
     name=b"GIB",
     boot_state=0x7F,
     reads=(Read(0x1009, 0, b"1.00"), Read(0x1200, 1, ID(0x600)), Read(0x1200, 2, ID(0x580)),
-           Read(0x1800, 1, ID(0x180)), Read(0x1800, 5, u16(100))),
+           Read(0x1800, 5, u16(100)), Read(0x1010, 1, u32(1)), Read(0x1005, 0, u32(0x80)),
+           Read(0x1800, 1, ID(0x40000180))),                 # bit 30: no RTR (README)
     rw=((0x1017, 0, u16(250)), (0x2001, 0, u8(2))),
     app_param=(0x6014, 0, i16(-120), i16(0)),
     aborts=COMMON_ABORTS + (
-        Abort("r", 0x1010, 1, 0x06010001),                 # wo (spec 2)
         Abort("w", 0x1017, 0, 0x06090030, u16(10)),        # 1..19 not accepted (B-17)
         Abort("w", 0x1800, 2, 0x06090030, u8(255)),        # 1..240, 254 only (C-18)
         Abort("w", 0x20F0, 0, 0x06090032, u8(0)),          # node-ID 1..127 (B-42)
@@ -156,6 +159,8 @@ DST = Facts(
     # B-41..B-44: both copies, stored by the device itself, active after a reset.
     node_id_change=NodeIdChange(steps=(("sdo", 0x20F0, 0, u8(6)), ("sdo", 0x20F1, 0, u8(6)),
                                        ("power-cycle",)), new_id=6),
+    sdo_segmented=False,                                   # expedited only (README)
+    sync_cobid_writable=False,                             # 1005h constant (README)
 )
 
 GSH = Facts(
@@ -166,11 +171,10 @@ GSH = Facts(
     name=b"GSHA",
     boot_state=0x05,                                       # 0x5000 = 1: starts by itself
     reads=(Read(0x100A, 0, b"1.00"), Read(0x1200, 1, ID(0x600)), Read(0x1800, 1, ID(0x180)),
-           Read(0x1800, 2, u8(254)), Read(0x5000, 0, u8(1))),
+           Read(0x1800, 2, u8(254)), Read(0x5000, 0, u8(1)), Read(0x1010, 1, u32(1))),
     rw=((0x1017, 0, u16(250)), (0x1800, 5, u16(200))),
     app_param=(0x5000, 0, u8(0), u8(1)),
     aborts=COMMON_ABORTS + (
-        Abort("r", 0x1010, 1, 0x06010001),                 # wo
         Abort("r", 0x1011, 1, 0x06020000),                 # no 0x1011 (C-09)
         Abort("w", 0x3001, 0, 0x06090032, u8(0)),          # node-ID 1..127
         Abort("w", 0x1800, 5, 0x06090032, u16(3)),         # 0 or 4..65535 ms (D-38)
@@ -221,6 +225,7 @@ JD = Facts(
     corrupt=Corrupt(emcy_code=0x6300),
     # R41, R44: LSS configure node-ID + store, then reset communication.
     node_id_change=NodeIdChange(steps=(("lss-node-id", 32), ("nmt", 0x82)), new_id=32),
+    dynamic_mapping=True,
 )
 
 PF = Facts(
@@ -256,6 +261,7 @@ PF = Facts(
     corrupt=Corrupt(emcy_code=0x6300),                     # R52
     # L297-307: write 2000h, active after Reset Node.
     node_id_change=NodeIdChange(steps=(("sdo", 0x2000, 0, u8(15)), ("nmt", 0x81)), new_id=15),
+    dynamic_mapping=True,
 )
 
 

@@ -51,7 +51,7 @@ def test_sdo_aborts(model, sensor_factory, network, bus):
     node = boot(sensor_factory(f"{model}-xy30"), network, bus)
     assert abort_code(lambda: node.sdo.upload(0x2106, 6)) == 0x06020000
     assert abort_code(lambda: node.sdo.upload(0x1800, 4)) == 0x06090011
-    assert abort_code(lambda: node.sdo.upload(0x1010, 1)) == 0x06010001
+    assert u32(node, 0x1010, 1) == 1  # CiA 301: saves on command
     assert abort_code(lambda: node.sdo.download(0x1000, 0, b"\0\0\0\0")) == 0x06010002
     assert abort_code(lambda: node.sdo.download(0x1017, 0, struct.pack("<H", 10))) == 0x06090030
     assert abort_code(lambda: node.sdo.download(0x1010, 1, b"sav!")) == 0x08000020

@@ -15,14 +15,17 @@ check and says so: nothing here is skipped.
 """
 import re
 import struct
+import subprocess
 import time
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import pytest
 from canopen.lss import LssMaster
 from canopen.sdo.exceptions import SdoAbortedError
 
-from facts import CI_PRODUCTS, ID, PRODUCTS, SAVE
+from conftest import BINARY
+from facts import CI_PRODUCTS, ID, PRODUCTS, SAVE, u16, u32
 from targets import Master, list_products, make_target
 
 NMT_START, NMT_STOP, NMT_PREOP, NMT_RESET_NODE, NMT_RESET_COMM = 0x01, 0x02, 0x80, 0x81, 0x82
@@ -311,6 +314,11 @@ def test_emcy_on_injected_fault(dut, facts):
         m = dut.frames.wait_for(facts.tpdo_cob.of(n), timeout=2, pred=lambda m: m.data[byte] & mask)
         assert m is not None, "fault not in the PDO's alarm word"
         assert not dut.frames.collect(0x80 + n, 0.3), "EMCY from a product that has none"
+    if f.emcy is not None:
+        # The error register while the error is active: the EMCY's byte 2
+        # (the register after the change, CiA 301); the DST's manual prints
+        # 00 there and says 1001h is "Always ZERO", and its bytes win.
+        assert up(dut, n, 0x1001, 0) == f.emcy[2:3]
     for line in f.off:
         dut.target.inject(line)
     if f.emcy_off is not None:
@@ -449,3 +457,237 @@ def test_facts_cover_every_product():
             assert members & set(ids), f"no {family} product in CI_PRODUCTS[{target!r}]"
     for target, ids in CI_PRODUCTS.items():
         assert set(ids) <= set(PRODUCTS), target
+
+
+# --- conformance: the CiA conformance test plan's cases ----------------------
+#
+# What a product's dictionary holds is read from its EDS (canopen-sensor
+# --eds, the same tables the MCU images are built from), so that every
+# object of every product is covered without a list here.
+
+EDS_SIZES = {0x0001: 1, 0x0002: 1, 0x0003: 2, 0x0004: 4, 0x0005: 1, 0x0006: 2, 0x0007: 4}
+
+
+@dataclass(frozen=True)
+class EdsEntry:
+    index: int
+    sub: int
+    access: str
+    data_type: int
+    default: str      # the DefaultValue as written, None where the EDS gives none
+    comment: str      # the comment line before it ("" where none)
+
+
+def eds_entries(product):
+    """(index, sub) -> EdsEntry of the product's EDS, in the EDS's order."""
+    text = subprocess.run([BINARY, "--product", product, "--eds"], check=True,
+                          capture_output=True, text=True).stdout
+    entries = {}
+    for block in text.split("\n\n"):
+        lines = block.strip().splitlines()
+        head = re.fullmatch(r"\[([0-9A-F]{4})(?:sub([0-9A-F]+))?\]", lines[0]) if lines else None
+        if head is None:
+            continue
+        keys = dict(l.split("=", 1) for l in lines[1:] if "=" in l and not l.startswith(";"))
+        if keys.get("ObjectType") != "0x7":
+            continue
+        comment = next((l for l in lines if l.startswith(";")), "")
+        index, sub = int(head[1], 16), int(head[2] or "0", 16)
+        entries[(index, sub)] = EdsEntry(index, sub, keys["AccessType"], int(keys["DataType"], 16),
+                                         keys.get("DefaultValue"), comment)
+    assert entries, f"no object in the EDS of {product}"
+    return entries
+
+
+def eds_value(e, node_id):
+    """The EDS DefaultValue of e as the bytes the device answers (node-ID resolved)."""
+    text = e.default
+    m = re.fullmatch(r"\$NODEID\+(0x[0-9A-Fa-f]+|[0-9]+)", text)
+    if e.data_type == 0x0009:
+        return text.encode()
+    v = node_id + int(m[1], 0) if m else int(text, 0)
+    return (v & (1 << (8 * EDS_SIZES[e.data_type])) - 1).to_bytes(EDS_SIZES[e.data_type], "little")
+
+
+def abort_or_none(fn):
+    """The abort code fn ends with, or None where it succeeds."""
+    try:
+        fn()
+    except SdoAbortedError as e:
+        return e.code
+    return None
+
+
+def test_blank_device_reads_its_eds_defaults(dut, facts, product):
+    """A blank device (no stored set) reads the DefaultValue its EDS gives for
+    every readable object, on every node: a live value (an input, an error
+    state) has none; where the manual asks the EDS for another value (a
+    comment line says so) the device reads its own, which the comment
+    names; a node-relative one is $NODEID. 0x1018 sub 4, the serial number,
+    is each unit's own: no comparison."""
+    eds = eds_entries(product)
+    dut.power_on(facts.nodes)
+    for n in facts.nodes:
+        wrong = []
+        for (index, sub), e in eds.items():
+            if e.access == "wo" or e.default is None or (index, sub) == (0x1018, 4):
+                continue
+            want = eds_value(e, n)
+            own = re.match(r"; the device's default is (0x[0-9A-F]+|-?[0-9]+);", e.comment)
+            if own:
+                want = eds_value(replace(e, default=own[1]), n)
+            got = up(dut, n, index, sub)
+            if got != want:
+                wrong.append(f"{index:04X}h/{sub}: reads {got.hex()}, EDS {e.default}")
+        assert not wrong, f"node {n:#x}: " + "; ".join(wrong)
+
+
+def test_segmented_download_as_expedited(dut, facts, product):
+    """Every object the product can write takes the same bytes by segmented
+    and by block download as by expedited: the same answer (success, or
+    the same abort code) and the same value read back. The bytes are the
+    object's own value as read (zeros where it is write-only), so nothing
+    changes underway. The DSTs take expedited transfer only (README):
+    there both other ways are refused with 05040001h, and change nothing."""
+    eds = eds_entries(product)
+    dut.power_on(facts.nodes)
+    n = facts.nodes[0]
+    sdo = dut.node(n).sdo
+    checked = 0
+    for (index, sub), e in eds.items():
+        if "w" not in e.access:
+            continue
+        readable = e.access != "wo"
+        data = up(dut, n, index, sub) if readable else bytes(EDS_SIZES.get(e.data_type, 4))
+        def block():
+            with sdo.open(index, sub, "wb", size=len(data), block_transfer=True) as f:
+                f.write(data)
+        ways = [("expedited", lambda: sdo.download(index, sub, data)),
+                ("segmented", lambda: sdo.download(index, sub, data, force_segment=True)),
+                ("block", block)]
+        results = {}
+        for way, fn in ways:
+            results[way] = abort_or_none(fn)
+            if readable:
+                results[way] = (results[way], up(dut, n, index, sub))
+        first = results["expedited"]
+        if facts.sdo_segmented:
+            assert all(r == first for r in results.values()), f"{index:04X}h/{sub}: {results}"
+        else:
+            refused = (0x05040001, first[1]) if readable else 0x05040001
+            assert results["segmented"] == results["block"] == refused, \
+                f"{index:04X}h/{sub}: {results}"
+        checked += 1
+    assert checked >= 3
+
+
+def test_rtr_answers_tpdo(dut, facts):
+    """CiA 301: a TPDO whose COB-ID has bit 30 clear ("RTR allowed") is sent
+    at once on a remote request while operational, one frame, as long as
+    the frames the TPDO sends by itself; while pre-operational none. One
+    with bit 30 set (the DSTs, README) is never sent on a remote request."""
+    dut.power_on(facts.nodes)
+    for n in facts.nodes:
+        nmt(dut, NMT_PREOP, n)
+        tpdos, no_rtr = [], []
+        for count in range(512):
+            code = abort_or_none(lambda: up(dut, n, 0x1800 + count, 1))
+            if code is not None:
+                assert code == 0x06020000, f"{0x1800 + count:04X}h sub 1: abort {code:08X}h"
+                break
+            cob = struct.unpack("<I", up(dut, n, 0x1800 + count, 1))[0]
+            if cob & 0xC0000000 == 0:
+                tpdos.append(cob & 0x7FF)
+            elif cob & 0x80000000 == 0:
+                no_rtr.append(cob & 0x7FF)
+        assert tpdos or no_rtr, f"node {n:#x}: no valid TPDO"
+        # Its own frames (timer or SYNC) first: their length.
+        nmt(dut, NMT_START, n)
+        time.sleep(0.05)
+        dut.send(0x080)
+        own = {}
+        for _, m in dut.frames.stream(0.4):
+            if m.arbitration_id in tpdos + no_rtr and not m.is_remote_frame:
+                own.setdefault(m.arbitration_id, len(m.data))
+        assert set(own) == set(tpdos + no_rtr), \
+            f"node {n:#x}: no TPDO of its own from {set(tpdos + no_rtr) - set(own)}"
+        # Quiet: no event timer (where it can be written), no SYNC.
+        nmt(dut, NMT_PREOP, n)
+        for k in range(count):
+            abort_or_none(lambda: down(dut, n, 0x1800 + k, 5, u16(0)))
+        time.sleep(0.05)
+        for cob in tpdos + no_rtr:
+            dut.frames.clear()
+            dut.send(cob, remote=True)
+            assert not dut.frames.collect(cob, 0.2), f"{cob:03X}h answered in pre-operational"
+        nmt(dut, NMT_START, n)
+        time.sleep(0.1)
+        for cob in tpdos:
+            dut.frames.clear()
+            dut.send(cob, remote=True)
+            got = dut.frames.collect(cob, 0.3)
+            assert len(got) == 1, f"node {n:#x}: {len(got)} TPDOs on RTR {cob:03X}h, want 1"
+            assert len(got[0][1].data) == own[cob], f"{cob:03X}h: {got[0][1]}"
+        for cob in no_rtr:
+            dut.frames.clear()
+            dut.send(cob, remote=True)
+            assert not dut.frames.collect(cob, 0.3), f"{cob:03X}h (no RTR) answered an RTR"
+        nmt(dut, NMT_PREOP, n)
+
+
+def test_mapping_count_beyond_entries(dut, facts, product):
+    """CiA 301: with the PDO invalid and sub 0 at 0, a mapping count one
+    larger than the entries written is refused with 06020000h (the entry
+    names no object: 0, or a sub-index the mapping lacks) or 06040042h
+    (more than 8 bytes); more than 64 with 06090031h. The count goes back
+    and the PDO is valid again."""
+    eds = eds_entries(product)
+    dut.power_on(facts.nodes)
+    n = facts.nodes[0]
+    writable = [i for (i, s), e in eds.items() if 0x1A00 <= i < 0x1C00 and s == 0 and e.access == "rw"]
+    if not facts.dynamic_mapping:
+        assert not writable, "a writable mapping the facts do not know of"
+        return
+    assert writable
+    for mapi in writable:
+        comm = mapi - 0x200
+        cob = up(dut, n, comm, 1)
+        count = up(dut, n, mapi, 0)[0]
+        entries = [struct.unpack("<I", up(dut, n, mapi, s))[0] for s in range(1, count + 1)]
+        down(dut, n, comm, 1, struct.pack("<I", struct.unpack("<I", cob)[0] | 0x80000000))
+        down(dut, n, mapi, 0, b"\0")
+        nxt = abort_or_none(lambda: up(dut, n, mapi, count + 1))
+        nxt = 0 if nxt is not None else struct.unpack("<I", up(dut, n, mapi, count + 1))[0]
+        bits = sum(m & 0xFF for m in entries) + (nxt & 0xFF)
+        want = 0x06020000 if nxt == 0 else 0x06040042 if bits > 64 else None
+        got = abort_or_none(lambda: down(dut, n, mapi, 0, bytes([count + 1])))
+        assert got == want, f"{mapi:04X}h sub 0 := {count + 1}: {got}, want {want}"
+        assert abort_code(lambda: down(dut, n, mapi, 0, bytes([65]))) == 0x06090031
+        down(dut, n, mapi, 0, bytes([count]))
+        down(dut, n, comm, 1, cob)
+        assert up(dut, n, mapi, 0)[0] == count and up(dut, n, comm, 1) == cob
+
+
+def test_sync_cobid(dut, facts):
+    """A product with SYNC transmission types has CiA 301's 1005h: a TPDO of
+    type 1 follows the SYNC on the COB-ID written there (on the DSTs it is
+    constant, README)."""
+    dut.power_on(facts.nodes)
+    n = facts.nodes[0]
+    if facts.sync_type is None:
+        return  # event-driven only: test_tpdo_by_sync shows the refusal
+    assert up(dut, n, 0x1005, 0) == u32(0x80)
+    if not facts.sync_cobid_writable:  # constant (README)
+        assert abort_code(lambda: down(dut, n, 0x1005, 0, u32(0x81))) == 0x06010002
+        return
+    cob = facts.tpdo_cob.of(n)
+    down(dut, n, 0x1800, 2, b"\x01")
+    down(dut, n, 0x1005, 0, u32(0x81))
+    nmt(dut, NMT_START, n)
+    time.sleep(0.1)
+    dut.frames.clear()
+    dut.send(0x080)
+    assert not dut.frames.collect(cob, 0.2), "TPDO on 080h after 1005h := 81h"
+    dut.send(0x081)
+    assert len(dut.frames.collect(cob, 0.2)) == 1, "no TPDO on SYNC 081h"
+    assert abort_code(lambda: down(dut, n, 0x1005, 0, u32(0x40000081))) == 0x06090030

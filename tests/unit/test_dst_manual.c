@@ -195,7 +195,7 @@ static void test_e2_node_id(void)
     h_rx(d, 0x606, "40 14 10 00 00 00 00 00");
     EXPECT(d, 0x586, "43 14 10 00 86 00 00 00"); /* EMCY COB-ID follows */
     h_rx(d, 0x606, "40 00 18 01 00 00 00 00");
-    EXPECT(d, 0x586, "43 00 18 01 86 01 00 00"); /* TPDO COB-ID follows */
+    EXPECT(d, 0x586, "43 00 18 01 86 01 00 40"); /* TPDO COB-ID follows */
     CHECK_EQ(h_read(d, 0x20F0, 0), 6);
     /* Copies that differ commit nothing. */
     SDO(d, "2F F0 20 00 09 00 00 00", "60 F0 20 00 00 00 00 00");
@@ -363,6 +363,23 @@ static void test_e13_sync(void)
     EXPECT_NONE(d); /* no PDO outside operational */
 }
 
+/* 0x1800 sub 1 has bit 30 set (no RTR, CiA 301): a remote request on
+ * 0x1FF gets no TPDO, in any state; the COB-ID stays read-only. */
+static void test_rtr_refused(void)
+{
+    boot(M->xy30);
+    SDO(d, "40 00 18 01 00 00 00 00", "43 00 18 01 FF 01 00 40");
+    SDO(d, "23 00 18 01 FF 01 00 00", "80 00 18 01 02 00 01 06");
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* no timer */
+    co_frame_t rtr = {.id = 0x1FF, .rtr = true, .dlc = 8};
+    h_rx(d, 0x000, "01 7F");
+    h_advance(d, 100000);
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    h_advance(d, 100000);
+    EXPECT_NONE(d);
+}
+
 /* ---- 4.4 derived vectors ----------------------------------------------- */
 
 static void test_derived_reads(void)
@@ -407,7 +424,9 @@ static void test_derived_rejections(void)
     SDO(d, "2F 11 60 00 00 00 00 00", "60 11 60 00 00 00 00 00"); /* D17 */
     SDO(d, "2B 00 60 00 64 00 00 00", "80 00 60 00 22 00 00 08");
     SDO(d, "2F 11 60 00 04 00 00 00", "80 11 60 00 31 00 09 06"); /* > 3 */
-    SDO(d, "40 10 10 01 00 00 00 00", "80 10 10 01 01 00 01 06"); /* D25 */
+    /* D25 (the spec's, not the manual's) read it as wo: CiA 301's rw, the
+     * storage capability 1 = saves on command. */
+    SDO(d, "40 10 10 01 00 00 00 00", "43 10 10 01 01 00 00 00");
     SDO(d, "23 10 10 01 00 00 00 00", "80 10 10 01 20 00 00 08"); /* D26 */
     SDO(d, "2B 10 10 01 73 61 00 00", "80 10 10 01 13 00 07 06"); /* B-54 length */
     SDO(d, "23 00 10 00 00 00 00 00", "80 00 10 00 02 00 01 06"); /* ro */
@@ -417,7 +436,8 @@ static void test_derived_rejections(void)
     SDO(d, "40 00 18 04 00 00 00 00", "80 00 18 04 11 00 09 06"); /* C-19 */
     SDO(d, "40 01 10 01 00 00 00 00", "80 01 10 01 11 00 09 06"); /* "1001h sub 1" */
     SDO(d, "40 06 21 06 00 00 00 00", "80 06 21 06 00 00 02 06"); /* "2106h sub 6" */
-    SDO(d, "40 05 10 00 00 00 00 00", "80 05 10 00 00 00 02 06");
+    SDO(d, "40 05 10 00 00 00 00 00", "43 05 10 00 80 00 00 00"); /* COB-ID SYNC (CiA 301) */
+    SDO(d, "40 06 10 00 00 00 00 00", "80 06 10 00 00 00 02 06");
     SDO(d, "2F 00 40 00 FF 00 00 00", "60 00 40 00 00 00 00 00"); /* 0x4000 0..255 */
     SDO(d, "23 14 10 00 FF 00 00 40", "80 14 10 00 30 00 09 06"); /* bit 30 */
     SDO(d, "22 01 20 00 01 00 00 00", "60 01 20 00 00 00 00 00"); /* B-39 */
@@ -631,6 +651,7 @@ int main(void)
         RUN(test_e11_restore_defaults);
         RUN(test_e12_event_timer_off);
         RUN(test_e13_sync);
+        RUN(test_rtr_refused);
         RUN(test_derived_reads);
         RUN(test_derived_rejections);
         RUN(test_derived_preset_and_diff);

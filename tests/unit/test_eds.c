@@ -81,6 +81,25 @@ static void test_gsh_event_timer(void)
     CHECK(e != NULL && e->def == 100u);
 }
 
+/* A value computed at run time (a live input) has no DefaultValue; the
+ * GSH-A's node-ID setting 0x3001 is each node's own node-ID ($NODEID),
+ * so that one EDS describes both nodes of the redundant version. */
+static void test_live_values_and_node_relative_default(void)
+{
+    int unused = -1;
+    char *eds = eds_text(&gsh_a_redundant, &unused);
+    CHECK(eds != NULL && unused == 0);
+    char s[1024];
+    section(eds != NULL ? eds : "", "6004", s, sizeof(s));
+    CHECK(strstr(s, "ParameterName=") != NULL && strstr(s, "DefaultValue") == NULL);
+    section(eds != NULL ? eds : "", "6810", s, sizeof(s));
+    CHECK(strstr(s, "ParameterName=") != NULL && strstr(s, "DefaultValue") == NULL);
+    section(eds != NULL ? eds : "", "3001", s, sizeof(s));
+    CHECK(strstr(s, "\n; the device's default is each node's own node-ID: ") != NULL);
+    CHECK(strstr(s, "\nDefaultValue=$NODEID+0x0\n") != NULL);
+    free(eds);
+}
+
 /* Without overrides, the EDS carries the device's own default. */
 static void test_no_override_keeps_the_device_value(void)
 {
@@ -126,6 +145,7 @@ int main(void)
     RUN(test_every_product_applies_its_overrides);
     RUN(test_gsh_event_timer);
     RUN(test_no_override_keeps_the_device_value);
+    RUN(test_live_values_and_node_relative_default);
     RUN(test_wrong_overrides_are_counted);
     return h_finish();
 }

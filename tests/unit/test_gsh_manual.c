@@ -241,7 +241,8 @@ static void test_derived_aborts_d30_to_d39(void)
 {
     boot(&gsh_a);
     SDO(d, "23 00 10 00 00 00 00 00", "80 00 10 00 02 00 01 06"); /* D-30 */
-    SDO(d, "40 10 10 01 00 00 00 00", "80 10 10 01 01 00 01 06"); /* D-31 */
+    /* D-31 (the spec's) read it as wo: CiA 301's rw, 1 = saves on command. */
+    SDO(d, "40 10 10 01 00 00 00 00", "43 10 10 01 01 00 00 00");
     SDO(d, "23 10 10 01 00 00 00 00", "80 10 10 01 20 00 00 08"); /* D-32 */
     SDO(d, "40 00 20 00 00 00 00 00", "80 00 20 00 00 00 02 06"); /* D-33 */
     SDO(d, "40 18 10 05 00 00 00 00", "80 18 10 05 11 00 09 06"); /* D-34 */
@@ -306,6 +307,35 @@ static void test_alarms_counter_checksum(void)
     CHECK_EQ(h_read(d, 0x1001, 0), 0); /* always 0 */
 }
 
+/* 0x1800 sub 1 has bit 30 clear (RTR allowed, CiA 301): a remote request
+ * on 0x193 is answered at once, in the fixed layout with the next
+ * counter; none outside operational. */
+static void test_rtr_answered(void)
+{
+    boot(&gsh_a);
+    SDO(d, "40 00 18 01 00 00 00 00", "43 00 18 01 93 01 00 00");
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* no timer */
+    h_advance(d, 200000);
+    h_drain(d);
+    co_frame_t rtr = {.id = 0x193, .rtr = true, .dlc = 8};
+    uint8_t counter = 0;
+    for (unsigned i = 0; i < 2u; i++) {
+        h_rx_frame(d, &rtr);
+        const co_frame_t *f = h_next(d);
+        CHECK(f != NULL && f->id == 0x193 && f->dlc == 8 && !f->rtr);
+        if (f != NULL) {
+            CHECK(f->data[7] == gsh_pdo_checksum(f->data));
+            CHECK(i == 0u || f->data[6] == (uint8_t)(counter + 1u));
+            counter = f->data[6];
+        }
+        EXPECT_NONE(d);
+    }
+    h_rx(d, 0x000, "80 13");
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT_NONE(d);
+}
+
 static void test_redundant_channels_are_independent(void)
 {
     boot(&gsh_a_redundant);
@@ -359,6 +389,7 @@ int main(void)
     RUN(test_derived_reads_d1_to_d29);
     RUN(test_derived_aborts_d30_to_d39);
     RUN(test_alarms_counter_checksum);
+    RUN(test_rtr_answered);
     RUN(test_redundant_channels_are_independent);
     RUN(test_group_save);
     return h_finish();

@@ -74,8 +74,9 @@ static void test_b_tpdo2_mapping_example(void)
     boot(&jd2xxx);
     SDO(d, "22 01 18 01 00 00 00 80", "60 01 18 01 00 00 00 00"); /* B1, D-B1 */
     SDO(d, "22 01 1A 00 00 00 00 80", "60 01 1A 00 00 00 00 00"); /* B2 as printed (R28) */
-    /* B3 as printed writes sub 0 with 0x10 entries (C5): too high. */
-    SDO(d, "22 01 1A 00 10 00 00 34", "80 01 1A 00 31 00 09 06");
+    /* B3 as printed writes sub 0 with 0x10 entries (C5): entry 3 names no
+     * object (the mapping has two), CiA 301's 0x06020000. */
+    SDO(d, "22 01 1A 00 10 00 00 34", "80 01 1A 00 00 00 02 06");
     SDO(d, "22 01 1A 01 10 00 00 34", "60 01 1A 01 00 00 00 00"); /* B3 corrected, D-B3 */
     SDO(d, "22 01 1A 02 10 00 03 34", "60 01 1A 02 00 00 00 00"); /* B4, D-B4 */
     SDO(d, "22 01 1A 00 02 00 00 00", "60 01 1A 00 00 00 00 00"); /* B5, D-B5 */

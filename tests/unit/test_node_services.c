@@ -409,6 +409,26 @@ static void test_tpdo_mapping_longer_than_8_bytes(void)
     EXPECT_NONE(d);
 }
 
+/* CiA 301's answers to a mapping count (0x1A00 sub 0) larger than the
+ * entries written: an entry that names no object (0, or a sub-index the
+ * mapping lacks) 0x06020000, more than 8 bytes 0x06040042; an entry that
+ * names an unmappable object is refused when written (0x06040041). */
+static void test_tpdo_mapping_count_beyond_entries(void)
+{
+    boot();
+    SDO(d, "23 00 18 01 C0 01 00 80", "60 00 18 01 00 00 00 00"); /* invalidate TPDO1 */
+    SDO(d, "2F 00 1A 00 03 00 00 00", "80 00 1A 00 00 00 02 06"); /* sub 3 is 0 */
+    SDO(d, "2F 00 1A 00 04 00 00 00", "80 00 1A 00 00 00 02 06"); /* no sub 4 */
+    SDO(d, "2F 00 1A 00 08 00 00 00", "80 00 1A 00 00 00 02 06");
+    SDO(d, "2F 00 1A 00 41 00 00 00", "80 00 1A 00 31 00 09 06"); /* beyond 64 */
+    SDO(d, "2F 00 1A 00 00 00 00 00", "60 00 1A 00 00 00 00 00");
+    SDO(d, "23 00 1A 03 20 00 00 10", "80 00 1A 03 41 00 04 06"); /* 0x1000: not mappable */
+    SDO(d, "23 00 1A 03 20 00 00 20", "60 00 1A 03 00 00 00 00"); /* 4 + 2 + 4 bytes */
+    SDO(d, "2F 00 1A 00 03 00 00 00", "80 00 1A 00 42 00 04 06");
+    SDO(d, "2F 00 1A 00 02 00 00 00", "60 00 1A 00 00 00 00 00"); /* the two first: fine */
+    SDO(d, "40 00 1A 00 00 00 00 00", "4F 00 1A 00 02 00 00 00");
+}
+
 /* The active-error table holds CO_EMCY_ACTIVE_MAX errors; one more is
  * refused (no EMCY) until one clears. EMCY COB-ID: 11-bit, never 0. */
 static void test_emcy_table_full_and_cobid(void)
@@ -447,6 +467,7 @@ int main(void)
     RUN(test_nmt_state_hook);
     RUN(test_cia303_led_mapping);
     RUN(test_tpdo_mapping_longer_than_8_bytes);
+    RUN(test_tpdo_mapping_count_beyond_entries);
     RUN(test_emcy_table_full_and_cobid);
     return h_finish();
 }
