@@ -36,7 +36,9 @@ def test_usage_errors(tmp_path):
     refused(run("--node", "nope@3", "--iface", "vcan0"), "--node nope@3: unknown product 'nope'")
     refused(run("--node", "jd2xxx@128", "--iface", "vcan0"), "node-ID '128' is not 1..127")
     refused(run("--node", "jd2xxx@", "--iface", "vcan0"), "node-ID '' is not 1..127")
-    refused(run("--node", "gsh-a-redundant@127", "--iface", "vcan0"), "pass 127")
+    refused(run("--node", "gsh-a-redundant@127", "--iface", "vcan0"),
+            "--node gsh-a-redundant@127: gsh-a-redundant has 2 nodes, node-IDs 0x7F to 0x80: "
+            "the last passes 127 (give at most 0x7E)")
     refused(run("--node", "jd2xxx@5"), "--node jd2xxx@5: no interface (give /IFACE or --iface)")
     refused(run("--node", "jd2xxx@5/vcan0,vcan1"), "jd2xxx has one node")
     many = [a for i in range(1, 129) for a in ("--node", f"jd2xxx@{min(i, 127)}")]
