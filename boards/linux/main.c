@@ -1612,8 +1612,10 @@ int main(int argc, char **argv)
      * sockets, the EEPROM files) is a clean stop (exit 0) like one a
      * minute later, not the default action (killed, 143). One during a
      * failing start is dropped with the process (the failure's status).
-     * Only a signal before main (the dynamic loader's first milliseconds
-     * after exec) meets the default action. */
+     * Only a signal before main (exec and the dynamic loader: about 1 ms
+     * on a PC, up to 20 ms under User-Mode Linux) meets the default
+     * action; a parent that blocks them for the child avoids that too
+     * (the mask is inherited through exec: README). */
     sigset_t sigs;
     stop_signals(&sigs);
     sigprocmask(SIG_BLOCK, &sigs, NULL);

@@ -454,6 +454,25 @@ def test_sigterm_right_after_start_is_a_clean_stop(tmp_path, delay_ms):
     p.stderr.close()
 
 
+def test_sigterm_before_main_with_the_mask_inherited(tmp_path):
+    """Before main (the kernel's exec and the dynamic loader: up to 20 ms
+    under User-Mode Linux, about 1 ms on a PC) no program can catch a
+    signal. A parent that may signal at once starts the program with the
+    stop signals blocked (a mask is inherited through exec, README): a
+    SIGTERM at any moment, before main included, is then a clean stop."""
+    cmd = [BINARY, "--product", "jd2xxx", "--iface", "vcan0", "--log", str(tmp_path / "log")]
+    for _ in range(5):
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
+        try:
+            p = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        p.send_signal(signal.SIGTERM)  # at once: before main, as a rule, under UML
+        assert p.wait(timeout=5) == 0, p.stderr.read()
+        p.stdin.close()
+        p.stderr.close()
+
+
 def test_two_processes_one_eeprom_file(tmp_path, procs):
     """Two processes with the same --nvm overwrote each other's saves:
     the second is refused (exit 2) while the first runs, also through
