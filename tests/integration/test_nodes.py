@@ -183,7 +183,11 @@ def test_one_id_on_two_buses_is_two_devices_with_two_files(tmp_path):
     for run_no in range(2):
         proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL)
         try:
-            time.sleep(0.5)
+            # Up on both buses (not a fixed sleep: a loaded machine starts slower)
+            for ch in ("vcan0", "vcan1"):
+                end = time.monotonic() + 10
+                while sdo_on(ch, 0x21, "4000100000000000", timeout=0.3) is None:
+                    assert time.monotonic() < end, f"no SDO answer on {ch}"
             if run_no == 0:
                 for ch, hb in (("vcan0", "3412"), ("vcan1", "7707")):
                     assert sdo_on(ch, 0x21, f"2B171000{hb}0000")[0] == 0x60
