@@ -395,3 +395,37 @@ def test_selectors_on_standard_input(tmp_path):
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+def test_selector_of_nodes_lss_made_unconfigured(tmp_path):
+    """Two JDs made LSS-unconfigured (node-ID 0xFF, CiA 305): '0xFF get'
+    said 'held by more than one node'; 0xFF is no node-ID, and @N selects
+    a node without one."""
+    path = str(tmp_path / "c.sock")
+    proc = subprocess.Popen([BINARY, "--iface", IFACE, "--node", "jd2xxx@0x22", "--node",
+                             "jd1xxx@0x24", "--control", f"unix:{path}", "--on-eof", "run"],
+                            stdin=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    bus = can.Bus(interface="socketcan", channel=IFACE,
+                  can_filters=[{"can_id": 0x7E4, "can_mask": 0x7FF}])
+    try:
+        c = Client(path)
+        # switch state global (configuration), configure node-ID 0xFF, waiting
+        for data in ("0401", "11FF", "0400"):
+            bus.send(can.Message(arbitration_id=0x7E5, data=bytes.fromhex(data).ljust(8, b"\0"),
+                                 is_extended_id=False))
+        answers = [bus.recv(1) for _ in range(2)]
+        assert all(m is not None and bytes(m.data[:2]) == b"\x11\x00" for m in answers), answers
+        bus.send(can.Message(arbitration_id=0x000, data=b"\x82\x00", is_extended_id=False))
+        end = time.monotonic() + 3
+        while not (c.ask("0x22 get").startswith("error: no node") and
+                   c.ask("0x24 get").startswith("error: no node")):
+            assert time.monotonic() < end, "the JDs kept their node-IDs"
+            time.sleep(0.05)
+        assert c.ask("0xFF get") == \
+            "error: '0xFF': not a node-ID 1..127 (a node without one: select it by index, @N)"
+        assert c.ask("@1 get").startswith("ok z=0.000 ")
+        c.close()
+    finally:
+        bus.shutdown()
+        proc.terminate()
+        assert proc.wait(timeout=5) == 0
