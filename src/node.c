@@ -38,13 +38,53 @@ bool co_node_tx_drop(co_node_t *node)
     return false;
 }
 
-co_res_t co_node_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len)
+/*
+ * A write the product stores at once (cfg->autosave): the value, then its
+ * class saved. When the save fails, the write is aborted (CO_E_HW or
+ * CO_E_STORE), and an aborted write changes nothing (CiA 301: the value
+ * was not taken): the class's RAM goes back to the copy taken before,
+ * whole, since a hook may change more than its entry (a preset moves its
+ * offset too). The hook then runs again with the former value, for what
+ * it set going outside the RAM (the heartbeat's timer, a TPDO's state),
+ * and the copy is put back once more, as a hook's store may differ from
+ * the value it is given (the preset's offset follows the measurement).
+ * Not inlined: the copy (at most CO_STORE_MAX_DATA bytes, the largest
+ * class a store takes) is on the stack on this path only.
+ */
+static CO_NOINLINE co_res_t write_stored(co_node_t *node, const co_od_entry_t *e,
+                                         const uint8_t *buf, uint32_t len)
 {
+    uint8_t before[CO_STORE_MAX_DATA];
+    co_cls_t cls = (co_cls_t)e->cls;
+    uint8_t *ram = node->ram[cls];
+    /* Bounded for the analyzer: a stored class fits a record (co_store.h). */
+    uint32_t size = co_min_u32(co_cfg(node)->ram_size[cls], sizeof(before));
+    if (ram != NULL) {
+        memcpy(before, ram, size);
+    }
     co_res_t r = co_od_write(node, e, buf, len);
-    if (r == CO_OK && co_cfg(node)->autosave && (e->cls == CO_CLS_PARA || e->cls == CO_CLS_LSS)) {
-        r = co_store_save(node, (co_cls_t)e->cls); /* the product stores every change */
+    if (r != CO_OK) {
+        return r;
+    }
+    r = co_store_save(node, cls);
+    if (r != CO_OK && ram != NULL) {
+        memcpy(ram, before, size);
+        uint32_t v = 0;
+        co_od_write_fn hook = co_od_write_hook(e);
+        if (hook != NULL && e->type != CO_T_VSTR && co_od_get(node, e, &v) == CO_OK) {
+            (void)hook(node, e, v); /* the former value again: no new rule applies */
+            memcpy(ram, before, size);
+        }
     }
     return r;
+}
+
+co_res_t co_node_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len)
+{
+    if (co_cfg(node)->autosave && (e->cls == CO_CLS_PARA || e->cls == CO_CLS_LSS)) {
+        return write_stored(node, e, buf, len); /* the product stores every change */
+    }
+    return co_od_write(node, e, buf, len);
 }
 
 /* A restore, and the check of a record's values (co_store.h). */

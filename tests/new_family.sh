@@ -18,6 +18,12 @@ git -C "$src" ls-files -z --cached --others --exclude-standard |
   (cd "$src" && tar --null -T - -cf - 2>/dev/null) | tar -xf - -C "$tmp"
 cd "$tmp"
 tools/new-family demo
+# Twice: the family exists (not a "header clash" with its own header).
+if out=$(tools/new-family demo 2>&1); then
+  echo "FAIL: tools/new-family demo accepted twice" >&2; exit 1
+fi
+[ "$out" = "new-family: family 'demo' exists already (od/demo); choose another name" ] ||
+  { echo "FAIL: tools/new-family demo twice said: $out" >&2; exit 1; }
 cmake -S . -B .nf-host -G Ninja -DCO_SANITIZE=OFF >/dev/null
 ninja -C .nf-host canopen-sensor test_demo test_demo.demo_cfg >/dev/null
 .nf-host/bin/test_demo

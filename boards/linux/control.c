@@ -267,6 +267,41 @@ uint32_t ctl_events(const ctl_t *c, unsigned k)
     return ev;
 }
 
+/*
+ * Whether c->path still leads to our listening socket: a user may have
+ * removed it and started another program on the path meanwhile, whose
+ * socket must stay. Not told by the device and inode recorded at bind:
+ * tmpfs gives a freed inode number to the next file at once. Instead a
+ * connection is made through the path: it arrives here or not (a unix
+ * connect completes at once while the backlog has room). Connections
+ * waiting from before are taken first, so that what arrives after the
+ * probe came through the path now. (Between this and the unlink another
+ * program could still take the path: a window of microseconds that no
+ * call closes.)
+ */
+static bool path_is_ours(const ctl_t *c)
+{
+    int in;
+    while ((in = accept4(c->fd, NULL, NULL, SOCK_CLOEXEC)) >= 0) {
+        close(in); /* a client that came too late */
+    }
+    struct sockaddr_un sa = {.sun_family = AF_UNIX};
+    snprintf(sa.sun_path, sizeof(sa.sun_path), "%s", c->path);
+    int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    bool ours = false;
+    if (fd >= 0 && connect(fd, (const struct sockaddr *)&sa, sizeof(sa)) == 0) {
+        in = accept4(c->fd, NULL, NULL, SOCK_CLOEXEC);
+        ours = in >= 0;
+        if (in >= 0) {
+            close(in);
+        }
+    }
+    if (fd >= 0) {
+        close(fd);
+    }
+    return ours;
+}
+
 void ctl_close(ctl_t *c)
 {
     if (c->fd < 0) {
@@ -277,11 +312,9 @@ void ctl_close(ctl_t *c)
             drop(&c->cl[k]);
         }
     }
-    if (c->fd >= 0) {
-        close(c->fd);
-        c->fd = -1;
-    }
-    if (c->path[0] != '\0') {
+    if (c->path[0] != '\0' && path_is_ours(c)) {
         unlink(c->path);
     }
+    close(c->fd);
+    c->fd = -1;
 }

@@ -80,7 +80,10 @@ bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx);
  * lines, EPOLLOUT while answers wait for the kernel. */
 uint32_t ctl_events(const ctl_t *c, unsigned k);
 
-/* Close every client and the listening socket (a unix path is removed);
+/* Close every client and the listening socket; a unix path is removed
+ * when it still leads to this socket (a connection made through it
+ * arrives here), never one another process bound there after ours was
+ * removed;
  * nothing when ctl_open() was not called or failed (c->fd -1). */
 void ctl_close(ctl_t *c);
 

@@ -12,32 +12,61 @@
 #include <linux/can/raw.h>
 #include <linux/if_arp.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/uio.h>
+#include <sys/un.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "co_port.h"
 
-/* The log is the process's one piece of board state outside the ports:
- * set once at start-up, only read afterwards. */
+/* The log is the process's one piece of board state outside the ports
+ * (its file, time zero and clock): set once at start-up, only read
+ * afterwards. */
 static FILE *log_file;
+static struct timespec log_t0;
+static bool log_wall;
 
 void lp_log_open(FILE *f)
 {
     log_file = f;
 }
 
+void lp_log_start(void)
+{
+    clock_gettime(CLOCK_MONOTONIC, &log_t0);
+}
+
+void lp_log_clock(bool wall)
+{
+    log_wall = wall;
+}
+
 void lp_log(const char *fmt, ...)
 {
     FILE *f = log_file != NULL ? log_file : stderr;
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    fprintf(f, "[%5lld.%03ld] ", (long long)ts.tv_sec, ts.tv_nsec / 1000000L);
+    if (log_wall) {
+        /* UTC: a log compared with another machine's, or read in another
+         * zone, needs no zone to be known */
+        clock_gettime(CLOCK_REALTIME, &ts);
+        struct tm tm;
+        char when[32];
+        gmtime_r(&ts.tv_sec, &tm);
+        strftime(when, sizeof(when), "%Y-%m-%d %H:%M:%S", &tm);
+        fprintf(f, "[%s.%03ld] ", when, ts.tv_nsec / 1000000L);
+    } else {
+        /* Seconds since the start (the kernel's boot meant nothing to a reader) */
+        clock_gettime(CLOCK_MONOTONIC, &ts);
+        long long ns = ((long long)ts.tv_sec - (long long)log_t0.tv_sec) * 1000000000LL +
+                       (ts.tv_nsec - log_t0.tv_nsec);
+        fprintf(f, "[%4lld.%03lld] ", ns / 1000000000LL, ns / 1000000LL % 1000LL);
+    }
     va_list ap;
     va_start(ap, fmt);
     vfprintf(f, fmt, ap);
@@ -213,7 +242,7 @@ int lp_open(lp_port_t *p, const char *iface, unsigned node, lp_nvm_t *nvm, uint3
     if (l == LP_LINK_ABSENT) {
         /* At start a missing interface is a mistake to report, not a cable
          * to wait for: the user named it a moment ago. */
-        snprintf(err, errlen, "--iface %s: %s", iface, cause);
+        snprintf(err, errlen, "%s", cause); /* the caller names the option and interface */
         close(p->fd);
         p->fd = -1;
         return -1;
@@ -724,8 +753,8 @@ static const char *file_kind(mode_t m)
          : S_ISBLK(m) ? "a block device" : S_ISSOCK(m) ? "a socket" : "not a regular file";
 }
 
-int lp_nvm_open(lp_nvm_t *n, const char *path, uint8_t *mem, uint32_t size, char *err,
-                unsigned errlen)
+int lp_nvm_open(lp_nvm_t *n, const char *opt, const char *path, uint8_t *mem, uint32_t size,
+                char *err, unsigned errlen)
 {
     memset(n, 0, sizeof(*n));
     n->mem = mem;
@@ -740,19 +769,29 @@ int lp_nvm_open(lp_nvm_t *n, const char *path, uint8_t *mem, uint32_t size, char
     struct stat st;
     if (stat(path, &st) == 0) {
         if (!S_ISREG(st.st_mode)) {
-            snprintf(err, errlen, "--nvm %s: %s, not a regular file", path, file_kind(st.st_mode));
+            snprintf(err, errlen, "%s %s: %s, not a regular file", opt, path,
+                     file_kind(st.st_mode));
             return -2;
         }
         if (realpath(path, n->real) == NULL) {
-            snprintf(err, errlen, "--nvm %s: %s", path, strerror(errno));
+            snprintf(err, errlen, "%s %s: %s", opt, path, strerror(errno));
             return -2;
         }
+    } else if (errno == ENOENT && lstat(path, &st) == 0 && S_ISLNK(st.st_mode)) {
+        /* A link to nothing: the first save would replace the link by a
+         * file (rename over it), not create what it names. Refused. */
+        char to[256];
+        ssize_t tl = readlink(path, to, sizeof(to) - 1u);
+        to[tl > 0 ? tl : 0] = '\0';
+        snprintf(err, errlen, "%s %s: a symbolic link to %s, which does not exist (create the "
+                 "file, or give the path without the link)", opt, path, to);
+        return -2;
     } else if (errno == ENOENT) {
         /* A new file: its directory must exist (the first save creates the file). */
         char d[sizeof(n->real)];
         char b[sizeof(n->real)];
         if (snprintf(d, sizeof(d), "%s", path) >= (int)sizeof(d)) {
-            snprintf(err, errlen, "--nvm: path too long");
+            snprintf(err, errlen, "%s %s: path too long", opt, path);
             return -2;
         }
         snprintf(b, sizeof(b), "%s", path);
@@ -761,34 +800,34 @@ int lp_nvm_open(lp_nvm_t *n, const char *path, uint8_t *mem, uint32_t size, char
         struct stat ds;
         char rdir[PATH_MAX];
         if (stat(dir, &ds) != 0 || !S_ISDIR(ds.st_mode) || realpath(dir, rdir) == NULL) {
-            snprintf(err, errlen, "--nvm %s: directory %s does not exist", path, dir);
+            snprintf(err, errlen, "%s %s: directory %s does not exist", opt, path, dir);
             return -2;
         }
         if (strcmp(base, "/") == 0 || strcmp(base, ".") == 0 || strcmp(base, "..") == 0 ||
             snprintf(n->real, sizeof(n->real), "%s/%s", strcmp(rdir, "/") == 0 ? "" : rdir,
                      base) >= (int)sizeof(n->real)) {
-            snprintf(err, errlen, "--nvm %s: not a file name", path);
+            snprintf(err, errlen, "%s %s: not a file name", opt, path);
             return -2;
         }
-        n->path = path;
+        n->path = n->real;
         lp_log("EEPROM file %s does not exist yet: factory defaults; the first save creates it",
                n->real);
         return 0;
     } else {
-        snprintf(err, errlen, "--nvm %s: %s", path, strerror(errno));
+        snprintf(err, errlen, "%s %s: %s", opt, path, strerror(errno));
         return -2;
     }
-    n->path = path;
+    n->path = n->real;
     /* O_NONBLOCK: should the path have become a FIFO since stat(), open
      * returns at once; fstat then refuses it. */
     int fd = open(n->real, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) {
-        snprintf(err, errlen, "--nvm %s: cannot read: %s", path, strerror(errno));
+        snprintf(err, errlen, "%s %s: cannot read: %s", opt, path, strerror(errno));
         return -1;
     }
     if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         close(fd);
-        snprintf(err, errlen, "--nvm %s: not a regular file", path);
+        snprintf(err, errlen, "%s %s: not a regular file", opt, path);
         return -2;
     }
     size_t got = 0;
@@ -801,7 +840,7 @@ int lp_nvm_open(lp_nvm_t *n, const char *path, uint8_t *mem, uint32_t size, char
             int e = errno;
             close(fd);
             memset(mem, 0xFF, size);
-            snprintf(err, errlen, "--nvm %s: cannot read: %s", path, strerror(e));
+            snprintf(err, errlen, "%s %s: cannot read: %s", opt, path, strerror(e));
             return -1;
         }
         if (r == 0) {
@@ -821,6 +860,51 @@ int lp_nvm_open(lp_nvm_t *n, const char *path, uint8_t *mem, uint32_t size, char
                "left out at the next save)", n->real, (long long)st.st_size, size);
     }
     return 0;
+}
+
+int lp_nvm_lock(lp_nvm_t *n, const char *opt, const char *path, char *err, unsigned errlen)
+{
+    n->lock_fd = -1;
+    if (n->path == NULL) {
+        return 0;
+    }
+    /* Not flock() on the file, as tools/emu does for its flash: every save
+     * replaces the file (a new inode, whose lock nobody holds), and the
+     * first save creates it. The name is held instead: an abstract unix
+     * socket (no file on disk; gone with the process, however it ends)
+     * named by a hash (FNV-1a, 64 bits) of the resolved path. */
+    uint64_t h = 0xCBF29CE484222325u;
+    for (const char *c = n->real; *c != '\0'; c++) {
+        h = (h ^ (uint8_t)*c) * 0x100000001B3u;
+    }
+    struct sockaddr_un sa = {.sun_family = AF_UNIX};
+    int len = snprintf(sa.sun_path + 1, sizeof(sa.sun_path) - 1u, "canopen-sensor/nvm/%016llx",
+                       (unsigned long long)h);
+    int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    socklen_t salen = (socklen_t)(offsetof(struct sockaddr_un, sun_path) + 1u + (size_t)len);
+    if (fd < 0 || bind(fd, (const struct sockaddr *)&sa, salen) != 0) {
+        int e = errno;
+        if (fd >= 0) {
+            close(fd);
+        }
+        if (e == EADDRINUSE) {
+            snprintf(err, errlen, "%s %s: EEPROM file %s is in use by another canopen-sensor "
+                     "process (two users would overwrite each other's saves)", opt, path, n->real);
+            return -2;
+        }
+        snprintf(err, errlen, "%s %s: cannot hold the file: %s", opt, path, strerror(e));
+        return -1;
+    }
+    n->lock_fd = fd;
+    return 0;
+}
+
+void lp_nvm_unlock(lp_nvm_t *n)
+{
+    if (n->lock_fd > 0) {
+        close(n->lock_fd);
+    }
+    n->lock_fd = -1;
 }
 
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)

@@ -44,6 +44,7 @@ typedef struct lp_nvm {
     uint8_t *mem;      /* mirror of the file, size bytes (caller's storage); always
                         * what the file holds (a write that fails changes neither) */
     uint32_t size;
+    int lock_fd;       /* lp_nvm_lock's hold on the file; -1 or 0: none */
 } lp_nvm_t;
 
 /* A rate limit for one kind of log line: a window of LP_RATE_US from the
@@ -121,9 +122,14 @@ typedef struct lp_port {
     unsigned long filt_changes; /* times the filter was (re)installed */
 } lp_port_t;
 
-/* Log a line with a time stamp to the log (stderr or --log FILE). */
+/* Log a line with a time stamp to the log (stderr or --log FILE): by
+ * default seconds since lp_log_start ("[   1.234] "), with wall true the
+ * UTC wall clock ("[2026-11-25 01:05:12.345] "). */
 void lp_log(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 void lp_log_open(FILE *f);
+/* The log's time zero (call first thing), and its clock (lp_log). */
+void lp_log_start(void);
+void lp_log_clock(bool wall);
 
 /*
  * Rate limit: true when a line may be logged at time now (at most `lines`
@@ -137,7 +143,8 @@ uint32_t lp_rate_wait(const lp_rate_t *r, uint32_t now);
 /*
  * Open a non-blocking raw CAN socket on iface, error frames and the drop
  * count enabled. A down interface is accepted (bus-off until it comes up).
- * Returns 0, or -1 with a one-line cause in err (errlen bytes) when the
+ * Returns 0, or -1 with a one-line cause in err (errlen bytes; the
+ * interface not named: the caller says which option named it) when the
  * interface does not exist, is not a CAN interface, or the kernel has no CAN.
  */
 int lp_open(lp_port_t *p, const char *iface, unsigned node, lp_nvm_t *nvm, uint32_t now,
@@ -212,15 +219,27 @@ int lp_read(lp_port_t *p, co_frame_t *f, uint32_t now);
 /*
  * Open the EEPROM file (path NULL: RAM only). path must be a regular file,
  * or not exist in an existing directory; anything else (a directory, a
- * FIFO, a device, a missing directory) is refused with -2 and a one-line
- * cause in err (errlen bytes); it is looked at with stat() before any
+ * FIFO, a device, a missing directory, a symbolic link to nothing) is
+ * refused with -2 and a one-line cause in err (errlen bytes; it begins
+ * with opt, the option that named the file, and path); it is looked at
+ * with stat() before any
  * open, so a FIFO never blocks. The file is read into mem (size bytes;
  * beyond a short file's end: erased, 0xFF); a missing file reads as
  * erased. Nothing is written, created or changed on disk here: the file is
  * written by the first save only. -1 with the cause in err: the file
  * could not be read. 0: done (notes logged).
  */
-int lp_nvm_open(lp_nvm_t *n, const char *path, uint8_t *mem, uint32_t size, char *err,
-                unsigned errlen);
+int lp_nvm_open(lp_nvm_t *n, const char *opt, const char *path, uint8_t *mem, uint32_t size,
+                char *err, unsigned errlen);
+
+/*
+ * Hold n's file (lp_nvm_open'ed; nothing for RAM) for this process until
+ * lp_nvm_unlock or its end: one file, one user. Returns 0; -2 with the
+ * cause in err when another holder (this process or another) has the
+ * same resolved path; -1 when the hold cannot be made. Messages begin
+ * with opt and path as lp_nvm_open's.
+ */
+int lp_nvm_lock(lp_nvm_t *n, const char *opt, const char *path, char *err, unsigned errlen);
+void lp_nvm_unlock(lp_nvm_t *n);
 
 #endif /* LINUX_PORT_H */

@@ -92,16 +92,22 @@ static void put_product(FILE *f, const product_t *p, const char *family)
     fputs("]}", f);
 }
 
-int products_json(FILE *f)
+int products_json(FILE *f, const product_t *only)
 {
     fputs("[\n", f);
+    bool first = true;
     for (size_t i = 0; product_list[i] != NULL; i++) {
+        if (only != NULL && product_list[i] != only) {
+            continue;
+        }
         /* The unit tests' registry also lists the templates, after the rows
          * families[] names: those have no family here. */
         bool named = i < sizeof(families) / sizeof(families[0]) && families[i] != NULL;
+        fputs(first ? "" : ",\n", f);
         put_product(f, product_list[i], named ? families[i] : "");
-        fputs(product_list[i + 1] != NULL ? ",\n" : "\n", f);
+        first = false;
     }
+    fputs(first ? "" : "\n", f);
     fputs("]\n", f);
     return fflush(f) == 0 && !ferror(f) ? 0 : -1;
 }

@@ -7,14 +7,17 @@
 
 #include <stdio.h>
 
+#include "product.h"
+
 /*
  * Write a JSON array to f, one object a product (the --list-products
  * order): id, family, summary, vendor, nodes, default_node_ids (one per
  * node), default_bitrate_kbps, lss, inputs (name, unit, limit, initial:
  * numbers in the input's unit), faults (names). Builds each product's
  * instance in a local buffer to read its nodes' node-IDs (nothing is sent,
- * no port is called). Returns 0, or -1 when f reported a write error.
+ * no port is called). only: that product alone (--product), NULL: all.
+ * Returns 0, or -1 when f reported a write error.
  */
-int products_json(FILE *f);
+int products_json(FILE *f, const product_t *only);
 
 #endif /* LINUX_PRODUCTS_JSON_H */

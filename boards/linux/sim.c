@@ -385,15 +385,79 @@ static unsigned csv_fields(char *line, char *field[], unsigned max)
     }
 }
 
+/* A replay file read a block at a time (one system call per block, not
+ * per line), cut into lines. */
+typedef struct line_reader {
+    int fd;
+    char buf[4096];
+    size_t pos, len;
+    unsigned long total; /* bytes read */
+    bool eof;
+} line_reader_t;
+
+/* The reader's results (next_line). */
+enum { LR_LINE = 1, LR_END = 0, LR_LONG = -1, LR_NUL = -2, LR_READ = -3, LR_BIG = -4 };
+
+/* The next line, without its newline, into line (SIM_LINE_MAX + 1 bytes):
+ * LR_LINE; LR_END at the end; LR_LONG, LR_NUL for a line too long or
+ * holding a NUL byte; LR_READ (errno) when read() fails; LR_BIG past
+ * SIM_REPLAY_BYTES (a file that grew after fstat). */
+static int next_line(line_reader_t *lr, char *line)
+{
+    size_t n = 0;
+    bool nul = false;
+    for (;;) {
+        if (lr->pos == lr->len) {
+            if (lr->eof) {
+                break;
+            }
+            ssize_t got = read(lr->fd, lr->buf, sizeof(lr->buf));
+            if (got < 0 && errno == EINTR) {
+                continue;
+            }
+            if (got < 0) {
+                return LR_READ;
+            }
+            lr->pos = 0;
+            lr->len = (size_t)got;
+            lr->total += (unsigned long)got;
+            lr->eof = got == 0;
+            if (lr->total > SIM_REPLAY_BYTES) {
+                return LR_BIG;
+            }
+            continue;
+        }
+        char c = lr->buf[lr->pos++];
+        if (c == '\n') {
+            line[n] = '\0';
+            return nul ? LR_NUL : LR_LINE;
+        }
+        if (n == SIM_LINE_MAX) {
+            return LR_LONG;
+        }
+        nul |= c == '\0';
+        line[n++] = c;
+    }
+    line[n] = '\0';
+    return n == 0u ? LR_END : nul ? LR_NUL : LR_LINE; /* a last line without newline */
+}
+
 bool sim_replay_load(const product_t *prod, const char *file, sim_replay_t *r, char *err,
                      unsigned errlen)
 {
+    /* A relative name is the program's working directory's: an error
+     * says which directory that is. */
+    char where[300] = "";
+    char cwd[256];
+    if (file[0] != '/' && getcwd(cwd, sizeof(cwd)) != NULL) {
+        snprintf(where, sizeof(where), " (in %s, the program's working directory)", cwd);
+    }
     /* Opened without waiting (a FIFO with no writer would block the
      * whole program, every node), and only a regular file is read. */
     int fd = open(file, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     struct stat st;
     if (fd < 0 || fstat(fd, &st) != 0) {
-        snprintf(err, errlen, "replay %s: %s", file, strerror(errno));
+        snprintf(err, errlen, "replay %s: %s%s", file, strerror(errno), where);
         if (fd >= 0) {
             close(fd);
         }
@@ -404,13 +468,18 @@ bool sim_replay_load(const product_t *prod, const char *file, sim_replay_t *r, c
         close(fd);
         return false;
     }
-    FILE *f = fdopen(fd, "r");
-    if (f == NULL) {
-        snprintf(err, errlen, "replay %s: %s", file, strerror(errno));
+    /* The whole file is read while every node waits (one thread): its
+     * size bounds that wait (a few milliseconds at the limit). A table
+     * of SIM_REPLAY_ROWS rows fits many times over. */
+    if (st.st_size > (off_t)SIM_REPLAY_BYTES) {
+        snprintf(err, errlen, "replay %s: %lld bytes, more than the %u a replay file may have "
+                 "(it is read while every node waits)", file, (long long)st.st_size,
+                 SIM_REPLAY_BYTES);
         close(fd);
         return false;
     }
-    char line[SIM_LINE_MAX + 2u];
+    line_reader_t lr = {.fd = fd};
+    char line[SIM_LINE_MAX + 1u];
     char *field[PRODUCT_MAX_INPUTS + 1u];
     int input_of[PRODUCT_MAX_INPUTS + 1u] = {0}; /* column -> input */
     unsigned cols = 0;                           /* 0: header not read yet */
@@ -418,28 +487,34 @@ bool sim_replay_load(const product_t *prod, const char *file, sim_replay_t *r, c
     bool ok = true;
     memset(r, 0, sizeof(*r));
     memset(r->col, -1, sizeof(r->col));
-    long before = ftell(f);
-    while (ok && fgets(line, sizeof(line), f) != NULL) {
+    int got;
+    while (ok && (got = next_line(&lr, line)) != LR_END) {
         no++;
-        size_t len = strlen(line);
-        long after = ftell(f);
-        /* fgets stops at nothing but a newline or the buffer's end: fewer
-         * characters than it consumed means a NUL byte (a regular file:
-         * ftell counts). */
-        bool nul = before >= 0 && after > before && (size_t)(after - before) != len;
-        before = after;
-        if (nul) {
+        if (got == LR_READ) {
+            snprintf(err, errlen, "replay %s: read error: %s", file, strerror(errno));
+            ok = false;
+            break;
+        }
+        if (got == LR_BIG) {
+            snprintf(err, errlen, "replay %s: grew past %u bytes while read", file,
+                     SIM_REPLAY_BYTES);
+            ok = false;
+            break;
+        }
+        if (got == LR_NUL) {
             snprintf(err, errlen, "replay %s: line %u: holds a NUL byte", file, no);
             ok = false;
             break;
         }
-        if (len > 0u && line[len - 1u] == '\n') {
-            line[--len] = '\0';
-        } else if (!feof(f)) {
+        if (got == LR_LONG) {
             snprintf(err, errlen, "replay %s: line %u: longer than %u characters", file, no,
                      SIM_LINE_MAX);
             ok = false;
             break;
+        }
+        if (no == 1u && strncmp(line, "\xEF\xBB\xBF", 3) == 0) {
+            /* UTF-8's byte order mark, as spreadsheets save CSV: not data */
+            memmove(line, line + 3, strlen(line + 3) + 1u);
         }
         size_t lead = strspn(line, " \t\r");
         if (line[lead] == '\0' || line[lead] == '#') {
@@ -506,15 +581,11 @@ bool sim_replay_load(const product_t *prod, const char *file, sim_replay_t *r, c
         }
         r->rows++;
     }
-    if (ok && ferror(f)) {
-        snprintf(err, errlen, "replay %s: read error", file);
-        ok = false;
-    }
     if (ok && r->rows == 0u) {
         snprintf(err, errlen, "replay %s: %s", file, cols == 0u ? "empty" : "no data rows");
         ok = false;
     }
-    fclose(f);
+    close(fd);
     return ok;
 }
 
@@ -650,7 +721,7 @@ bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
         return can_command(s, &save, err, errlen);
     }
     snprintf(err, errlen,
-             "unknown command '%s' (set, ramp, sine, noise, replay, fault, can, get, quit)", cmd);
+             "unknown command '%s' (" SIM_VERBS ")", cmd);
     return false;
 }
 
@@ -658,7 +729,7 @@ bool sim_command(sim_t *s, const char *line, char *err, unsigned errlen)
 static void end_line(sim_t *s, sim_report_fn report, void *ctx)
 {
     s->line[s->len] = '\0';
-    char err[200];
+    char err[600]; /* a replay error: two paths (the file's, the working directory) */
     if (s->overflow) {
         snprintf(err, sizeof(err), "line too long (more than %u characters): ignored",
                  SIM_LINE_MAX);
@@ -666,6 +737,8 @@ static void end_line(sim_t *s, sim_report_fn report, void *ctx)
     } else if (s->nul) {
         /* Not cut at the NUL: "set x=11<NUL>y=99" is neither command. */
         report(ctx, "", "line contains a NUL byte: ignored");
+    } else if (s->route != NULL && s->route(s->route_ctx, s->line, err, sizeof(err))) {
+        report(ctx, s->line, err[0] != '\0' ? err : NULL);
     } else if (!sim_command(s, s->line, err, sizeof(err))) {
         report(ctx, s->line, err);
     } else {

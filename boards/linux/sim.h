@@ -28,8 +28,9 @@
  * C +- A); noise can carry a value past it, and the sum is saturated at
  * +-limit.
  *
- * Replay file (CSV, at most SIM_REPLAY_ROWS rows, lines of at most
- * SIM_LINE_MAX characters): a header row "t,NAME,..." (t or time, then
+ * Replay file (CSV, at most SIM_REPLAY_BYTES bytes and SIM_REPLAY_ROWS
+ * rows, lines of at most SIM_LINE_MAX characters, a UTF-8 byte order mark
+ * at its start ignored): a header row "t,NAME,..." (t or time, then
  * product input names, each once), then rows "SECONDS,VALUE,...": times
  * from 0, strictly increasing; blank lines and lines starting with # are
  * skipped. The named inputs hold their value now until the first row's
@@ -58,6 +59,10 @@
 
 #include "product.h"
 
+/* Every command of the line language, for messages (one list: sim.c's
+ * parser and the control socket's answers name them all). */
+#define SIM_VERBS "set, ramp, sine, noise, replay, fault, can, get, quit"
+
 /* Longest line accepted, without its newline. */
 #define SIM_LINE_MAX 255u
 
@@ -66,6 +71,11 @@
 
 /* Most data rows of a replay file. */
 #define SIM_REPLAY_ROWS 512u
+
+/* Largest replay file: read whole while every node waits, so its size is
+ * what one command may cost the loop (256 KiB: about 5 ms in User-Mode
+ * Linux, the slowest place it runs). 512 rows of 255 characters fit. */
+#define SIM_REPLAY_BYTES 262144u
 
 /* Seed when none is given (--seed). */
 #define SIM_SEED_DEFAULT 1u
@@ -110,6 +120,12 @@ typedef struct sim {
     bool can_request;
     co_can_state_t can_state;
     uint32_t can_hold_ms; /* bus-off: how long the bus stays unusable */
+    /* A line sim_feed hands another handler first (the board's node
+     * selectors); NULL: none. It returns false for a line it leaves to
+     * sim_command, true when it took it, with its error in err ("" when
+     * the line was applied). */
+    bool (*route)(void *ctx, const char *line, char *err, unsigned errlen);
+    void *route_ctx;
     /* The standard input line being assembled (sim_feed). */
     char line[SIM_LINE_MAX + 1u];
     size_t len;

@@ -129,3 +129,138 @@ def test_missing_interface_is_a_clear_error(tmp_path):
     last = r.stderr.strip().splitlines()[-1]
     assert "nosuchcan0: no such network interface" in last or "CAN socket" in last
     assert not (tmp_path / "e.bin").exists()  # nothing written before a save
+
+
+def test_every_option_once_but_node():
+    """One rule for every option: given twice, it is a wrong command line
+    naming it (the last one silently won for --iface, --nvm, ...); only
+    --node repeats."""
+    base = ["--product", "jd1xxx", "--iface", "vcan0"]
+    twice = {
+        "--product": ["jd1xxx"], "--iface": ["vcan1"], "--nvm": ["/tmp/a.nvm"],
+        "--nvm-dir": ["/tmp"], "--control": ["tcp:5000"], "--log": ["/tmp/x.log"],
+        "--log-time": ["wall"], "--led-chip": ["gpiochip0"], "--led-green": ["2"],
+        "--led-red": ["3"], "--on-eof": ["run"], "--seed": ["7"],
+    }
+    for opt, val in twice.items():
+        args = [*base, opt, *val, opt, *val] if opt not in ("--product", "--iface") \
+            else [*base, opt, *val]
+        one_line(run(*args), 2, f"{opt[2:]} given twice (every option but --node at most once)")
+    for flag in ("--eds", "--list-products", "--json"):
+        one_line(run("--product", "jd1xxx", flag, flag), 2, f"--{flag[2:]} given twice")
+
+
+def test_list_products_of_one_product():
+    """--list-products with --product: that product alone (it was ignored)."""
+    import json
+    r = run("--list-products", "--json", "--product", "inx360d")
+    assert r.returncode == 0, r.stderr
+    assert [p["id"] for p in json.loads(r.stdout)] == ["inx360d"]
+    r = run("--list-products", "--product", "inx360d")
+    assert [line.split()[0] for line in r.stdout.splitlines()] == ["inx360d"]
+    one_line(run("--list-products", "--product", "nope"), 2, "unknown product 'nope'")
+
+
+def test_eds_to_a_full_output():
+    """--eds whose output cannot be written says why (it exited 1 silently)."""
+    with open("/dev/full", "w") as full:
+        r = subprocess.run([BINARY, "--product", "jd2xxx", "--eds"], stdout=full,
+                           stderr=subprocess.PIPE, text=True, timeout=10)
+    assert r.returncode == 1
+    assert r.stderr.strip() == \
+        "canopen-sensor: --eds: standard output: No space left on device"
+
+
+def test_node_interface_that_is_not_can():
+    """The option that named the interface is the one blamed."""
+    r = run("--node", "jd2xxx@5/lo", "--iface", "vcan0")
+    assert r.returncode == 1
+    assert r.stderr.strip().splitlines()[-1] == \
+        "canopen-sensor: --node jd2xxx@5/lo: lo: not a CAN interface (SocketCAN: can0, vcan0, ...)"
+    r = run("--product", "gsh-a-redundant", "--iface", "vcan0,lo")
+    assert r.returncode == 1
+    assert r.stderr.strip().splitlines()[-1] == \
+        "canopen-sensor: --iface vcan0,lo: lo: not a CAN interface (SocketCAN: can0, vcan0, ...)"
+
+
+def test_directory_as_standard_input(tmp_path):
+    """read() fails (EISDIR): it was taken for the end of input (exit 0, no word)."""
+    fd = os.open(tmp_path, os.O_RDONLY)
+    try:
+        r = subprocess.run([BINARY, "--product", "jd2xxx", "--iface", "vcan0"], stdin=fd,
+                           capture_output=True, text=True, timeout=10)
+    finally:
+        os.close(fd)
+    one_line(r, 2, "standard input is a directory (give the commands on a pipe, a terminal or "
+                   "a file, or < /dev/null)")
+
+
+def test_nvm_link_to_nothing(tmp_path):
+    """A link into a missing directory was taken, and the first save
+    replaced the link by a file: refused at start, the link kept."""
+    link = tmp_path / "e.nvm"
+    link.symlink_to(tmp_path / "gone" / "e.nvm")
+    one_line(run("--product", "jd1xxx", "--iface", "vcan0", "--nvm", str(link)), 2,
+             f"--nvm {link}: a symbolic link to {tmp_path}/gone/e.nvm, which does not exist")
+    assert link.is_symlink()
+
+
+def test_nvm_dir_former_name_not_a_file(tmp_path):
+    """The former name (before the interface was in it) as a directory or
+    FIFO: refused, and nothing renamed (it was renamed, then refused)."""
+    for make in (os.mkdir, os.mkfifo):
+        d = tmp_path / make.__name__
+        d.mkdir()
+        former = d / "jd2xxx-0x0A.nvm"
+        make(former)
+        one_line(run("--product", "jd2xxx", "--iface", "vcan0", "--nvm-dir", str(d)), 2,
+                 f"--nvm-dir {d}: {former} (the former name of {d}/jd2xxx-0x0A-vcan0.nvm) is not "
+                 "a regular file: move it away")
+        assert sorted(os.listdir(d)) == ["jd2xxx-0x0A.nvm"]
+
+
+def test_a_failed_start_renames_nothing(tmp_path):
+    """A stored set under the former name is renamed only by a start that
+    works: one that fails later (no such interface) leaves it."""
+    former = tmp_path / "jd2xxx-0x0A-nosuchcan0.nvm"
+    (tmp_path / "jd2xxx-0x0A.nvm").write_bytes(b"\xff" * 768)
+    r = run("--product", "jd2xxx", "--iface", "nosuchcan0", "--nvm-dir", str(tmp_path))
+    assert r.returncode == 1, r.stderr
+    assert sorted(os.listdir(tmp_path)) == ["jd2xxx-0x0A.nvm"]
+    assert not former.exists()
+
+
+def test_one_eeprom_file_for_two_instances(tmp_path):
+    """--nvm D/x.nvm and --nvm-dir D naming one file: two users of one
+    EEPROM would overwrite each other's saves."""
+    path = tmp_path / "jd2xxx-0x0B-vcan0.nvm"
+    r = run("--product", "jd1xxx", "--iface", "vcan0", "--nvm", str(path), "--nvm-dir",
+            str(tmp_path), "--node", "jd2xxx@0x0B")
+    assert r.returncode == 2  # (the log, on stderr without --log, comes first)
+    assert r.stderr.strip().splitlines()[-1] == \
+        f"canopen-sensor: --nvm-dir {tmp_path}: {path}: the EEPROM file of jd1xxx too (one " \
+        "file, one instance) (see --help)"
+
+
+def test_log_time_stamps(tmp_path):
+    """The log's time stamps count from the program's start (they were the
+    kernel's uptime), or are the UTC wall clock with --log-time wall."""
+    import datetime
+    import re
+    log = tmp_path / "start.log"
+    r = run("--product", "jd2xxx", "--iface", "nosuchcan0", "--log", str(log))
+    assert r.returncode == 1
+    stamps = [float(m) for m in re.findall(r"^\[ *(\d+\.\d{3})\] ", log.read_text(), re.M)]
+    assert stamps and all(0 <= t < 5 for t in stamps), log.read_text()
+    log = tmp_path / "wall.log"
+    before = datetime.datetime.now(datetime.timezone.utc).replace(microsecond=0)
+    r = run("--product", "jd2xxx", "--iface", "nosuchcan0", "--log", str(log),
+            "--log-time", "wall")
+    assert r.returncode == 1
+    m = re.match(r"^\[(\d{4}-\d\d-\d\d \d\d:\d\d:\d\d)\.\d{3}\] ", log.read_text())
+    assert m, log.read_text()
+    when = datetime.datetime.strptime(m[1], "%Y-%m-%d %H:%M:%S").replace(
+        tzinfo=datetime.timezone.utc)
+    assert before <= when <= before + datetime.timedelta(seconds=5)
+    one_line(run("--product", "jd2xxx", "--iface", "vcan0", "--log-time", "boot"), 2,
+             "--log-time takes start or wall, not 'boot'")

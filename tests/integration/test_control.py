@@ -246,3 +246,186 @@ def test_a_client_faster_than_it_reads_is_slowed_down_not_cut_off(sim):
         else:
             assert answer.startswith(f"ok x={(i - 1) % 90 if i else 0}.000 "), (i, answer)
     assert client().ask("get").startswith("ok x=0.000")  # others served meanwhile
+
+
+def test_lines_that_misled(sim, tmp_path):
+    """An empty line names every command; a node-ID out of 1..127 (0xFF: an
+    LSS-unconfigured node's) is not 'held by more than one node'; a replay
+    file with a UTF-8 byte order mark (as spreadsheets save CSV) is taken;
+    a relative name's error says which directory it was looked for in."""
+    proc, client = sim
+    c = client()
+    assert c.ask("") == \
+        "error: no command (set, ramp, sine, noise, replay, fault, can, get, quit)"
+    assert c.ask("0xFF get") == \
+        "error: '0xFF': not a node-ID 1..127 (a node without one: select it by index, @N)"
+    assert c.ask("0 get").startswith("error: '0': not a node-ID 1..127")
+    bom = tmp_path / "bom.csv"
+    bom.write_bytes(b"\xef\xbb\xbft,x\r\n0,21\r\n")
+    assert c.ask(f"0x22 replay {bom}") == "ok"
+    time.sleep(0.05)
+    assert c.ask("0x22 get").startswith("ok x=21.000")
+    cwd = os.getcwd()
+    assert c.ask("replay no-such.csv") == \
+        f"error: replay no-such.csv: No such file or directory (in {cwd}, the program's " \
+        "working directory)"
+
+
+def test_replay_file_size_bounded(sim, tmp_path):
+    """A replay file is read while every node waits: 10 MB of comments
+    held every node 8.5 s. Beyond SIM_REPLAY_BYTES (256 KiB) it is refused
+    at once, saying why; one just within is read without a heartbeat
+    missing its period (node 0x22, the JD, at 50 ms)."""
+    proc, client = sim
+    c = client()
+    huge = tmp_path / "huge.csv"
+    with open(huge, "w") as f:
+        f.write("t,x\n" + "#\n" * 5_000_000 + "0,1\n")
+    t0 = time.monotonic()
+    assert c.ask(f"replay {huge}") == \
+        f"error: replay {huge}: 10000008 bytes, more than the 262144 a replay file may have " \
+        "(it is read while every node waits)"
+    assert time.monotonic() - t0 < 0.5
+    big = tmp_path / "big.csv"  # 131068 comment lines: at the limit, in bytes
+    big.write_text("t,x\n" + "#\n" * ((262144 - 8) // 2) + "0,2\n")
+    assert big.stat().st_size == 262144
+    bus = can.Bus(interface="socketcan", channel=IFACE,
+                  can_filters=[{"can_id": 0x722, "can_mask": 0x7FF}])
+    try:
+        # 50 ms heartbeat on the JD (0x1017 through SDO would need a master:
+        # the JD's default is 0, so set it with a raw expedited download)
+        sdo = can.Bus(interface="socketcan", channel=IFACE,
+                      can_filters=[{"can_id": 0x5A2, "can_mask": 0x7FF}])
+        sdo.send(can.Message(arbitration_id=0x622, is_extended_id=False,
+                             data=bytes([0x2B, 0x17, 0x10, 0, 50, 0, 0, 0])))
+        assert sdo.recv(2).data[0] == 0x60
+        sdo.shutdown()
+        stamps = []
+        end = time.monotonic() + 1.5
+        sent = False
+        while time.monotonic() < end:
+            m = bus.recv(0.2)
+            if m is not None:
+                stamps.append(m.timestamp)
+            if not sent and time.monotonic() > end - 1.0:
+                assert c.ask(f"0x22 replay {big}") == "ok"
+                sent = True
+        gaps = [b - a for a, b in zip(stamps, stamps[1:])]
+        assert len(gaps) > 20 and max(gaps) < 0.050 * 1.5, max(gaps)
+    finally:
+        bus.shutdown()
+    assert c.ask("0x22 get").startswith("ok x=2.000")
+
+
+def test_socket_removed_at_stop_only_when_ours(tmp_path):
+    """A clean stop removed the unix socket at PATH whoever bound it: after
+    ours was removed and another program bound PATH, that one's was
+    deleted. Only the socket this process bound goes."""
+    path = str(tmp_path / "c.sock")
+    proc = subprocess.Popen([BINARY, "--iface", IFACE, "--node", "jd2xxx@5", "--control",
+                             f"unix:{path}", "--on-eof", "run"], stdin=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    c = Client(path)
+    assert c.ask("get").startswith("ok ")
+    c.close()
+    os.unlink(path)
+    other = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    other.bind(path)
+    other.listen(1)
+    proc.terminate()
+    assert proc.wait(timeout=5) == 0
+    assert os.path.exists(path), "another program's socket was removed"
+    other.close()
+
+
+def test_ctl_client(tmp_path):
+    """tools/ctl: one command from its arguments, or lines from standard
+    input; answers printed as they come; exit 0 / 1 (an error answer) / 2."""
+    ctl = os.path.join(os.path.dirname(__file__), "..", "..", "tools", "ctl")
+    path = str(tmp_path / "c.sock")
+    proc = subprocess.Popen([BINARY, "--iface", IFACE, "--node", "jd2xxx@0x22", "--node",
+                             "inx360d@0x23", "--control", f"unix:{path}", "--on-eof", "run"],
+                            stdin=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        Client(path).close()  # listening
+        r = subprocess.run([ctl, f"unix:{path}", "0x22", "set", "x=5"], capture_output=True,
+                           text=True, timeout=10)
+        assert (r.returncode, r.stdout) == (0, "ok\n"), r.stderr
+        r = subprocess.run([ctl, path, "0x22 get"], capture_output=True, text=True, timeout=10)
+        assert r.returncode == 0 and r.stdout.startswith("ok x=5.000 "), r
+        r = subprocess.run([ctl, f"unix:{path}"], input="0x23 set x=7\n0x23 get\n0x24 get\n",
+                           capture_output=True, text=True, timeout=10)
+        lines = r.stdout.splitlines()
+        assert r.returncode == 1 and lines[0] == "ok" and lines[1].startswith("ok x=7.000 ")
+        assert lines[2] == "error: no node with node-ID 0x24"
+        r = subprocess.run([ctl, str(tmp_path / "none.sock"), "get"], capture_output=True,
+                           text=True, timeout=10)
+        assert r.returncode == 2 and "No such file or directory" in r.stderr
+        r = subprocess.run([ctl], capture_output=True, text=True, timeout=10)
+        assert r.returncode == 2 and "usage: tools/ctl" in r.stderr
+    finally:
+        proc.terminate()
+        assert proc.wait(timeout=5) == 0
+
+
+def test_selectors_on_standard_input(tmp_path):
+    """Standard input takes the control socket's selectors: 0xNN, @N, @all
+    (a line without one acts on the first instance, as before); a selected
+    get answers on standard output, a bad line is rejected on stderr."""
+    path = str(tmp_path / "c.sock")
+    proc = subprocess.Popen([BINARY, "--iface", IFACE, "--node", "jd2xxx@0x22", "--node",
+                             "inx360d@0x23", "--control", f"unix:{path}", "--log",
+                             str(tmp_path / "log")], stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        c = Client(path)
+        proc.stdin.write(b"0x23 set x=9\n@0 set x=4\n@1 get\n@all set x=1\n0x7E get\n"
+                         b"0x22 get\n")
+        proc.stdin.flush()
+        assert proc.stdout.readline().startswith(b"ok x=9.000 ")
+        assert proc.stdout.readline().startswith(b"ok x=1.000 ")
+        assert c.ask("0x23 get").startswith("ok x=1.000")
+        c.close()
+        proc.stdin.close()
+        assert proc.wait(timeout=5) == 0
+        assert "no node with node-ID 0x7E" in proc.stderr.read().decode()
+        log = (tmp_path / "log").read_text()
+        assert "stdin: 0x23 set x=9" in log and "control: 0x23 set x=9" not in log
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def test_selector_of_nodes_lss_made_unconfigured(tmp_path):
+    """Two JDs made LSS-unconfigured (node-ID 0xFF, CiA 305): '0xFF get'
+    said 'held by more than one node'; 0xFF is no node-ID, and @N selects
+    a node without one."""
+    path = str(tmp_path / "c.sock")
+    proc = subprocess.Popen([BINARY, "--iface", IFACE, "--node", "jd2xxx@0x22", "--node",
+                             "jd1xxx@0x24", "--control", f"unix:{path}", "--on-eof", "run"],
+                            stdin=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    bus = can.Bus(interface="socketcan", channel=IFACE,
+                  can_filters=[{"can_id": 0x7E4, "can_mask": 0x7FF}])
+    try:
+        c = Client(path)
+        # switch state global (configuration), configure node-ID 0xFF, waiting
+        for data in ("0401", "11FF", "0400"):
+            bus.send(can.Message(arbitration_id=0x7E5, data=bytes.fromhex(data).ljust(8, b"\0"),
+                                 is_extended_id=False))
+        answers = [bus.recv(1) for _ in range(2)]
+        assert all(m is not None and bytes(m.data[:2]) == b"\x11\x00" for m in answers), answers
+        bus.send(can.Message(arbitration_id=0x000, data=b"\x82\x00", is_extended_id=False))
+        end = time.monotonic() + 3
+        while not (c.ask("0x22 get").startswith("error: no node") and
+                   c.ask("0x24 get").startswith("error: no node")):
+            assert time.monotonic() < end, "the JDs kept their node-IDs"
+            time.sleep(0.05)
+        assert c.ask("0xFF get") == \
+            "error: '0xFF': not a node-ID 1..127 (a node without one: select it by index, @N)"
+        assert c.ask("@1 get").startswith("ok z=0.000 ")
+        c.close()
+    finally:
+        bus.shutdown()
+        proc.terminate()
+        assert proc.wait(timeout=5) == 0

@@ -416,6 +416,123 @@ def test_eof_run_and_sighup(tmp_path, procs):
     assert led[-1].endswith("LED green off, red off")  # switched off at exit
 
 
+def test_binary_standard_input_is_not_echoed_raw(tmp_path, procs):
+    """A rejected line's bytes reach the log and stderr as \\xNN, not raw
+    (escape sequences, binary)."""
+    p, b = boot(procs, tmp_path, "jd2xxx", 10)
+    b.shutdown()
+    p.send(b"\x1b[2J\xff\xfe set\n")
+    assert p.wait_log("stdin rejected")
+    p.p.stdin.close()
+    assert p.p.wait(timeout=3) == 0
+    stderr = p.p.stderr.read()
+    log = p.log.read_bytes()
+    want = b"unknown command '\\x1B[2J\\xFF\\xFE'"
+    assert want in log and want in stderr, (log, stderr)
+    assert b"\x1b" not in log and b"\xff" not in log and b"\x1b" not in stderr
+
+
+@pytest.mark.parametrize("delay_ms", [0, 1, 3, 10, 50])
+def test_sigterm_right_after_start_is_a_clean_stop(tmp_path, delay_ms):
+    """SIGTERM while the program starts (the log, EEPROM file, sockets
+    being opened) exited 143, the default action, where the README says
+    0: the stop signals are blocked from main's first line now, and read
+    by the loop. Sent when the log file appears (the start's first step),
+    and a few milliseconds later. (Before main, while the dynamic loader
+    runs, no program can have a handler: README.)"""
+    log = tmp_path / "log"
+    cmd = [BINARY, "--product", "jd2xxx", "--iface", "vcan0", "--log", str(log), "--nvm",
+           str(tmp_path / "e.nvm")]
+    p = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+    end = time.monotonic() + 5
+    while not log.exists() and time.monotonic() < end:
+        pass
+    time.sleep(delay_ms / 1000)
+    p.send_signal(signal.SIGTERM)
+    assert p.wait(timeout=5) == 0, p.stderr.read()
+    p.stdin.close()
+    p.stderr.close()
+
+
+def test_sigterm_before_main_with_the_mask_inherited(tmp_path):
+    """Before main (the kernel's exec and the dynamic loader: up to 20 ms
+    under User-Mode Linux, about 1 ms on a PC) no program can catch a
+    signal. A parent that may signal at once starts the program with the
+    stop signals blocked (a mask is inherited through exec, README): a
+    SIGTERM at any moment, before main included, is then a clean stop."""
+    cmd = [BINARY, "--product", "jd2xxx", "--iface", "vcan0", "--log", str(tmp_path / "log")]
+    for _ in range(5):
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
+        try:
+            p = subprocess.Popen(cmd, stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        p.send_signal(signal.SIGTERM)  # at once: before main, as a rule, under UML
+        assert p.wait(timeout=5) == 0, p.stderr.read()
+        p.stdin.close()
+        p.stderr.close()
+
+
+def test_two_processes_one_eeprom_file(tmp_path, procs):
+    """Two processes with the same --nvm overwrote each other's saves:
+    the second is refused (exit 2) while the first runs, also through
+    --nvm-dir naming the same file, and starts once the first is gone."""
+    nvm = tmp_path / "jd2xxx-0x0A-vcan0.nvm"
+    p, b = boot(procs, tmp_path, "jd2xxx", 10, nvm=nvm)
+    for args in (["--nvm", str(nvm)], ["--nvm-dir", str(tmp_path)],
+                 ["--nvm", str(tmp_path / "." / nvm.name)]):
+        r = subprocess.run([BINARY, "--product", "jd2xxx", "--iface", "vcan0", *args],
+                           capture_output=True, text=True, timeout=10, stdin=subprocess.DEVNULL)
+        assert r.returncode == 2, r.stderr
+        assert r.stderr.strip().splitlines()[-1].endswith(
+            f"EEPROM file {nvm} is in use by another canopen-sensor process (two users would "
+            "overwrite each other's saves)"), r.stderr
+    b.shutdown()
+    assert p.stop() == 0
+    r = subprocess.run([BINARY, "--product", "jd2xxx", "--iface", "vcan1", "--nvm", str(nvm),
+                        "--on-eof", "quit"], capture_output=True, text=True, timeout=10,
+                       stdin=subprocess.DEVNULL)
+    assert r.returncode == 0, r.stderr
+
+
+def sdo_read(b, node, index, sub):
+    """Expedited SDO upload; returns the value or ("abort", code)."""
+    data = struct.pack("<BHB", 0x40, index, sub) + bytes(4)
+    b.send(can.Message(arbitration_id=0x600 + node, data=data, is_extended_id=False))
+    m = wait_for(b, 0x580 + node, 2.0)
+    assert m is not None, f"no SDO answer from node {node:#x}"
+    if m.data[0] == 0x80:
+        return ("abort", struct.unpack_from("<I", m.data, 4)[0])
+    n = 4 - ((m.data[0] >> 2) & 3)
+    return int.from_bytes(m.data[4:4 + n], "little")
+
+
+def test_pf_aborted_write_changes_nothing(small_fs, tmp_path, procs):
+    """The P+F stores every write at once: with its EEPROM's file system
+    read only (a remount: refused to root too), writing 1017h = 900 was
+    answered 06060000h yet read back 900. Now it reads back what it was,
+    and after a power cycle too."""
+    nvm = small_fs / "inx.nvm"
+    p, b = boot(procs, tmp_path, "inx360d", 1, nvm=nvm)
+    assert sdo_write(b, 1, 0x1017, 0, 500, 2) == 0
+    subprocess.run(["mount", "-o", "remount,ro", str(small_fs)], check=True)
+    try:
+        assert sdo_write(b, 1, 0x1017, 0, 900, 2) == 0x06060000
+        assert p.wait_log("Read-only file system")
+        assert sdo_read(b, 1, 0x1017, 0) == 500
+        hb = [m.timestamp for m in frames(b, 1.6) if m.arbitration_id == 0x701]
+        gaps = [y - x for x, y in zip(hb, hb[1:])]
+        assert gaps and all(0.4 < g < 0.6 for g in gaps), gaps  # 500 ms, not 900
+    finally:
+        subprocess.run(["mount", "-o", "remount,rw", str(small_fs)], check=True)
+    b.shutdown()
+    assert p.stop() == 0
+    p, b = boot(procs, tmp_path, "inx360d", 1, nvm=nvm)
+    assert sdo_read(b, 1, 0x1017, 0) == 500
+    b.shutdown()
+    assert p.stop() == 0
+
+
 # ---- simulated bus-off -------------------------------------------------------
 
 def test_jd_bus_off_sends_nothing_then_8140(tmp_path, procs):

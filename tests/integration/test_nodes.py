@@ -36,7 +36,9 @@ def test_usage_errors(tmp_path):
     refused(run("--node", "nope@3", "--iface", "vcan0"), "--node nope@3: unknown product 'nope'")
     refused(run("--node", "jd2xxx@128", "--iface", "vcan0"), "node-ID '128' is not 1..127")
     refused(run("--node", "jd2xxx@", "--iface", "vcan0"), "node-ID '' is not 1..127")
-    refused(run("--node", "gsh-a-redundant@127", "--iface", "vcan0"), "pass 127")
+    refused(run("--node", "gsh-a-redundant@127", "--iface", "vcan0"),
+            "--node gsh-a-redundant@127: gsh-a-redundant has 2 nodes, node-IDs 0x7F to 0x80: "
+            "the last passes 127 (give at most 0x7E)")
     refused(run("--node", "jd2xxx@5"), "--node jd2xxx@5: no interface (give /IFACE or --iface)")
     refused(run("--node", "jd2xxx@5/vcan0,vcan1"), "jd2xxx has one node")
     many = [a for i in range(1, 129) for a in ("--node", f"jd2xxx@{min(i, 127)}")]
@@ -181,7 +183,11 @@ def test_one_id_on_two_buses_is_two_devices_with_two_files(tmp_path):
     for run_no in range(2):
         proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL)
         try:
-            time.sleep(0.5)
+            # Up on both buses (not a fixed sleep: a loaded machine starts slower)
+            for ch in ("vcan0", "vcan1"):
+                end = time.monotonic() + 10
+                while sdo_on(ch, 0x21, "4000100000000000", timeout=0.3) is None:
+                    assert time.monotonic() < end, f"no SDO answer on {ch}"
             if run_no == 0:
                 for ch, hb in (("vcan0", "3412"), ("vcan1", "7707")):
                     assert sdo_on(ch, 0x21, f"2B171000{hb}0000")[0] == 0x60

@@ -65,3 +65,18 @@ def test_misuse_is_refused(sensor_interface):
     finally:
         bus.close()
     assert first.poll() is not None  # no orphan left
+
+
+def test_messages_that_misled(sensor_bus, sensor_interface):
+    """An empty node list is named as such (it said "--product is
+    missing"); a huge value is "not a number within" its limit (it said
+    "line longer than 255 characters": 1e300 written out in full)."""
+    with pytest.raises(SimError, match="nodes: an empty list"):
+        sensor_bus([])
+    sim = sensor_bus(["jd1xxx@0x43"])
+    with pytest.raises(SimError, match=r"'z=1e\+300': not a number within \+-"):
+        sim.set(0x43, z=1e300)
+    with pytest.raises(SimError, match=r"'z=inf': not a number within \+-"):
+        sim.set(0x43, z=float("inf"))
+    sim.set(0x43, z=12.5)
+    assert sim.get(0x43)["z"] == 12.5

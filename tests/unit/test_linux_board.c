@@ -235,7 +235,7 @@ static void test_eeprom_file(void)
     char err[600];
     log_start();
     /* A new file: nothing is created until the first save. */
-    CHECK_EQ(lp_nvm_open(&n, path, mem, sizeof(mem), err, sizeof(err)), 0);
+    CHECK_EQ(lp_nvm_open(&n, "--nvm", path, mem, sizeof(mem), err, sizeof(err)), 0);
     CHECK(access(path, F_OK) != 0);
     CHECK(strstr(log_text(), "the first save creates it") != NULL);
     CHECK_EQ(mem[0], 0xFF);
@@ -252,12 +252,12 @@ static void test_eeprom_file(void)
     CHECK(access(tmp, F_OK) != 0); /* no temporary left behind */
     uint8_t again[CO_STORE_NVM_SIZE];
     lp_nvm_t n2;
-    CHECK_EQ(lp_nvm_open(&n2, path, again, sizeof(again), err, sizeof(err)), 0);
+    CHECK_EQ(lp_nvm_open(&n2, "--nvm", path, again, sizeof(again), err, sizeof(err)), 0);
     CHECK(memcmp(&again[10], "abc", 3) == 0);
     CHECK_EQ(again[9], 0xFF);
     /* A short file reads as erased beyond its end, and stays short on disk. */
     CHECK(truncate(path, 11) == 0);
-    CHECK_EQ(lp_nvm_open(&n2, path, again, sizeof(again), err, sizeof(err)), 0);
+    CHECK_EQ(lp_nvm_open(&n2, "--nvm", path, again, sizeof(again), err, sizeof(err)), 0);
     CHECK_EQ(again[10], 'a');
     CHECK_EQ(again[11], 0xFF);
     CHECK(stat(path, &st) == 0 && st.st_size == 11);
@@ -268,7 +268,7 @@ static void test_eeprom_file(void)
     char link[300];
     snprintf(link, sizeof(link), "%s/link.bin", dir);
     CHECK(symlink(path, link) == 0);
-    CHECK_EQ(lp_nvm_open(&n2, link, again, sizeof(again), err, sizeof(err)), 0);
+    CHECK_EQ(lp_nvm_open(&n2, "--nvm", link, again, sizeof(again), err, sizeof(err)), 0);
     CHECK(co_port_nvm_write(&p2, 0, "z", 1));
     CHECK(lstat(link, &st) == 0 && S_ISLNK(st.st_mode));
     CHECK(stat(path, &st) == 0 && st.st_size == (off_t)sizeof(again));
@@ -293,21 +293,82 @@ static void test_eeprom_not_a_file(void)
     char err[600];
     log_start();
     /* A FIFO: would block in open() for ever (this test would hang). */
-    CHECK_EQ(lp_nvm_open(&n, fifo, mem, sizeof(mem), err, sizeof(err)), -2);
+    CHECK_EQ(lp_nvm_open(&n, "--nvm", fifo, mem, sizeof(mem), err, sizeof(err)), -2);
     CHECK(strstr(err, "a FIFO, not a regular file") != NULL);
     /* A device (/dev/null, /dev/zero): a save would replace it by a
      * regular file (as root). /dev/zero, as /dev/null may itself have been
      * replaced on a machine where the old program ran as root. */
     struct stat st;
     CHECK(stat("/dev/zero", &st) == 0 && S_ISCHR(st.st_mode));
-    CHECK_EQ(lp_nvm_open(&n, "/dev/zero", mem, sizeof(mem), err, sizeof(err)), -2);
+    CHECK_EQ(lp_nvm_open(&n, "--nvm", "/dev/zero", mem, sizeof(mem), err, sizeof(err)), -2);
     CHECK(strstr(err, "a character device") != NULL);
-    CHECK_EQ(lp_nvm_open(&n, dir, mem, sizeof(mem), err, sizeof(err)), -2);
+    CHECK_EQ(lp_nvm_open(&n, "--nvm", dir, mem, sizeof(mem), err, sizeof(err)), -2);
     CHECK(strstr(err, "a directory") != NULL);
-    CHECK_EQ(lp_nvm_open(&n, missing, mem, sizeof(mem), err, sizeof(err)), -2);
+    CHECK_EQ(lp_nvm_open(&n, "--nvm", missing, mem, sizeof(mem), err, sizeof(err)), -2);
     CHECK(strstr(err, "does not exist") != NULL);
     CHECK(strstr(log_text(), "created") == NULL);
     unlink(fifo);
+    rmdir(dir);
+    log_stop();
+}
+
+/* A symbolic link to nothing (into a missing directory): refused, with
+ * the option's name (the first save replaced the link by a file). */
+static void test_eeprom_link_to_nothing(void)
+{
+    char dir[] = "/tmp/co-nvm-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char link[300];
+    char to[300];
+    snprintf(link, sizeof(link), "%s/e.nvm", dir);
+    snprintf(to, sizeof(to), "%s/gone/e.nvm", dir);
+    CHECK(symlink(to, link) == 0);
+    uint8_t mem[CO_STORE_NVM_SIZE];
+    lp_nvm_t n;
+    char err[600];
+    log_start();
+    CHECK_EQ(lp_nvm_open(&n, "--nvm-dir D:", link, mem, sizeof(mem), err, sizeof(err)), -2);
+    char want[800];
+    snprintf(want, sizeof(want), "--nvm-dir D: %s: a symbolic link to %s, which does not exist "
+             "(create the file, or give the path without the link)", link, to);
+    if (strcmp(err, want) != 0) {
+        FAIL(err);
+    }
+    struct stat st;
+    CHECK(lstat(link, &st) == 0 && S_ISLNK(st.st_mode));
+    unlink(link);
+    rmdir(dir);
+    log_stop();
+}
+
+/* One EEPROM file, one user: a second hold on the same resolved path is
+ * refused (another name for it too), given back at unlock; RAM needs none. */
+static void test_eeprom_lock(void)
+{
+    char dir[] = "/tmp/co-nvm-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char path[300];
+    char other[300];
+    snprintf(path, sizeof(path), "%s/e.nvm", dir);
+    snprintf(other, sizeof(other), "%s/./e.nvm", dir);
+    uint8_t mem[CO_STORE_NVM_SIZE];
+    uint8_t mem2[CO_STORE_NVM_SIZE];
+    lp_nvm_t n;
+    lp_nvm_t n2;
+    char err[600];
+    log_start();
+    CHECK_EQ(lp_nvm_open(&n, "--nvm", path, mem, sizeof(mem), err, sizeof(err)), 0);
+    CHECK_EQ(lp_nvm_lock(&n, "--nvm", path, err, sizeof(err)), 0);
+    CHECK_EQ(lp_nvm_open(&n2, "--nvm", other, mem2, sizeof(mem2), err, sizeof(err)), 0);
+    CHECK_EQ(lp_nvm_lock(&n2, "--nvm", other, err, sizeof(err)), -2);
+    CHECK(strstr(err, "is in use by another canopen-sensor process") != NULL);
+    lp_nvm_unlock(&n);
+    CHECK_EQ(lp_nvm_lock(&n2, "--nvm", other, err, sizeof(err)), 0);
+    lp_nvm_unlock(&n2);
+    lp_nvm_t ram;
+    CHECK_EQ(lp_nvm_open(&ram, "--nvm", NULL, mem, sizeof(mem), err, sizeof(err)), 0);
+    CHECK_EQ(lp_nvm_lock(&ram, "--nvm", NULL, err, sizeof(err)), 0);
+    CHECK_EQ(lp_nvm_lock(&ram, "--nvm", NULL, err, sizeof(err)), 0);
     rmdir(dir);
     log_stop();
 }
@@ -329,7 +390,7 @@ static void test_eeprom_corrupt_untouched(void)
     uint8_t mem[CO_STORE_NVM_SIZE];
     lp_nvm_t n;
     char err[600];
-    CHECK_EQ(lp_nvm_open(&n, path, mem, sizeof(mem), err, sizeof(err)), 0);
+    CHECK_EQ(lp_nvm_open(&n, "--nvm", path, mem, sizeof(mem), err, sizeof(err)), 0);
     lp_port_t port;
     memset(&port, 0, sizeof(port));
     port.fd = -1;
@@ -368,7 +429,7 @@ static void test_eeprom_save_fails(void)
     uint8_t mem[CO_STORE_NVM_SIZE];
     lp_nvm_t n;
     char err[600];
-    CHECK_EQ(lp_nvm_open(&n, path, mem, sizeof(mem), err, sizeof(err)), 0);
+    CHECK_EQ(lp_nvm_open(&n, "--nvm", path, mem, sizeof(mem), err, sizeof(err)), 0);
     lp_port_t p = {.nvm = &n};
     CHECK(!co_port_nvm_write(&p, 4, "new", 3));
     CHECK(strstr(log_text(), "save failed") != NULL);
@@ -432,7 +493,7 @@ static void test_sim_bus_off(void)
     uint8_t mem[CO_STORE_NVM_SIZE];
     lp_nvm_t n;
     char err[600];
-    CHECK_EQ(lp_nvm_open(&n, NULL, mem, sizeof(mem), err, sizeof(err)), 0);
+    CHECK_EQ(lp_nvm_open(&n, "--nvm", NULL, mem, sizeof(mem), err, sizeof(err)), 0);
     lp_tx_t tx;
     memset(&tx, 0, sizeof(tx));
     tx.fd = sv[0]; /* a connected socket: no addresses */
@@ -610,6 +671,8 @@ int main(void)
     RUN(test_stdin_lines);
     RUN(test_eeprom_file);
     RUN(test_eeprom_not_a_file);
+    RUN(test_eeprom_link_to_nothing);
+    RUN(test_eeprom_lock);
     RUN(test_eeprom_corrupt_untouched);
     RUN(test_eeprom_save_fails);
     RUN(test_rate_limit);

@@ -306,7 +306,8 @@ static void write_file(const char *dir, const char *name, const char *text, char
 /* Remove dir and the files the tests wrote into it. */
 static void remove_files(const char *dir, char *path, size_t len)
 {
-    static const char *const files[] = {"a.csv", "b.csv", "c.csv", "d.csv", "e.csv", "bad.csv"};
+    static const char *const files[] = {"a.csv", "b.csv", "c.csv",  "d.csv",
+                                        "e.csv", "bad.csv", "bom.csv"};
     for (size_t k = 0; k < sizeof(files) / sizeof(files[0]); k++) {
         snprintf(path, len, "%s/%s", dir, files[k]);
         (void)unlink(path);
@@ -490,6 +491,103 @@ static void test_replay_bad_files(void)
     remove_files(dir, path, sizeof(path));
 }
 
+/* What one replay may cost the loop: a file over SIM_REPLAY_BYTES is
+ * refused from its size, before a byte is read (10 MB of comments held
+ * every node 8.5 s); one at the limit, of the shortest lines, is read.
+ * A UTF-8 byte order mark (spreadsheets) is no part of the header; a
+ * relative name's error says the directory it was looked for in. */
+static void test_replay_limits_bom_and_where(void)
+{
+    char dir[] = "/tmp/co-sim-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char path[128];
+    char line[200];
+    char err[300];
+    sim_t s;
+    start(&s);
+    snprintf(path, sizeof(path), "%s/big.csv", dir);
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    if (f != NULL) {
+        fputs("t,x\n", f);
+        for (unsigned k = 0; k < (SIM_REPLAY_BYTES - 8u) / 2u; k++) {
+            fputs("#\n", f);
+        }
+        fputs("0,7\n", f);
+        fclose(f);
+    }
+    snprintf(line, sizeof(line), "replay %s", path);
+    CHECK(sim_command(&s, line, err, sizeof(err))); /* exactly at the limit */
+    CHECK_EQ(s.values[0], 7000);
+    f = fopen(path, "a");
+    CHECK(f != NULL);
+    if (f != NULL) {
+        fputs("\n", f); /* one byte more */
+        fclose(f);
+    }
+    sim_t before = s;
+    CHECK(!sim_command(&s, line, err, sizeof(err)));
+    char want[600];
+    snprintf(want, sizeof(want), "replay %s: 262145 bytes, more than the 262144 a replay file "
+             "may have (it is read while every node waits)", path);
+    if (strcmp(err, want) != 0) {
+        FAIL(err);
+    }
+    CHECK(memcmp(&s, &before, sizeof(s)) == 0);
+    unlink(path);
+    write_file(dir, "bom.csv", "\xEF\xBB\xBFt,x\r\n0,12\r\n", path, sizeof(path));
+    snprintf(line, sizeof(line), "replay %s", path);
+    CHECK(sim_command(&s, line, err, sizeof(err)));
+    CHECK_EQ(s.values[0], 12000);
+    /* A mark anywhere else is no mark: the header it starts is wrong. */
+    write_file(dir, "bom.csv", "# c\n\xEF\xBB\xBFt,x\n0,12\n", path, sizeof(path));
+    CHECK(!sim_command(&s, line, err, sizeof(err)));
+    CHECK(strstr(err, "line 2: expected a header") != NULL);
+    char cwd[256];
+    CHECK(getcwd(cwd, sizeof(cwd)) != NULL);
+    CHECK(!sim_command(&s, "replay no-such-file.csv", err, sizeof(err)));
+    snprintf(want, sizeof(want), "replay no-such-file.csv: No such file or directory (in %s, "
+             "the program's working directory)", cwd);
+    if (strcmp(err, want) != 0) {
+        FAIL(err);
+    }
+    remove_files(dir, path, sizeof(path));
+}
+
+static void report(void *ctx, const char *line, const char *error);
+
+/* sim_t.route: a line it takes is reported with its error; one it leaves
+ * goes to sim_command as before. */
+static bool route_at(void *ctx, const char *line, char *err, unsigned errlen)
+{
+    unsigned *taken = ctx;
+    if (line[0] != '@') {
+        return false;
+    }
+    (*taken)++;
+    snprintf(err, errlen, "%s", strcmp(line, "@bad") == 0 ? "no such node" : "");
+    return true;
+}
+
+static void test_route(void)
+{
+    sim_t s;
+    start(&s);
+    unsigned taken = 0;
+    s.route = route_at;
+    s.route_ctx = &taken;
+    char last[200] = "";
+    static const char in[] = "@1 set x=5\n@bad\nset x=3\n";
+    sim_feed(&s, in, 11, report, last);
+    CHECK(strcmp(last, "@1 set x=5|ok") == 0);
+    sim_feed(&s, in + 11, 5, report, last);
+    CHECK(strcmp(last, "@bad|no such node") == 0);
+    sim_feed(&s, in + 16, sizeof(in) - 17u, report, last);
+    CHECK(strcmp(last, "set x=3|ok") == 0);
+    CHECK_EQ(taken, 2u);
+    CHECK_EQ(s.values[0], 3000); /* the routed set did not reach this sim */
+}
+
 /* Standard input lines: motion commands applied and answered like set. */
 static void report(void *ctx, const char *line, const char *error)
 {
@@ -574,6 +672,8 @@ int main(void)
     RUN(test_noise_composes);
     RUN(test_replay);
     RUN(test_replay_bad_files);
+    RUN(test_replay_limits_bom_and_where);
+    RUN(test_route);
     RUN(test_motion_lines);
     RUN(test_clock);
     return h_finish();

@@ -275,6 +275,40 @@ static void test_v21_to_v24_zero_point_d12_to_d18(void)
     SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 00 00 00 00");
 }
 
+/* An aborted write changes nothing. The P+F stores every write at once
+ * (G2); when that save fails (the EEPROM refuses the write) the write is
+ * answered 06060000h, and the value, what its hook moved with it (the
+ * preset's offset) and what it set going (the heartbeat's timer) stay as
+ * they were. */
+static void test_failed_autosave_changes_nothing(void)
+{
+    boot(&pf_inx360d);
+    settle(131700, 0);
+    SDO(d, "2B 17 10 00 F4 01 00 00", "60 17 10 00 00 00 00 00"); /* 500 ms */
+    SDO(d, "2F 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00"); /* scaling on */
+    long long out = h_read(d, 0x6010, 0);
+    long long offset = h_read(d, 0x6013, 0);
+    d->port.cut_after = 0; /* every EEPROM write fails from now */
+    SDO(d, "2B 17 10 00 84 03 00 00", "80 17 10 00 00 00 06 06"); /* 900 ms: aborted */
+    SDO(d, "40 17 10 00 00 00 00 00", "4B 17 10 00 F4 01 00 00"); /* still 500 */
+    SDO(d, "2B 12 60 00 64 00 00 00", "80 12 60 00 00 00 06 06"); /* preset 10.0: aborted */
+    CHECK_EQ(h_read(d, 0x6012, 0), 0);
+    CHECK_EQ(h_read(d, 0x6013, 0), offset);
+    CHECK_EQ(h_read(d, 0x6010, 0), out);
+    h_drain(d);
+    h_advance(d, 500000);
+    EXPECT(d, 0x701, "7F"); /* the heartbeat on its 500 ms, not 900 */
+    h_advance(d, 500000);
+    EXPECT(d, 0x701, "7F");
+    /* Writable again: the write is taken and stored. */
+    d->port.cut_after = -1;
+    SDO(d, "2B 17 10 00 84 03 00 00", "60 17 10 00 00 00 00 00");
+    h_power_cycle(d);
+    EXPECT(d, 0x701, "00");
+    CHECK_EQ(h_read(d, 0x1017, 0), 900);
+    CHECK_EQ(h_read(d, 0x6012, 0), 0);
+}
+
 static void test_d25_stopped_and_d26_store(void)
 {
     boot(&pf_inx360d);
@@ -351,6 +385,7 @@ int main(void)
     RUN(test_v18_heartbeat_d21);
     RUN(test_v19_v20_guarding_d22_d24);
     RUN(test_v21_to_v24_zero_point_d12_to_d18);
+    RUN(test_failed_autosave_changes_nothing);
     RUN(test_d25_stopped_and_d26_store);
     RUN(test_eeprom_checksum_6300);
     RUN(test_dynamic_mapping_and_cobid);

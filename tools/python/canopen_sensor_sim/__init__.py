@@ -60,8 +60,13 @@ def _selector(node):
 
 
 def _value(v):
-    """An input value as the line language writes it (units of the input)."""
-    return f"{v:.3f}" if isinstance(v, float) else str(v)
+    """An input value as the line language writes it (units of the input):
+    thousandths for a float of ordinary size; beyond 1e12 (no input's limit
+    comes near) its shortest form (1e+300), so that the program answers
+    "not a number within ..." rather than "line too long" for 300 digits."""
+    if isinstance(v, float):
+        return f"{v:.3f}" if abs(v) < 1e12 else repr(v)
+    return str(v)
 
 
 def parse_get(answer):
@@ -163,6 +168,8 @@ class SimBus:
             raise SimError(f"nodes: a list of 'PRODUCT[@NODEID][/IFACE]' strings, not {nodes!r} "
                            "alone (write [" + repr(nodes) + "])")
         self.nodes = list(nodes)
+        if not self.nodes:
+            raise SimError("nodes: an empty list: give at least one 'PRODUCT[@NODEID][/IFACE]'")
         self.interface = interface
         self.seed = seed
         self.program = program or find_program()
