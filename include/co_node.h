@@ -10,7 +10,7 @@
  *    product contexts; all of them outlive the node. The stack holds
  *    pointers to them and never frees anything.
  *  - Read, at any time (static inline, free): co_node_app(),
- *    co_node_id(), co_node_bitrate(), co_node_nmt_state(),
+ *    co_node_id(), co_node_serial(), co_node_bitrate(), co_node_nmt_state(),
  *    co_node_can_state(), co_node_tx_dropped(), co_node_store_status();
  *    dictionary values through co_node_entry() and co_od_get();
  *    co_store_limit_reached(); co_od_checking() in a write hook.
@@ -180,6 +180,7 @@ struct co_node {
     void *app;                  /* product context for its hooks */
     void *ram[CO_CLS_COUNT];    /* the class structs, owned by the caller */
     uint32_t nvm_base;          /* where this node's records start in NVM */
+    uint32_t serial;            /* co_node_set_serial(); 0: the table's 0x1018 sub 4 default */
     uint32_t now;               /* time of the latest co_node_poll() or co_node_receive() */
     uint32_t due;               /* not dirty: no service needs to run before this time */
     uint32_t tx_dropped;        /* frames the board could not queue */
@@ -347,6 +348,36 @@ static inline void co_node_set_factory_id(co_node_t *node, uint8_t id)
         node->node_id = id;
     }
 }
+
+/*
+ * The serial number of this unit (0x1018 sub 4, the last part of its LSS
+ * address, CiA 305), which the const table cannot hold: every instance of
+ * a product needs its own, or LSS cannot address one of them. A board
+ * calls it after co_node_init() and before co_node_start(), with a value
+ * from the unit itself (a chip's unique ID, the Linux program's command
+ * line): each node of a device its own. The product's 0x1018 sub 4 entry
+ * reads it through co_node_read_serial(). While the node runs, or serial
+ * 0 (no serial), it is a broken contract (CO_CHECK) and changes nothing.
+ */
+static inline void co_node_set_serial(co_node_t *node, uint32_t serial)
+{
+    if (CO_CHECK(node->nmt.state == CO_NMT_INIT) && CO_CHECK(serial != 0u)) {
+        node->serial = serial;
+    }
+}
+
+/* The serial number co_node_set_serial() gave, 0: none. */
+static inline uint32_t co_node_serial(const co_node_t *node)
+{
+    return node->serial;
+}
+
+/* Read hook of a product's 0x1018 sub 4: co_node_set_serial()'s value, or
+ * the entry's default where the board gave none (unit tests). A table
+ * names it through co_node_serial_ext: {.index = 0x1018, .sub = 4, ...,
+ * .ext = &co_node_serial_ext} (and an EDS writer knows the entry by it). */
+co_res_t co_node_read_serial(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
+extern const co_od_ext_t co_node_serial_ext;
 
 /* The node's factory node-ID: co_node_set_factory_id()'s, else the config's. */
 static inline uint8_t co_node_factory_id(const co_node_t *node)

@@ -20,6 +20,17 @@
 #include "flash_ee.h"
 #include "nrf51.h"
 #include "serial_link.h"
+#include "uid_serial.h"
+
+/* ---- identity ------------------------------------------------------------- */
+
+/* The serial number from the 64-bit device identifier FICR DEVICEID[0..1]
+ * (nRF51 reference manual, FICR), folded (uid_serial.h). */
+uint32_t board_serial(unsigned node)
+{
+    const uint32_t id[2] = {REG(FICR_DEVICEID0), REG(FICR_DEVICEID1)};
+    return board_uid_serial(id, 2u, node);
+}
 
 /* ---- time ---------------------------------------------------------------- */
 

@@ -15,6 +15,17 @@
 #include "co_port.h"
 #include "flash_ee.h"
 #include "stm32f042.h"
+#include "uid_serial.h"
+
+/* ---- identity ----------------------------------------------------------- */
+
+/* The serial number from the 96-bit unique device ID (RM0091 33.1, at
+ * 0x1FFFF7AC, read as three words), folded (uid_serial.h). */
+uint32_t board_serial(unsigned node)
+{
+    const uint32_t uid[3] = {RD32(UID_BASE), RD32(UID_BASE + 4u), RD32(UID_BASE + 8u)};
+    return board_uid_serial(uid, 3u, node);
+}
 
 /* ---- time -------------------------------------------------------------- */
 

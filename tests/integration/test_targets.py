@@ -185,6 +185,17 @@ def test_identity(dut, facts):
         assert up(dut, n, 0x1008, 0) == facts.name
 
 
+def test_serial_number_per_unit(dut, facts):
+    """0x1018 sub 4, the LSS address's last part (CiA 305), is the unit's
+    own: not 0, each node of a device its own, the same after a restart."""
+    dut.power_on(facts.nodes)
+    serials = [struct.unpack("<I", up(dut, n, 0x1018, 4))[0] for n in facts.nodes]
+    assert 0 not in serials and len(set(serials)) == len(serials), [hex(s) for s in serials]
+    assert dut.power_off() == 0
+    dut.power_on(facts.nodes)
+    assert [struct.unpack("<I", up(dut, n, 0x1018, 4))[0] for n in facts.nodes] == serials
+
+
 def test_sdo_reads_writes_aborts(dut, facts):
     dut.power_on(facts.nodes)
     n = facts.nodes[0]

@@ -16,6 +16,7 @@
 #include "co_port.h"
 #include "dst.h"
 #include "harness.h"
+#include "uid_serial.h"
 
 /* ---- libc_min.c, renamed -------------------------------------------- */
 
@@ -104,6 +105,7 @@ static struct board {
     unsigned red_only;  /* of which (green off, red on) */
     bool green_seen[2]; /* green off / on seen */
     unsigned red_limit; /* leave after this many red-only calls (0: never) */
+    unsigned serial_calls; /* board_serial() calls */
 } bd;
 
 static void board_reset(bool init_ok, bool bitrate_ok, uint32_t run_us)
@@ -171,6 +173,14 @@ void board_sensor(const product_t *p, int32_t values[], uint32_t *faults)
     values[0] = 12500; /* x = 12.5 deg */
     values[1] = -3000;
     *faults = 0;
+}
+
+/* A chip ID of the fake board's, folded as the real boards do. */
+uint32_t board_serial(unsigned node)
+{
+    static const uint32_t uid[3] = {0x00470021u, 0x31385107u, 0x20363650u};
+    bd.serial_calls++;
+    return board_uid_serial(uid, 3u, node);
 }
 
 void board_sleep(uint32_t us)
@@ -267,6 +277,65 @@ static void test_main_loop_runs_the_product(void)
     CHECK_EQ(sent_on(0x1FF, 0, start), 0); /* no PDO before NMT start */
 }
 
+/* The node answers 1018h:04 with the board's serial number (the LSS
+ * address's last part, CiA 305): the main loop asks the board once per
+ * node before the start. */
+static void test_main_loop_serial_from_board(void)
+{
+    board_reset(true, true, 200000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    uint32_t start = bd.now;
+    bd.rx = (co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x40, 0x18, 0x10, 0x04}};
+    bd.rx_at = start + 100000u;
+    bd.rx_pending = true;
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_any();
+    }
+    CHECK_EQ(bd.serial_calls, 1);
+    unsigned i = 0;
+    while (i < bd.ntx && bd.tx[i].id != 0x5FF) {
+        i++;
+    }
+    CHECK(i < bd.ntx);
+    if (i < bd.ntx) {
+        CHECK(bd.tx[i].data[0] == 0x43 && bd.tx[i].data[1] == 0x18 && bd.tx[i].data[3] == 0x04);
+        CHECK_EQ(co_get_u32(&bd.tx[i].data[4]), board_serial(0));
+        CHECK(co_get_u32(&bd.tx[i].data[4]) != 0u);
+    }
+}
+
+/* The fold of a chip's unique ID: never 0, the node in bit 0 (the two
+ * nodes of a device differ), chips that differ in any one bit differ. */
+static void test_uid_serial(void)
+{
+    const uint32_t a[3] = {0x00470021u, 0x31385107u, 0x20363650u};
+    uint32_t s0 = board_uid_serial(a, 3u, 0);
+    uint32_t s1 = board_uid_serial(a, 3u, 1);
+    CHECK(s0 != 0u && s1 != 0u && s0 != s1);
+    CHECK_EQ(s0 & 1u, 0);
+    CHECK_EQ(s1, s0 | 1u);
+    CHECK_EQ(board_uid_serial(a, 3u, 0), s0); /* stable */
+    for (unsigned w = 0; w < 3u; w++) {
+        for (unsigned bit = 0; bit < 32u; bit++) {
+            uint32_t b[3] = {a[0], a[1], a[2]};
+            b[w] ^= 1u << bit;
+            if (board_uid_serial(b, 3u, 0) == s0 || board_uid_serial(b, 3u, 1) == s1) {
+                FAIL("one bit of the ID changed, the serial number did not");
+            }
+        }
+    }
+    /* FNV-1a, by hand: the ID 0x00000000 (4 zero bytes). */
+    uint32_t h = 2166136261u;
+    for (unsigned k = 0; k < 4u; k++) {
+        h *= 16777619u;
+    }
+    h ^= h >> 31;
+    const uint32_t zero[1] = {0};
+    CHECK_EQ(board_uid_serial(zero, 1u, 1), ((h & 0x7FFFFFFFu) << 1) | 1u);
+    /* No ID at all (n = 0): the offset basis, folded; still not 0. */
+    CHECK(board_uid_serial(NULL, 0u, 0) != 0u);
+}
+
 /* NMT start through the loop: TPDO1 follows (X730 default event timer). */
 static void test_main_loop_nmt_start(void)
 {
@@ -345,6 +414,8 @@ int main(void)
     RUN(test_libc_min);
     RUN(test_main_loop_runs_the_product);
     RUN(test_main_loop_nmt_start);
+    RUN(test_main_loop_serial_from_board);
+    RUN(test_uid_serial);
     RUN(test_main_loop_bitrate_refused);
     RUN(test_port_bitrate_default);
     RUN(test_main_loop_refuses_to_run);
