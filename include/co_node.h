@@ -180,7 +180,6 @@ struct co_node {
     void *app;                  /* product context for its hooks */
     void *ram[CO_CLS_COUNT];    /* the class structs, owned by the caller */
     uint32_t nvm_base;          /* where this node's records start in NVM */
-    uint32_t serial;            /* co_node_set_serial(); 0: the table's 0x1018 sub 4 default */
     uint32_t now;               /* time of the latest co_node_poll() or co_node_receive() */
     uint32_t due;               /* not dirty: no service needs to run before this time */
     uint32_t tx_dropped;        /* frames the board could not queue */
@@ -193,6 +192,8 @@ struct co_node {
     co_guard_t guard;
     co_lss_t lss;
     co_hbc_t hbc;
+    uint32_t serial; /* co_node_set_serial(); 0: none given. Last: read
+                      * once a boot, it shifts no hot field's offset (Cortex-M0 bytes) */
 };
 
 /*
@@ -356,7 +357,8 @@ static inline void co_node_set_factory_id(co_node_t *node, uint8_t id)
  * calls it after co_node_init() and before co_node_start(), with a value
  * from the unit itself (a chip's unique ID, the Linux program's command
  * line): each node of a device its own. The product's 0x1018 sub 4 entry
- * reads it through co_node_read_serial(). While the node runs, or serial
+ * (attribute CO_A_SERIAL) reads it; 0 where none was given (unit tests).
+ * While the node runs, or serial
  * 0 (no serial), it is a broken contract (CO_CHECK) and changes nothing.
  */
 static inline void co_node_set_serial(co_node_t *node, uint32_t serial)
@@ -372,12 +374,7 @@ static inline uint32_t co_node_serial(const co_node_t *node)
     return node->serial;
 }
 
-/* Read hook of a product's 0x1018 sub 4: co_node_set_serial()'s value, or
- * the entry's default where the board gave none (unit tests). A table
- * names it through co_node_serial_ext: {.index = 0x1018, .sub = 4, ...,
- * .ext = &co_node_serial_ext} (and an EDS writer knows the entry by it). */
-co_res_t co_node_read_serial(co_node_t *node, const co_od_entry_t *e, uint32_t *value);
-extern const co_od_ext_t co_node_serial_ext;
+
 
 /* The node's factory node-ID: co_node_set_factory_id()'s, else the config's. */
 static inline uint8_t co_node_factory_id(const co_node_t *node)

@@ -23,14 +23,6 @@ void co_node_init(co_node_t *node, const co_node_cfg_t *cfg, void *port, void *a
     node->nmt.state = CO_NMT_INIT;
 }
 
-co_res_t co_node_read_serial(co_node_t *node, const co_od_entry_t *e, uint32_t *value)
-{
-    *value = node->serial != 0u ? node->serial : e->def;
-    return CO_OK;
-}
-
-const co_od_ext_t co_node_serial_ext = {.read = co_node_read_serial};
-
 const co_od_entry_t *co_node_entry(const co_node_t *node, uint16_t index, uint8_t sub)
 {
     return co_od_find(co_cfg(node)->od, index, sub, NULL);

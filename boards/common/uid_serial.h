@@ -9,29 +9,22 @@
 #include "co_common.h"
 #include "product.h"
 
-/* Bit 0 of a serial number is the node of the device (below). */
+/* Bit 1 of a serial number is the node of the device (below). */
 _Static_assert(PRODUCT_MAX_NODES <= 2u, "one bit of the serial number names the node");
 
+/* The chip's unique ID words are folded into one by XOR (h = w0 ^ w1 ^ ...,
+ * read by the board): the bits that tell two chips apart (wafer position,
+ * wafer and lot numbers) stay, at a few bytes of flash, which the Cortex-M0
+ * images count. */
 /*
- * The serial number of node `node` (0 or 1) of a device whose chip's
- * unique ID is the n words w[] (read by the caller): FNV-1a over the ID's
- * bytes, folded to 31 bits (0 taken as 1), shifted left by one, the node
- * in bit 0. So it is never 0, the two nodes of one device (the redundant
- * GSH-A) always differ, and two chips differ but for a 31-bit collision.
- * Cannot fail; O(n).
+ * The serial number of node `node` (0 or 1) from the folded ID h: its low
+ * 30 bits in bits 31..2, the node in bit 1, bit 0 set. So it is never 0,
+ * the two nodes of one device (the redundant GSH-A) always differ, and
+ * two chips whose folds differ in their low 30 bits differ. Cannot fail.
  */
-static inline uint32_t board_uid_serial(const uint32_t *w, unsigned n, unsigned node)
+static inline uint32_t board_uid_serial(uint32_t h, unsigned node)
 {
-    uint32_t h = 2166136261u;
-    for (unsigned i = 0; i < n; i++) {
-        for (unsigned b = 0; b < 32u; b += 8u) {
-            h = (h ^ ((w[i] >> b) & 0xFFu)) * 16777619u;
-        }
-    }
-    h ^= h >> 31; /* the bit the shift below drops, folded in */
-    h &= 0x7FFFFFFFu;
-    h += (uint32_t)(h == 0u); /* 0 taken as 1 */
-    return (h << 1) | (node & 1u);
+    return (h << 2) | ((node & 1u) << 1) | 1u;
 }
 
 #endif /* UID_SERIAL_H */

@@ -28,8 +28,7 @@
  * (nRF51 reference manual, FICR), folded (uid_serial.h). */
 uint32_t board_serial(unsigned node)
 {
-    const uint32_t id[2] = {REG(FICR_DEVICEID0), REG(FICR_DEVICEID1)};
-    return board_uid_serial(id, 2u, node);
+    return board_uid_serial(REG(FICR_DEVICEID0) ^ REG(FICR_DEVICEID1), node);
 }
 
 /* ---- time ---------------------------------------------------------------- */

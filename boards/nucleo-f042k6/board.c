@@ -23,8 +23,7 @@
  * 0x1FFFF7AC, read as three words), folded (uid_serial.h). */
 uint32_t board_serial(unsigned node)
 {
-    const uint32_t uid[3] = {RD32(UID_BASE), RD32(UID_BASE + 4u), RD32(UID_BASE + 8u)};
-    return board_uid_serial(uid, 3u, node);
+    return board_uid_serial(RD32(UID_BASE) ^ RD32(UID_BASE + 4u) ^ RD32(UID_BASE + 8u), node);
 }
 
 /* ---- time -------------------------------------------------------------- */

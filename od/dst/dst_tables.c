@@ -53,7 +53,7 @@
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x00000064u, CO_NAME("Product code")}, \
     {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x00000001u, CO_NAME("Revision number")}, \
     /* Per unit: the board's (co_node_set_serial), from the chip's ID. */ \
-    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = RO, .def = 0x00000000u, .ext = &co_node_serial_ext, CO_NAME("Serial number")}, \
+    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = RO | CO_A_SERIAL, .def = 0x00000000u, CO_NAME("Serial number")}, \
     {.index = 0x1200, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("SDO server parameter")}, \
     {.index = 0x1200, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x600, CO_NAME("COB-ID client to server")}, \
     {.index = 0x1200, .sub = 2, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x580, CO_NAME("COB-ID server to client")}, \

@@ -36,7 +36,7 @@
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x00000093u, CO_NAME("Vendor-ID")}, \
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x00000067u, CO_NAME("Product code")}, \
     {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x00000001u, CO_NAME("Revision number")}, \
-    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = RO, .def = 0, .ext = &co_node_serial_ext, CO_NAME("Serial number")}, /* per unit, each channel its own (co_node_set_serial) */ \
+    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = RO | CO_A_SERIAL, .def = 0, CO_NAME("Serial number")}, /* per unit, each channel its own (co_node_set_serial) */ \
     {.index = 0x1200, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("SDO server parameter")}, \
     {.index = 0x1200, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x600, CO_NAME("COB-ID client to server")}, \
     {.index = 0x1200, .sub = 2, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x580, CO_NAME("COB-ID server to client")}, \
