@@ -10,7 +10,7 @@
  *    product contexts; all of them outlive the node. The stack holds
  *    pointers to them and never frees anything.
  *  - Read, at any time (static inline, free): co_node_app(),
- *    co_node_id(), co_node_bitrate(), co_node_nmt_state(),
+ *    co_node_id(), co_node_serial(), co_node_bitrate(), co_node_nmt_state(),
  *    co_node_can_state(), co_node_tx_dropped(), co_node_store_status();
  *    dictionary values through co_node_entry() and co_od_get();
  *    co_store_limit_reached(); co_od_checking() in a write hook.
@@ -192,6 +192,8 @@ struct co_node {
     co_guard_t guard;
     co_lss_t lss;
     co_hbc_t hbc;
+    uint32_t serial; /* co_node_set_serial(); 0: none given. Last: read
+                      * once a boot, it shifts no hot field's offset (Cortex-M0 bytes) */
 };
 
 /*
@@ -347,6 +349,32 @@ static inline void co_node_set_factory_id(co_node_t *node, uint8_t id)
         node->node_id = id;
     }
 }
+
+/*
+ * The serial number of this unit (0x1018 sub 4, the last part of its LSS
+ * address, CiA 305), which the const table cannot hold: every instance of
+ * a product needs its own, or LSS cannot address one of them. A board
+ * calls it after co_node_init() and before co_node_start(), with a value
+ * from the unit itself (a chip's unique ID, the Linux program's command
+ * line): each node of a device its own. The product's 0x1018 sub 4 entry
+ * (attribute CO_A_SERIAL) reads it; 0 where none was given (unit tests).
+ * While the node runs, or serial
+ * 0 (no serial), it is a broken contract (CO_CHECK) and changes nothing.
+ */
+static inline void co_node_set_serial(co_node_t *node, uint32_t serial)
+{
+    if (CO_CHECK(node->nmt.state == CO_NMT_INIT) && CO_CHECK(serial != 0u)) {
+        node->serial = serial;
+    }
+}
+
+/* The serial number co_node_set_serial() gave, 0: none. */
+static inline uint32_t co_node_serial(const co_node_t *node)
+{
+    return node->serial;
+}
+
+
 
 /* The node's factory node-ID: co_node_set_factory_id()'s, else the config's. */
 static inline uint8_t co_node_factory_id(const co_node_t *node)

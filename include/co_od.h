@@ -52,6 +52,7 @@ enum {
     CO_A_CONST = 0x04,  /* never changes (EDS "const"); combine with CO_A_R */
     CO_A_PDO = 0x08,    /* may be mapped into a TPDO */
     CO_A_NODEID = 0x10, /* a COB-ID whose default follows the node-ID (below) */
+    CO_A_SERIAL = 0x20, /* 0x1018 sub 4: the unit's serial (co_node_set_serial; .def 0) */
 };
 
 /* Storage classes: which RAM struct holds the value, and what stores it. */

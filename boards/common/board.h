@@ -25,6 +25,9 @@ uint8_t board_can_state(void);
 void board_leds(bool green, bool red);
 /* One sensor sample of product p's inputs, in thousandths of their unit. */
 void board_sensor(const product_t *p, int32_t values[], uint32_t *faults);
+/* The serial number (0x1018 sub 4) of node i (0 or 1): from the chip's
+ * unique ID where it has one (uid_serial.h), never 0, the nodes differ. */
+uint32_t board_serial(unsigned node);
 /* Sleep until an interrupt or about us microseconds have passed. */
 void board_sleep(uint32_t us);
 

@@ -63,6 +63,9 @@ int main(void)
         }
     }
     p->create(p, mem, ports, nodes);
+    for (unsigned i = 0; i < p->nodes; i++) {
+        co_node_set_serial(nodes[i], board_serial(i)); /* the unit's own LSS address */
+    }
 #ifdef CO_FIXED_CFG
     for (unsigned i = 0; i < p->nodes; i++) {
         if (nodes[i]->cfg != &CO_FIXED_CFG) { /* the build paired it with another config */

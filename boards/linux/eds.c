@@ -78,6 +78,10 @@ static void entry_body(FILE *f, const product_t *p, const co_od_entry_t *e, cons
         fprintf(f, "DefaultValue=%.*s\n", (int)e->size, (const char *)e->cdata);
     } else if ((e->attr & CO_A_NODEID) != 0u) {
         fprintf(f, "DefaultValue=$NODEID+0x%lX\n", (unsigned long)e->def);
+    } else if ((e->attr & CO_A_SERIAL) != 0u) {
+        /* 1018h:04, the unit's serial: no DefaultValue (CiA 306 lets an
+         * entry omit it); a device-specific value here would make a master
+         * that checks it at boot (1F88h) reject every other unit. */
     } else if (co_od_read_hook(e) != NULL) {
         /* Computed at run time (a live input, an error state): no
          * DefaultValue (CiA 306: optional), so that a master that compares

@@ -93,6 +93,12 @@ static void usage(FILE *f)
             "                     LED changes are logged\n"
             "  --seed N           seed of the simulated noise (default 1): the same\n"
             "                     commands at the same times give the same values\n"
+            "  --serial N         serial number (0x1018 sub 4, the LSS address's last part)\n"
+            "                     of the first node; node i of the process (command-line\n"
+            "                     order from 0) gets N+i. 1..0xFFFFFFFF (decimal or 0x\n"
+            "                     hex). Without it each node's is derived from its product,\n"
+            "                     interface and factory node-ID: one per node, never 0, the\n"
+            "                     same at every start\n"
             "  --eds              print the product's EDS (CiA 306) and exit\n"
             "  --list-products    print every product ID with a description (with\n"
             "                     --product: that one only)\n"
@@ -192,6 +198,44 @@ static bool parse_number(const char *s, long max, long *out)
     }
     *out = v;
     return true;
+}
+
+/* --serial: decimal or 0x hex as parse_number, 1..0xFFFFFFFF (0 is no serial). */
+static bool parse_serial(const char *s, uint32_t *out)
+{
+    bool hex = s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
+    const char *d = hex ? s + 2 : s;
+    size_t n = strspn(d, hex ? "0123456789abcdefABCDEF" : "0123456789");
+    if (n == 0u || d[n] != '\0' || n > 10u) {
+        return false;
+    }
+    unsigned long long v = strtoull(d, NULL, hex ? 16 : 10);
+    if (v == 0u || v > 0xFFFFFFFFu) {
+        return false;
+    }
+    *out = (uint32_t)v;
+    return true;
+}
+
+/*
+ * The serial number of a node without --serial: FNV-1a over its product ID,
+ * interface and factory node-ID (all three fixed by the command line, so
+ * the same at every start), 0 taken as 1. Two nodes of one process differ
+ * in one of them (one factory node-ID twice on one interface is refused),
+ * so their LSS addresses differ but for a 32-bit hash collision.
+ */
+static uint32_t derived_serial(const char *product, const char *iface, uint8_t id)
+{
+    uint32_t h = 2166136261u;
+    const char *parts[2] = {product, iface};
+    for (unsigned k = 0; k < 2u; k++) {
+        for (const char *c = parts[k]; *c != '\0'; c++) {
+            h = (h ^ (uint8_t)*c) * 16777619u;
+        }
+        h *= 16777619u; /* a separator: "ab"+"c" is not "a"+"bc" */
+    }
+    h = (h ^ id) * 16777619u;
+    return h != 0u ? h : 1u;
 }
 
 static int parse_int(const char *s, int *out)
@@ -545,6 +589,7 @@ typedef struct options {
     bool eds;
     bool quit_on_eof;
     uint64_t seed; /* --seed: the simulator's noise (instance k: seed + k) */
+    uint32_t serial; /* --serial: node i's 0x1018 sub 4 is serial + i; 0: derived */
 } options_t;
 
 /* Not an exit status: go on (parse_options, set_up). */
@@ -656,6 +701,11 @@ static int check_specs(options_t *o)
     if (o->nnodes_total > APP_MAX_NODES) {
         return USAGE_ERROR("%u nodes: at most %u in one process", o->nnodes_total, APP_MAX_NODES);
     }
+    if (o->serial != 0u && o->serial > 0xFFFFFFFFu - (o->nnodes_total - 1u)) {
+        return USAGE_ERROR("--serial 0x%08lX: %u nodes take 0x%08lX..0x%08lX, past 0xFFFFFFFF",
+                           (unsigned long)o->serial, o->nnodes_total, (unsigned long)o->serial,
+                           (unsigned long)o->serial + o->nnodes_total - 1u);
+    }
     return GO_ON;
 }
 
@@ -690,7 +740,7 @@ static int parse_options(int argc, char **argv, options_t *o)
         {"help", no_argument, NULL, 'h'},          {"json", no_argument, NULL, 'J'},
         {"node", required_argument, NULL, 'N'},
         {"nvm-dir", required_argument, NULL, 'D'}, {"control", required_argument, NULL, 'C'},
-        {"log-time", required_argument, NULL, 'T'},
+        {"log-time", required_argument, NULL, 'T'}, {"serial", required_argument, NULL, 'S'},
         {NULL, 0, NULL, 0},
     };
     opterr = 0; /* our own one-line messages */
@@ -754,6 +804,12 @@ static int parse_options(int argc, char **argv, options_t *o)
             }
             break;
         }
+        case 'S':
+            if (!parse_serial(optarg, &o->serial)) {
+                return USAGE_ERROR("--serial takes a serial number 1..0xFFFFFFFF (decimal or 0x "
+                                   "hex), not '%s'", optarg);
+            }
+            break;
         case 'E':
             o->eds = true;
             break;
@@ -921,6 +977,13 @@ static int set_up_inst(app_t *a, const options_t *o, unsigned k, bool logf)
     a->nnodes += in->prod->nodes;
     for (unsigned i = 0; i < in->prod->nodes && n->id != 0u; i++) {
         co_node_set_factory_id(a->nodes[in->first + i], (uint8_t)(n->id + i));
+    }
+    /* Each node its own serial number, so that LSS can address it (CiA 305). */
+    for (unsigned i = 0; i < in->prod->nodes; i++) {
+        unsigned g = in->first + i;
+        co_node_set_serial(a->nodes[g], o->serial != 0u ? o->serial + g
+                                                        : derived_serial(in->prod->id, a->ifn[g],
+                                                                         co_node_factory_id(a->nodes[g])));
     }
     return GO_ON;
 }
@@ -1186,9 +1249,10 @@ static int set_up(app_t *a, const options_t *o)
         const product_t *prod = a->inst[a->node_inst[i]].prod;
         co_node_start(a->nodes[i], t);
         lp_log("node %u: %s, node-ID 0x%02X on %s, bit-rate code %u = %u kbit/s (vcan ignores "
-               "it); factory node-ID 0x%02X",
+               "it); factory node-ID 0x%02X, serial 0x%08lX",
                i, prod->id, co_node_id(a->nodes[i]), a->ifn[i], co_node_bitrate(a->nodes[i]),
-               product_kbps(prod, co_node_bitrate(a->nodes[i])), co_node_factory_id(a->nodes[i]));
+               product_kbps(prod, co_node_bitrate(a->nodes[i])), co_node_factory_id(a->nodes[i]),
+               (unsigned long)co_node_serial(a->nodes[i]));
     }
     log_store_status(a);
     /* A regular file or a device never blocks: read one block a pass of the

@@ -20,6 +20,16 @@
 #include "flash_ee.h"
 #include "nrf51.h"
 #include "serial_link.h"
+#include "uid_serial.h"
+
+/* ---- identity ------------------------------------------------------------- */
+
+/* The serial number from the 64-bit device identifier FICR DEVICEID[0..1]
+ * (nRF51 reference manual, FICR), folded (uid_serial.h). */
+uint32_t board_serial(unsigned node)
+{
+    return board_uid_serial(REG(FICR_DEVICEID0) ^ REG(FICR_DEVICEID1), node);
+}
 
 /* ---- time ---------------------------------------------------------------- */
 

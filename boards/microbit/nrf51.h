@@ -10,6 +10,10 @@
 
 #define REG(addr) (*(volatile uint32_t *)(addr))
 
+/* Factory information: the 64-bit device identifier. */
+#define FICR_DEVICEID0 0x10000060u
+#define FICR_DEVICEID1 0x10000064u
+
 /* Tasks are started by writing 1; events read 1 when they occurred and
  * are cleared by writing 0 (their interrupt line stays up until then). */
 

@@ -15,6 +15,16 @@
 #include "co_port.h"
 #include "flash_ee.h"
 #include "stm32f042.h"
+#include "uid_serial.h"
+
+/* ---- identity ----------------------------------------------------------- */
+
+/* The serial number from the 96-bit unique device ID (RM0091 33.1, at
+ * 0x1FFFF7AC, read as three words), folded (uid_serial.h). */
+uint32_t board_serial(unsigned node)
+{
+    return board_uid_serial(RD32(UID_BASE) ^ RD32(UID_BASE + 4u) ^ RD32(UID_BASE + 8u), node);
+}
 
 /* ---- time -------------------------------------------------------------- */
 

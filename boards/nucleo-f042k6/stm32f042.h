@@ -33,6 +33,9 @@
 #endif
 
 /* RCC */
+/* Unique device ID, 96 bits (RM0091 33.1). */
+#define UID_BASE 0x1FFFF7ACu
+
 #define RCC_BASE 0x40021000u
 #define RCC_CFGR (RCC_BASE + 0x04u)
 #define RCC_AHBENR (RCC_BASE + 0x14u)

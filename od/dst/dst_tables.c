@@ -59,7 +59,8 @@
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x00000093u, CO_NAME("Vendor-ID")}, \
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x00000064u, CO_NAME("Product code")}, \
     {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x00000001u, CO_NAME("Revision number")}, \
-    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0x00000000u, CO_NAME("Serial number")}, \
+    /* Per unit: the board's (co_node_set_serial), from the chip's ID. */ \
+    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = RO | CO_A_SERIAL, .def = 0x00000000u, CO_NAME("Serial number")}, \
     {.index = 0x1200, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("SDO server parameter")}, \
     {.index = 0x1200, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x600, CO_NAME("COB-ID client to server")}, \
     {.index = 0x1200, .sub = 2, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x580, CO_NAME("COB-ID server to client")}, \
@@ -78,10 +79,16 @@
     X710_ONLY(model, {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit_ms), .def = 4, CO_EXT(.min = 4, .max = 65535, .write = co_tpdo_write_comm), CO_NAME("Inhibit time")},) \
     /* 0 = inactive, 4..65535 ms; default 100 = 0x64 (C-16, C-17). */ \
     {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 100, CO_EXT(.write = dst_write_event), CO_NAME("Event timer")}, \
-    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("TPDO1 mapping parameter")}, \
+    /* The manual's table prints 2 entries (4 bytes) for its 8-byte frame \
+     * (C-4); 3 here: sub 3 maps the "(0x00)" the manual's TPDO tables print \
+     * in bytes 5-8 (0x2100 below), so that the mapping covers every byte \
+     * sent and a CiA 301 consumer that checks the length against it (EMCY \
+     * 8220h) sees none. The bytes on the wire are the manual's. */ \
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 3, CO_NAME("TPDO1 mapping parameter")}, \
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x60100010u, CO_NAME("1st mapped object")}, \
     /* The manual prints 0x60200020; 0x6020 is 16 bits (C-4). */ \
     {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x60200010u, CO_NAME("2nd mapped object")}, \
+    {.index = 0x1A00, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x21000020u, CO_NAME("3rd mapped object")}, \
     /* 0 slow, 1 medium, 2 fast; active after "save". Default 0 (C-2). */ \
     {.index = 0x2001, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(filter), .def = 0, CO_EXT(.min = 0, .max = 2), CO_NAME("Filter setting")}, \
     {.index = 0x20F0, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(id[0]), .def = 0x7F, CO_EXT(.min = 1, .max = 127, .write = dst_write_id), CO_NAME("Node-ID setting copy 1")}, \
@@ -89,6 +96,11 @@
     /* 0 1000k, 1 800k, 2 500k, 3 250k, 4 125k, 5 100k, 6 50k, 7 20k. */ \
     {.index = 0x20F2, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(br[0]), .def = 3, CO_EXT(.min = 0, .max = 7, .write = dst_write_bitrate), CO_NAME("Bit rate setting copy 1")}, \
     {.index = 0x20F3, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(br[1]), .def = 3, CO_EXT(.min = 0, .max = 7, .write = dst_write_bitrate), CO_NAME("Bit rate setting copy 2")}, \
+    /* TPDO1 bytes 5-8, "(0x00)" in the manual (its Z-360 table: bytes 3-8, \
+     * 0x6020 reading 0 there); an object of its own so that the mapping \
+     * can name them (sub 3 above). A manufacturer-specific index no \
+     * product uses. */ \
+    {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CONST | CO_A_PDO, .def = 0, CO_NAME("TPDO1 bytes 5-8 (0x00)")}, \
     /* 0 pre-operational, 1 no change, 2 stopped; 3..255 accepted as 1. */ \
     {.index = 0x4000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(err_behaviour), .def = 1, CO_NAME("Error behaviour")}, \
     {.index = 0x4001, .sub = 0, CO_TYPE_U8, .attr = RO, CO_EXT(.read = dst_read_errors), CO_NAME("Error code")}, \

@@ -42,11 +42,37 @@ co_res_t gsh_read_angle(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
     return CO_OK;
 }
 
+/* 0x2110: the alarm word, as the next PDO's bytes 5-6 carry it. */
+co_res_t gsh_read_alarm(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
+{
+    (void)e;
+    *v = chan_of(n)->alarms;
+    return CO_OK;
+}
+
+/* 0x2111: byte 7 of the last PDO sent. */
+co_res_t gsh_read_counter(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
+{
+    (void)e;
+    *v = chan_of(n)->sent_counter;
+    return CO_OK;
+}
+
+/* 0x2112: byte 8 of the last PDO sent. */
+co_res_t gsh_read_checksum(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
+{
+    (void)e;
+    *v = chan_of(n)->sent_checksum;
+    return CO_OK;
+}
+
 static void gsh_reset(co_node_t *n, co_reset_t kind)
 {
     (void)kind;
     gsh_chan_t *c = chan_of(n);
     c->counter = 0; /* 4.6: from 0 at every boot-up */
+    c->sent_counter = 0;
+    c->sent_checksum = 0;
     co_node_set_autostart(n, c->para.autostart == 1u); /* after every boot-up (C-22) */
 }
 
@@ -54,12 +80,13 @@ static void gsh_tpdo_fill(co_node_t *n, unsigned pdo, co_frame_t *f)
 {
     (void)pdo;
     gsh_chan_t *c = chan_of(n);
-    /* Fixed 8-byte layout (R-39): position, angle from the mapping, then
-     * the alarm word, the counter and the checksum. */
-    co_put_u16(&f->data[4], c->alarms);
+    /* Fixed 8-byte layout (R-39): position, angle and alarm word from the
+     * mapping, then the counter and the checksum, which only the frame
+     * knows (the mapped 0x2111/0x2112 give the last frame's). */
     f->data[6] = c->counter;
     f->data[7] = gsh_pdo_checksum(f->data);
-    f->dlc = 8;
+    c->sent_counter = c->counter;
+    c->sent_checksum = f->data[7];
     c->counter++; /* built only to be sent: type 254 is fixed */
 }
 

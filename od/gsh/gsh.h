@@ -47,7 +47,9 @@ typedef struct gsh_chan {
     co_incl_t incl;
     uint16_t position_mm;    /* 0x6004 */
     uint16_t alarms;
-    uint8_t counter;         /* PDO byte 7 */
+    uint8_t counter;         /* PDO byte 7 of the next PDO */
+    uint8_t sent_counter;    /* 0x2111: byte 7 of the last PDO sent (0 before one) */
+    uint8_t sent_checksum;   /* 0x2112: its byte 8 */
 } gsh_chan_t;
 
 typedef struct gsh_dev {
@@ -69,6 +71,9 @@ void gsh_sample(void *mem, const int32_t values[], uint32_t faults);
 co_res_t gsh_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v);
 co_res_t gsh_read_position(co_node_t *n, const co_od_entry_t *e, uint32_t *v);
 co_res_t gsh_read_angle(co_node_t *n, const co_od_entry_t *e, uint32_t *v);
+co_res_t gsh_read_alarm(co_node_t *n, const co_od_entry_t *e, uint32_t *v);
+co_res_t gsh_read_counter(co_node_t *n, const co_od_entry_t *e, uint32_t *v);
+co_res_t gsh_read_checksum(co_node_t *n, const co_od_entry_t *e, uint32_t *v);
 
 extern const co_node_cfg_t gsh_ch1_cfg, gsh_ch2_cfg;
 extern const product_t gsh_a, gsh_a_redundant;

@@ -37,7 +37,7 @@
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x00000093u, CO_NAME("Vendor-ID")}, \
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x00000067u, CO_NAME("Product code")}, \
     {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x00000001u, CO_NAME("Revision number")}, \
-    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Serial number")}, /* per unit */ \
+    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = RO | CO_A_SERIAL, .def = 0, CO_NAME("Serial number")}, /* per unit, each channel its own (co_node_set_serial) */ \
     {.index = 0x1200, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("SDO server parameter")}, \
     {.index = 0x1200, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x600, CO_NAME("COB-ID client to server")}, \
     {.index = 0x1200, .sub = 2, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x580, CO_NAME("COB-ID server to client")}, \
@@ -48,18 +48,39 @@
     {.index = 0x1800, .sub = 4, CO_TYPE_U8, .attr = RO, .def = 0, CO_NAME("Reserved")}, /* listed (C-13) */ \
     /* 100 ms (C-02); 0 = off, 4..65535 ms. */ \
     {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 100, CO_EXT(.write = gsh_write_event), CO_NAME("Event timer")}, \
-    /* Informative: the frame is always the fixed 8-byte layout (C-04). */ \
-    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("Tx PDO #0 mapping parameter")}, \
+    /* The manual's table prints 2 entries (4 bytes) for its 8-byte frame \
+     * (C-04); 5 here, so that the mapping covers every byte the frame has \
+     * and a CiA 301 consumer that checks the length against it (EMCY 8220h) \
+     * sees none: subs 3..5 map the alarm word, counter and checksum the \
+     * manual's Table 3 prints in bytes 5-6, 7 and 8 (0x2110..0x2112 below). \
+     * Subs 1 and 2 are the manual's bytes. */ \
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, CO_NAME("Tx PDO #0 mapping parameter")}, \
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x60040010u, CO_NAME("1st object")}, /* (C-03, C-05) */ \
     {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x68100010u, CO_NAME("2nd object")}, \
+    {.index = 0x1A00, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x21100010u, CO_NAME("3rd object")}, /* bytes 5-6 */ \
+    {.index = 0x1A00, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0x21110008u, CO_NAME("4th object")}, /* byte 7 */ \
+    {.index = 0x1A00, .sub = 5, CO_TYPE_U32, .attr = CONST, .def = 0x21120008u, CO_NAME("5th object")}, /* byte 8 */ \
+    /* The PDO's bytes 5-8 as objects (the manual has none: C-04, N-1), \
+     * manufacturer-specific indices no other product uses: the alarm word \
+     * now (GSH_ALARM_*), the counter and the checksum of the last PDO sent \
+     * (0 before the first). */ \
+    {.index = 0x2110, .sub = 0, CO_TYPE_U16, .attr = RO | CO_A_PDO, CO_EXT(.read = gsh_read_alarm), CO_NAME("Alarm")}, \
+    {.index = 0x2111, .sub = 0, CO_TYPE_U8, .attr = RO | CO_A_PDO, CO_EXT(.read = gsh_read_counter), CO_NAME("Counter")}, \
+    {.index = 0x2112, .sub = 0, CO_TYPE_U8, .attr = RO | CO_A_PDO, CO_EXT(.read = gsh_read_checksum), CO_NAME("Checksum")}, \
     /* Bit rate 0..7 = 1000, 800, 500, 250, 125, 100, 50, 20 kbit/s; node-ID 1..127.
      * Both saved by 0x1010 and active after a reset (R-29, R-31, C-24). */ \
     {.index = 0x3000, .sub = 0, CO_TYPE_U8, .attr = RW, LSS(bitrate), .def = 3, CO_EXT(.min = 0, .max = 7), CO_NAME("Setting of the baud rate")}, \
     {.index = 0x3001, .sub = 0, CO_TYPE_U8, .attr = RW, LSS(node_id), .def = (node_id_default), CO_EXT(.min = 1, .max = 127), CO_NAME("Setting of the node-ID")}, \
     {.index = 0x5000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(autostart), .def = 1, CO_EXT(.min = 0, .max = 1), CO_NAME("Automatic NMT start after power on")}, \
     {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RO, .def = 0, CO_NAME("Operating parameters")}, /* (C-16) */ \
-    /* Position in 0x6005 steps (1 mm); the PDO carries its low 16 bits (C-05). */ \
-    {.index = 0x6004, .sub = 0, CO_TYPE_U32, .attr = RO | CO_A_PDO, CO_EXT(.read = gsh_read_position), CO_NAME("Position value")}, \
+    /* Position in 0x6005 steps (1 mm). UNSIGNED16, where the manual's \
+     * 0x6004 row says "Unsigned32" (C-05): its PDO text ("Byte 1 and 2 \
+     * contain the length measurement ... unsigned integer 16-bit value") \
+     * and its mapping length 0x10 (1A00h:01 = 60040010h) both say 16 bits, \
+     * and the same type column calls 1A00h's 32-bit subs "Unsigned16" \
+     * (C-03). So a master decoding by the mapping and this type gets the \
+     * manual's value; the bytes on the wire are the manual's either way. */ \
+    {.index = 0x6004, .sub = 0, CO_TYPE_U16, .attr = RO | CO_A_PDO, CO_EXT(.read = gsh_read_position), CO_NAME("Position value")}, \
     {.index = 0x6005, .sub = 0, CO_TYPE_U32, .attr = RO, .def = 1000000u, CO_NAME("Position step setting")}, /* nm (C-17) */ \
     {.index = 0x67FF, .sub = 0, CO_TYPE_U32, .attr = RO, .def = 0x000A0196u, CO_NAME("Device type logical device 1")}, \
     {.index = 0x6800, .sub = 0, CO_TYPE_U16, .attr = RO, .def = 100, CO_NAME("Resolution")}, /* 0.1 deg */ \

@@ -58,7 +58,7 @@
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x0069666Du, CO_NAME("Vendor-ID")}, /* "ifm" */ \
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Product code")}, /* "0x0 (JDxxxx)" (?) */ \
     {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x00010000u, CO_NAME("Revision number")}, /* build constant (?) */ \
-    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0x0000D001u, CO_NAME("Serial number")} /* per unit; this build's (?) */
+    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = RO | CO_A_SERIAL, .def = 0, CO_NAME("Serial number")} /* per unit (co_node_set_serial) */
 
 /* 0x2200 .. 0x3411 (2601h on JD2 only). */
 #define JD_MFR_HEAD \

@@ -36,7 +36,7 @@
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Vendor-ID")}, /* [ph] */ \
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Product code")}, /* [ph] */ \
     {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Revision number")}, /* [ph] */ \
-    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Serial number")}, /* [ph] */ \
+    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = RO | CO_A_SERIAL, .def = 0, CO_NAME("Serial number")}, /* per unit (co_node_set_serial) */ \
     {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, CO_NAME("TPDO1 communication parameter")}, \
     {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(tpdo_cobid), .def = 0x180, CO_EXT(.write = co_tpdo_write_cobid), CO_NAME("COB-ID TPDO1")}, \
     /* Default 1: synchronous, CiA 410 (G1); 0, 1..240, 252..255 accepted (C10). */ \

@@ -103,7 +103,7 @@ static const co_od_entry_t skel_entries[] = {
     {.index = 0x1018, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Vendor-ID")}, /* the vendor's CiA ID */
     {.index = 0x1018, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 1, CO_NAME("Product code")},
     {.index = 0x1018, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x00010000u, CO_NAME("Revision number")},
-    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0, CO_NAME("Serial number")},
+    {.index = 0x1018, .sub = 4, CO_TYPE_U32, .attr = RO | CO_A_SERIAL, .def = 0, CO_NAME("Serial number")}, /* per unit: co_node_set_serial */
     {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, CO_NAME("TPDO1 communication parameter")},
     {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(tpdo_cobid), .def = 0x180, CO_EXT(.write = co_tpdo_write_cobid), CO_NAME("COB-ID TPDO1")},
     {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RW, PARA(tx_type), .def = 254, CO_EXT(.write = co_tpdo_write_comm), CO_NAME("Transmission type")},

@@ -88,7 +88,7 @@ class Facts:
     family: str
     nodes: tuple                 # factory node-IDs, one per node of the device
     device_type: int             # 0x1000
-    identity: dict               # 0x1018 sub -> value
+    identity: dict               # 0x1018 sub -> value (sub 4, the serial, is per unit)
     name: bytes                  # 0x1008
     boot_state: int              # heartbeat state after boot-up: 0x7F pre-op, 0x05 operational
     reads: tuple                 # more SDO reads (Read)
@@ -128,7 +128,7 @@ DST = Facts(
     family="dst",
     nodes=(0x7F,),
     device_type=0x0008019A,
-    identity={1: 0x93, 2: 0x64, 3: 1, 4: 0},
+    identity={1: 0x93, 2: 0x64, 3: 1},                     # sub 4 per unit
     name=b"GIB",
     boot_state=0x7F,
     reads=(Read(0x1009, 0, b"1.00"), Read(0x1200, 1, ID(0x600)), Read(0x1200, 2, ID(0x580)),
@@ -167,7 +167,7 @@ GSH = Facts(
     family="gsh",
     nodes=(0x13,),
     device_type=0xFFFF0196,
-    identity={1: 0x93, 2: 0x67, 3: 1},                     # sub 4 is per unit (C-31)
+    identity={1: 0x93, 2: 0x67, 3: 1},                     # sub 4 per unit (C-31)
     name=b"GSHA",
     boot_state=0x05,                                       # 0x5000 = 1: starts by itself
     reads=(Read(0x100A, 0, b"1.00"), Read(0x1200, 1, ID(0x600)), Read(0x1800, 1, ID(0x180)),
@@ -200,7 +200,7 @@ JD = Facts(
     family="jd",
     nodes=(10,),
     device_type=0x0002019A,
-    identity={1: 0x0069666D, 2: 0, 3: 0x00010000, 4: 0x0000D001},
+    identity={1: 0x0069666D, 2: 0, 3: 0x00010000},        # sub 4 per unit
     name=b"JD2xxx",
     boot_state=0x7F,
     reads=(Read(0x1009, 0, b"HW 1.0"), Read(0x1800, 1, ID(0x180)), Read(0x1801, 1, ID(0x280)),
@@ -232,7 +232,7 @@ PF = Facts(
     family="pf",
     nodes=(1,),
     device_type=0x0000019A,
-    identity={1: 0, 2: 0, 3: 0, 4: 0},                     # placeholders (G4)
+    identity={1: 0, 2: 0, 3: 0},                           # placeholders (G4); 4 per unit
     name=b"INY360D-F99-B16-V15",
     boot_state=0x7F,
     reads=(Read(0x1010, 1, u32(3)), Read(0x1800, 1, ID(0x180)), Read(0x1800, 2, u8(1)),

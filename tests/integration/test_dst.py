@@ -100,7 +100,10 @@ def test_pdo_decoding_follows_tilt(model, sensor_factory, network, bus):
     pdo = node.tpdo[1]
     assert pdo.cob_id == 0x1FF
     assert pdo.trans_type == 254 and pdo.event_timer == 100
-    assert [v.index for v in pdo.map] == [0x6010, 0x6020]
+    # Bytes 5-8 ("(0x00)" in the manual) mapped too: the mapping is as long
+    # as the frame (CiA 301 length check).
+    assert [v.index for v in pdo.map] == [0x6010, 0x6020, 0x2100]
+    assert pdo.length == 64
     node.sdo.download(0x6000, 0, struct.pack("<H", 10))  # 0.01 deg
     sensor.send("set x=12.34 y=-7.5")
     node.nmt.state = "OPERATIONAL"
@@ -114,6 +117,7 @@ def test_pdo_decoding_follows_tilt(model, sensor_factory, network, bus):
     pdo.wait_for_reception(timeout=1)
     assert pdo["Slope longitudinal"].raw == -3000
     assert pdo["Slope lateral"].raw == 2000
+    assert pdo["TPDO1 bytes 5-8 (0x00)"].raw == 0 and len(pdo.data) == 8
     # The PDO period is the event timer: 100 ms.
     bus.clear()
     frames = bus.collect(0x1FF, 1.05)

@@ -89,3 +89,16 @@ def test_readme_dcfchk_commands(tmp_path):
 def test_unknown_product_eds():
     r = subprocess.run([BINARY, "--product", "nope", "--eds"], capture_output=True, text=True)
     assert r.returncode == 2 and "unknown product" in r.stderr
+
+
+@pytest.mark.parametrize("pid", product_ids())
+def test_serial_number_has_no_default(pid, tmp_path):
+    """1018h:04 is each unit's own (its LSS address): the EDS gives no
+    DefaultValue for it (CiA 306 lets an entry omit one), so that a master
+    checking the serial at boot (1F88h) from a DCF of this EDS rejects no
+    unit; the canopen package loads it with no default."""
+    path = eds_of(pid, tmp_path)
+    section = path.read_text().split("[1018sub4]\n")[1].split("\n\n")[0]
+    assert "AccessType=ro" in section and "DefaultValue" not in section, section
+    od = canopen.import_od(str(path), 5)
+    assert od[0x1018][4].default is None and od[0x1018][3].default is not None

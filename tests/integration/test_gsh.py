@@ -28,11 +28,16 @@ def test_single_autostart_pdo_and_mapping(sensor_factory, network, bus):
     assert pdo.cob_id == 0x193 and pdo.trans_type == 254
     time.sleep(0.3)
     pdo.wait_for_reception(timeout=1)
-    # The manual maps 16 bits of the 32-bit 0x6004 (C-05); the canopen package
-    # decodes a variable by its object's type, so the position is read from
-    # the frame's first 16 bits. The angle decodes as mapped.
-    assert pdo["Position value"].raw & 0xFFFF == 52
+    # Decoded through the EDS mapping as a CiA 301 master does: 0x6004 is
+    # UNSIGNED16 as the manual's PDO text and mapping length say, and the
+    # mapping covers all 8 bytes (alarm word, counter, checksum).
+    assert [v.od.index for v in pdo.map] == [0x6004, 0x6810, 0x2110, 0x2111, 0x2112]
+    assert pdo.length == 64
+    assert pdo["Position value"].raw == 52
     assert pdo["Slope long16"].raw == 34
+    assert pdo["Alarm"].raw == 0
+    assert pdo["Checksum"].raw == checksum(pdo.data)
+    assert pdo["Counter"].raw == pdo.data[6]
     bus.clear()
     frames = bus.collect(0x193, 1.05)
     assert 9 <= len(frames) <= 11  # 100 ms, no NMT start needed
@@ -78,6 +83,17 @@ def test_redundant_on_one_bus(sensor_factory, network, bus):
     assert int.from_bytes(f2.data[0:2], "little") == 8000 - 52  # backwards
     assert int.from_bytes(f1.data[2:4], "little") == 34
     assert int.from_bytes(f2.data[2:4], "little") == 3600 - 34
+    # Both nodes decoded through their EDS mapping give the manual's values.
+    decoded = {}
+    for nid in (0x13, 0x14):
+        node = canopen.RemoteNode(nid, eds_od("gsh-a-redundant", sensor.log.parent, nid))
+        network.add_node(node)
+        node.tpdo.read()
+        pdo = node.tpdo[1]
+        pdo.wait_for_reception(timeout=1)
+        assert len(pdo.data) * 8 == pdo.length == 64
+        decoded[nid] = (pdo["Position value"].raw, pdo["Slope long16"].raw, pdo["Alarm"].raw)
+    assert decoded == {0x13: (52, 34, 0), 0x14: (8000 - 52, 3600 - 34, 0)}
     n13 = network.add_node(0x13, canopen.ObjectDictionary())
     n14 = network.add_node(0x14, canopen.ObjectDictionary())
     n13.sdo.download(0x1800, 5, (200).to_bytes(2, "little"))

@@ -13,7 +13,7 @@ from conftest import eds_od
 from conftest import boot as start_node
 
 NODE = 10
-VENDOR, PRODUCT, REVISION, SERIAL = 0x0069666D, 0, 0x00010000, 0x0000D001
+VENDOR, PRODUCT, REVISION = 0x0069666D, 0, 0x00010000  # the serial (1018h:04) is per unit
 
 
 
@@ -24,11 +24,12 @@ def boot(sensor, network, bus, node_id=NODE):
 
 def test_lss_configure_store_and_activate(sensor_factory, network, bus):
     sensor = sensor_factory("jd2xxx")
-    boot(sensor, network, bus)
+    node = boot(sensor, network, bus)
+    serial = node.sdo["Identity object"]["Serial number"].raw
     lss = network.lss
-    assert lss.send_switch_state_selective(VENDOR, PRODUCT, REVISION, SERIAL)
+    assert lss.send_switch_state_selective(VENDOR, PRODUCT, REVISION, serial)
     assert lss.inquire_lss_address(CS_INQUIRE_VENDOR_ID) == VENDOR
-    assert lss.inquire_lss_address(CS_INQUIRE_SERIAL_NUMBER) == SERIAL
+    assert lss.inquire_lss_address(CS_INQUIRE_SERIAL_NUMBER) == serial
     assert lss.inquire_node_id() == NODE
     lss.configure_node_id(32)
     lss.configure_bit_timing(2)  # 500 kbit/s
@@ -58,7 +59,7 @@ def test_lss_configure_store_and_activate(sensor_factory, network, bus):
 
 def test_lss_fastscan_finds_an_unconfigured_node(sensor_factory, network, bus):
     sensor = sensor_factory("jd1xxx")
-    boot(sensor, network, bus)
+    serial = boot(sensor, network, bus).sdo["Identity object"]["Serial number"].raw
     lss = network.lss
     lss.send_switch_state_global(lss.CONFIGURATION_STATE)
     lss.configure_node_id(0xFF)  # unconfigured from the next reset
@@ -71,7 +72,7 @@ def test_lss_fastscan_finds_an_unconfigured_node(sensor_factory, network, bus):
     m = bus.wait_for(0x7E4, timeout=1)
     assert m is not None and m.data[0] == 0x50
     found, address = lss.fast_scan()
-    assert found and address == [VENDOR, PRODUCT, REVISION, SERIAL]
+    assert found and address == [VENDOR, PRODUCT, REVISION, serial]
     lss.configure_node_id(7)  # fastscan left it selected
     bus.clear()
     lss.send_switch_state_global(lss.WAITING_STATE)

@@ -264,3 +264,92 @@ def test_127_nodes_in_one_process(tmp_path, bus):
     finally:
         proc.terminate()
         assert proc.wait(timeout=10) == 0
+
+
+# --- serial numbers: each node its own LSS address (CiA 305) ---------------
+
+JDS = (("jd2xxx", 0x21), ("jd2xxx", 0x22), ("jd1xxx", 0x23))
+
+
+def start_jds(tmp_path, bus, extra=()):
+    bus.clear()
+    cmd = [BINARY, "--iface", IFACE, "--log", str(tmp_path / "sensor.log"), "--on-eof", "run"]
+    for p, i in JDS:
+        cmd += ["--node", f"{p}@{i:#x}"]
+    proc = subprocess.Popen(cmd + list(extra), stdin=subprocess.DEVNULL)
+    seen = set()
+    for m in bus.frames(4):
+        if m.arbitration_id in (0x721, 0x722, 0x723) and bytes(m.data) == b"\0":
+            seen.add(m.arbitration_id)
+        if len(seen) == 3:
+            break
+    assert len(seen) == 3, f"boot-ups {sorted(seen)}"
+    return proc
+
+
+def stop(proc):
+    proc.send_signal(signal.SIGTERM)
+    assert proc.wait(timeout=5) == 0
+
+
+def identities(network):
+    """1018h subs 1..4 of each JD, by SDO."""
+    out = {}
+    for _, i in JDS:
+        node = network[i] if i in network else network.add_node(i, canopen.ObjectDictionary())
+        out[i] = tuple(int.from_bytes(node.sdo.upload(0x1018, s), "little") for s in range(1, 5))
+    return out
+
+
+def lss(network, cs, data=b""):
+    network.send_message(0x7E5, bytes([cs]) + data.ljust(7, b"\0"))
+
+
+def test_three_jds_have_their_own_lss_addresses(tmp_path, network, bus):
+    """Three JDs on one bus: 1018h:04 differs between them, so a switch state
+    selective request with one unit's address is answered by that one alone
+    (one 7E4 44); the serials are the same after a restart (derived from
+    product, interface and factory node-ID), and --serial N gives N, N+1, ..."""
+    proc = start_jds(tmp_path, bus)
+    try:
+        ids = identities(network)
+        serials = [ids[i][3] for _, i in JDS]
+        assert len(set(serials)) == 3 and 0 not in serials, serials
+        vendor, product, revision, serial = ids[0x22]
+        bus.clear()
+        for cs, v in ((0x40, vendor), (0x41, product), (0x42, revision), (0x43, serial)):
+            lss(network, cs, v.to_bytes(4, "little"))
+        answers = bus.collect(0x7E4, 0.5)
+        assert [bytes(m.data) for m in answers] == [b"\x44" + bytes(7)], answers
+        lss(network, 0x5E)  # inquire node-ID: the selected one
+        m = bus.wait_for(0x7E4, timeout=1)
+        assert m is not None and m.data[0] == 0x5E and m.data[1] == 0x22
+        lss(network, 0x04, b"\0")  # all back to waiting
+    finally:
+        stop(proc)
+    for i in list(network):
+        del network[i]
+    proc = start_jds(tmp_path, bus)
+    try:
+        assert identities(network) == ids  # stable across restarts
+    finally:
+        stop(proc)
+    for i in list(network):
+        del network[i]
+    proc = start_jds(tmp_path, bus, ["--serial", "0x5E000001"])
+    try:
+        got = identities(network)
+        assert [got[i][3] for _, i in JDS] == [0x5E000001, 0x5E000002, 0x5E000003]
+    finally:
+        stop(proc)
+    log = (tmp_path / "sensor.log").read_text()
+    assert "factory node-ID 0x22, serial 0x5E000002" in log
+
+
+def test_serial_usage_errors():
+    for bad in ("0", "-1", "0x100000000", "4294967296", "12x", "", "0x"):
+        refused(run("--product", "jd2xxx", "--iface", "vcan0", "--serial", bad),
+                f"--serial takes a serial number 1..0xFFFFFFFF (decimal or 0x hex), not '{bad}'")
+    refused(run("--product", "gsh-a-redundant", "--iface", "vcan0", "--serial", "0xFFFFFFFF"),
+            "--serial 0xFFFFFFFF: 2 nodes take 0xFFFFFFFF..0x100000000, past 0xFFFFFFFF")
+    assert "--serial N" in run("--help").stdout

@@ -188,6 +188,17 @@ def test_identity(dut, facts):
         assert up(dut, n, 0x1008, 0) == facts.name
 
 
+def test_serial_number_per_unit(dut, facts):
+    """0x1018 sub 4, the LSS address's last part (CiA 305), is the unit's
+    own: not 0, each node of a device its own, the same after a restart."""
+    dut.power_on(facts.nodes)
+    serials = [struct.unpack("<I", up(dut, n, 0x1018, 4))[0] for n in facts.nodes]
+    assert 0 not in serials and len(set(serials)) == len(serials), [hex(s) for s in serials]
+    assert dut.power_off() == 0
+    dut.power_on(facts.nodes)
+    assert [struct.unpack("<I", up(dut, n, 0x1018, 4))[0] for n in facts.nodes] == serials
+
+
 def test_sdo_reads_writes_aborts(dut, facts):
     dut.power_on(facts.nodes)
     n = facts.nodes[0]
@@ -295,6 +306,34 @@ def test_tpdo_by_event_timer(dut, facts):
     got = dut.frames.collect(cob, WINDOW_S)
     want = WINDOW_S * 1000 / EVENT_MS
     assert want - 1 <= len(got) <= want + 1, f"{len(got)} TPDOs in {WINDOW_S} s at {EVENT_MS} ms"
+
+
+def test_tpdo_length_is_the_mapped_length(dut, facts):
+    """CiA 301: a consumer checks a PDO's length against its mapping (EMCY
+    8220h when they differ). TPDO1's mapping read over SDO: every entry is
+    its object's length (the object's SDO upload has that many bytes), and
+    every TPDO1 frame has as many bytes as the entries add up to."""
+    dut.power_on(facts.nodes)
+    for n in facts.nodes:
+        count = up(dut, n, 0x1A00, 0)[0]
+        total = 0
+        for sub in range(1, count + 1):
+            m = struct.unpack("<I", up(dut, n, 0x1A00, sub))[0]
+            bits = m & 0xFF
+            assert len(up(dut, n, m >> 16, (m >> 8) & 0xFF)) * 8 == bits, \
+                f"node {n:#x}: 1A00h:{sub} = {m:08X}h is not its object's length"
+            total += bits // 8
+        cob = facts.tpdo_cob.of(n)
+        nmt(dut, NMT_PREOP, n)
+        for index, sub, data in facts.event_mode:
+            down(dut, n, index, sub, data)
+        down(dut, n, 0x1800, 5, struct.pack("<H", EVENT_MS))
+        dut.frames.clear()
+        nmt(dut, NMT_START, n)
+        dut.frames.wait_for(cob, timeout=0.5)
+        got = dut.frames.collect(cob, 0.2)
+        assert got and all(len(m.data) == total for _, m in got), \
+            f"node {n:#x}: TPDO1 lengths {sorted({len(m.data) for _, m in got})}, mapped {total}"
 
 
 def test_emcy_on_injected_fault(dut, facts):

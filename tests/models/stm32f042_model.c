@@ -433,6 +433,16 @@ static void reset_all(bool new_chip)
     spin_count = 0;
 }
 
+/* The 96-bit unique device ID (RM0091 33.1): factory-programmed, read-only. */
+static uint32_t uid[3] = {0x00470021u, 0x31385107u, 0x20363650u};
+
+void stm_uid_set(const uint32_t id[3])
+{
+    uid[0] = id[0];
+    uid[1] = id[1];
+    uid[2] = id[2];
+}
+
 void stm_chip_new(void)
 {
     reset_all(true);
@@ -502,6 +512,9 @@ static uint32_t read32(uint32_t addr, bool peek)
     }
     if (IN(addr, STM_FLASH_BASE, STM_FLASH_SIZE)) {
         return peek ? 0u : flash_mem_read(addr - STM_FLASH_BASE, 4);
+    }
+    if (IN(addr, 0x1FFFF7ACu, 12u)) {
+        return uid[(addr - 0x1FFFF7ACu) / 4u]; /* the system memory's ID words */
     }
     if (!peek) {
         stm_violation("read of unmodelled address 0x%08X", (unsigned)addr);

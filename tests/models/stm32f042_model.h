@@ -52,6 +52,8 @@ void stm_wfi(void);
 /* A new chip: every register at its reset value, flash memory holding the
  * image (a pattern) in its first 24 KB and erased (0xFF) above. */
 void stm_chip_new(void);
+/* The chip's 96-bit unique ID (0x1FFFF7AC, three words), kept until set again. */
+void stm_uid_set(const uint32_t id[3]);
 /* A system reset (or power cycle): every register at its reset value, the
  * flash memory kept, the flash key lockout lifted. */
 void stm_reset(void);

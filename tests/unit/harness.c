@@ -105,6 +105,9 @@ static void create(h_dev_t *d)
         if (d->factory_id[i] != 0u) {
             co_node_set_factory_id(d->nodes[i], d->factory_id[i]);
         }
+        if (d->serial[i] != 0u) {
+            co_node_set_serial(d->nodes[i], d->serial[i]);
+        }
         co_node_start(d->nodes[i], d->now);
     }
     d->next_sample = d->now + CO_FILTER_PERIOD_US;

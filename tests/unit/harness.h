@@ -130,6 +130,7 @@ typedef struct h_dev {
     int32_t truth[PRODUCT_MAX_INPUTS]; /* true inputs, milli-units */
     uint32_t fault; /* bit i: the product's fault i */
     uint8_t factory_id[PRODUCT_MAX_NODES]; /* co_node_set_factory_id() at each boot; 0: none */
+    uint32_t serial[PRODUCT_MAX_NODES];    /* co_node_set_serial() at each boot; 0: none */
 } h_dev_t;
 
 /* The product instance (aligned for any type: cast it to the family's type). */

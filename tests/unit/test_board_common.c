@@ -16,6 +16,7 @@
 #include "co_port.h"
 #include "dst.h"
 #include "harness.h"
+#include "uid_serial.h"
 
 /* ---- libc_min.c, renamed -------------------------------------------- */
 
@@ -104,6 +105,7 @@ static struct board {
     unsigned red_only;  /* of which (green off, red on) */
     bool green_seen[2]; /* green off / on seen */
     unsigned red_limit; /* leave after this many red-only calls (0: never) */
+    unsigned serial_calls; /* board_serial() calls */
 } bd;
 
 static void board_reset(bool init_ok, bool bitrate_ok, uint32_t run_us)
@@ -171,6 +173,13 @@ void board_sensor(const product_t *p, int32_t values[], uint32_t *faults)
     values[0] = 12500; /* x = 12.5 deg */
     values[1] = -3000;
     *faults = 0;
+}
+
+/* A chip ID of the fake board's, folded as the real boards do. */
+uint32_t board_serial(unsigned node)
+{
+    bd.serial_calls++;
+    return board_uid_serial(0x00470021u ^ 0x31385107u ^ 0x20363650u, node);
 }
 
 void board_sleep(uint32_t us)
@@ -267,6 +276,50 @@ static void test_main_loop_runs_the_product(void)
     CHECK_EQ(sent_on(0x1FF, 0, start), 0); /* no PDO before NMT start */
 }
 
+/* The node answers 1018h:04 with the board's serial number (the LSS
+ * address's last part, CiA 305): the main loop asks the board once per
+ * node before the start. */
+static void test_main_loop_serial_from_board(void)
+{
+    board_reset(true, true, 200000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    uint32_t start = bd.now;
+    bd.rx = (co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x40, 0x18, 0x10, 0x04}};
+    bd.rx_at = start + 100000u;
+    bd.rx_pending = true;
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_any();
+    }
+    CHECK_EQ(bd.serial_calls, 1);
+    unsigned i = 0;
+    while (i < bd.ntx && bd.tx[i].id != 0x5FF) {
+        i++;
+    }
+    CHECK(i < bd.ntx);
+    if (i < bd.ntx) {
+        CHECK(bd.tx[i].data[0] == 0x43 && bd.tx[i].data[1] == 0x18 && bd.tx[i].data[3] == 0x04);
+        CHECK_EQ(co_get_u32(&bd.tx[i].data[4]), board_serial(0));
+        CHECK(co_get_u32(&bd.tx[i].data[4]) != 0u);
+    }
+}
+
+/* The serial number from a chip's folded ID: never 0, the node in bit 1
+ * (the two nodes of a device differ), bit 0 set, the ID's low 30 bits in
+ * bits 31..2 (IDs that differ there differ). */
+static void test_uid_serial(void)
+{
+    CHECK_EQ(board_uid_serial(0, 0), 1);
+    CHECK_EQ(board_uid_serial(0, 1), 3);
+    CHECK_EQ(board_uid_serial(0xC0000000u, 0), 1); /* bits 31, 30 dropped: still not 0 */
+    CHECK_EQ(board_uid_serial(0x12345678u, 0), 0x48D159E1u);
+    CHECK_EQ(board_uid_serial(0x12345678u, 1), 0x48D159E3u);
+    for (unsigned bit = 0; bit < 30u; bit++) {
+        if (board_uid_serial(1u << bit, 0) == board_uid_serial(0, 0)) {
+            FAIL("one bit of the ID changed, the serial number did not");
+        }
+    }
+}
+
 /* NMT start through the loop: TPDO1 follows (X730 default event timer). */
 static void test_main_loop_nmt_start(void)
 {
@@ -345,6 +398,8 @@ int main(void)
     RUN(test_libc_min);
     RUN(test_main_loop_runs_the_product);
     RUN(test_main_loop_nmt_start);
+    RUN(test_main_loop_serial_from_board);
+    RUN(test_uid_serial);
     RUN(test_main_loop_bitrate_refused);
     RUN(test_port_bitrate_default);
     RUN(test_main_loop_refuses_to_run);

@@ -221,9 +221,13 @@ static void test_derived_reads_d1_to_d29(void)
     SDO(d, "40 00 18 03 00 00 00 00", "4B 00 18 03 04 00 00 00"); /* D-13 */
     SDO(d, "40 00 18 04 00 00 00 00", "4F 00 18 04 00 00 00 00"); /* D-14 */
     SDO(d, "40 00 18 05 00 00 00 00", "4B 00 18 05 64 00 00 00"); /* D-15 */
-    SDO(d, "40 00 1A 00 00 00 00 00", "4F 00 1A 00 02 00 00 00"); /* D-16 */
+    /* D-16 is 2 (the manual's count); 5: bytes 5-8 mapped too (gsh_a.c). */
+    SDO(d, "40 00 1A 00 00 00 00 00", "4F 00 1A 00 05 00 00 00");
     SDO(d, "40 00 1A 01 00 00 00 00", "43 00 1A 01 10 00 04 60"); /* D-17 */
     SDO(d, "40 00 1A 02 00 00 00 00", "43 00 1A 02 10 00 10 68"); /* D-18 */
+    SDO(d, "40 00 1A 03 00 00 00 00", "43 00 1A 03 10 00 10 21"); /* alarm word */
+    SDO(d, "40 00 1A 04 00 00 00 00", "43 00 1A 04 08 00 11 21"); /* counter */
+    SDO(d, "40 00 1A 05 00 00 00 00", "43 00 1A 05 08 00 12 21"); /* checksum */
     SDO(d, "40 00 30 00 00 00 00 00", "4F 00 30 00 03 00 00 00"); /* D-19 */
     SDO(d, "40 01 30 00 00 00 00 00", "4F 01 30 00 13 00 00 00"); /* D-20 */
     SDO(d, "40 00 50 00 00 00 00 00", "4F 00 50 00 01 00 00 00"); /* D-21 */
@@ -233,7 +237,9 @@ static void test_derived_reads_d1_to_d29(void)
     SDO(d, "40 00 68 00 00 00 00 00", "4B 00 68 00 64 00 00 00"); /* D-25 */
     SDO(d, "40 11 68 00 00 00 00 00", "4F 11 68 00 00 00 00 00"); /* D-26 */
     SDO(d, "40 FF 6F 00 00 00 00 00", "43 FF 6F 00 9A 01 02 00"); /* D-27 */
-    SDO(d, "40 04 60 00 00 00 00 00", "43 04 60 00 34 00 00 00"); /* D-28 */
+    /* D-28 with 0x6004 UNSIGNED16, as the PDO text and the mapping length
+     * say (gsh_a.c): 2 bytes, where the spec's vector has 4. */
+    SDO(d, "40 04 60 00 00 00 00 00", "4B 04 60 00 34 00 00 00");
     SDO(d, "40 10 68 00 00 00 00 00", "4B 10 68 00 22 00 00 00"); /* D-29 */
 }
 
@@ -303,6 +309,13 @@ static void test_alarms_counter_checksum(void)
         } else if (v[i].len_mm < 0) {
             CHECK_EQ(co_get_u16(last->data), 0);
         }
+        /* Bytes 5-8 as the mapped objects read them: the alarm word now,
+         * the counter and checksum of the last PDO sent. */
+        uint8_t counter = last->data[6];
+        uint8_t sum = last->data[7];
+        CHECK_EQ(h_read(d, 0x2110, 0), v[i].alarms);
+        CHECK_EQ(h_read(d, 0x2111, 0), counter);
+        CHECK_EQ(h_read(d, 0x2112, 0), sum);
     }
     CHECK_EQ(h_read(d, 0x1001, 0), 0); /* always 0 */
 }

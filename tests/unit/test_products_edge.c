@@ -8,7 +8,10 @@
  * raised while stopped reported once allowed again, the error behaviour
  * 0x4000 = 0 in pre-operational, an EEPROM that cannot be read (0x4001
  * bit 6); on the P+F (specs/pf-inx-iny.md) the fixed resolution (L760),
- * the error LED and 6300h for stored sets that cannot be used.
+ * the error LED and 6300h for stored sets that cannot be used. For every
+ * product: each TPDO's mapping names objects of the mapped length and
+ * covers exactly the bytes the frame has (CiA 301: a consumer checks the
+ * length against the mapping, EMCY 8220h).
  */
 #include "dst.h"
 #include "harness.h"
@@ -207,6 +210,131 @@ static void test_pf_stored_set_unusable(void)
     EXPECT(d, 0x081, "00 63 01 00 00 00 00 00");
 }
 
+/* ---- every product: TPDO length = mapped length ------------------------ */
+
+/* Bytes mapped by TPDO n of node k (0: no TPDO n); every entry must name a
+ * mappable object of exactly the mapped length (CiA 301). */
+static unsigned mapped_bytes(co_node_t *node, unsigned n)
+{
+    const co_od_entry_t *cnt = co_node_entry(node, (uint16_t)(0x1A00u + n), 0);
+    uint32_t count = 0;
+    if (cnt == NULL || co_od_get(node, cnt, &count) != CO_OK) {
+        return 0;
+    }
+    unsigned bytes = 0;
+    for (uint32_t i = 1; i <= count; i++) {
+        uint32_t m = 0;
+        const co_od_entry_t *me = co_node_entry(node, (uint16_t)(0x1A00u + n), (uint8_t)i);
+        CHECK(me != NULL && co_od_get(node, me, &m) == CO_OK);
+        const co_od_entry_t *obj = co_node_entry(node, (uint16_t)(m >> 16), (uint8_t)(m >> 8));
+        CHECK(obj != NULL && (obj->attr & CO_A_PDO) != 0u);
+        if (obj == NULL || co_od_size(obj) * 8u != (m & 0xFFu)) {
+            fprintf(stderr, "  %s: 1A%02Xh:%02X = %08lXh: the object is not %lu bits\n",
+                    d->prod->id, n, (unsigned)i, (unsigned long)m, (unsigned long)(m & 0xFFu));
+            FAIL("a mapped length differs from its object's");
+        }
+        bytes += (m & 0xFFu) / 8u;
+    }
+    return bytes;
+}
+
+/* The TPDO frames node k sends within 300 ms of NMT start and two SYNCs:
+ * each has the DLC its mapping gives. Returns the frames checked. */
+static unsigned check_sent_lengths(unsigned k)
+{
+    co_node_t *node = d->nodes[k];
+    uint16_t cob[CO_TPDO_MAX] = {0};
+    unsigned len[CO_TPDO_MAX] = {0};
+    for (unsigned n = 0; n < CO_TPDO_MAX; n++) {
+        const co_od_entry_t *c = co_node_entry(node, (uint16_t)(0x1800u + n), 1);
+        uint32_t v = 0x80000000u;
+        if (c != NULL) {
+            (void)co_od_get(node, c, &v);
+        }
+        cob[n] = (v & 0x80000000u) != 0u ? 0u : (uint16_t)(v & 0x7FFu);
+        len[n] = mapped_bytes(node, n);
+        if (cob[n] != 0u) {
+            co_frame_t f;
+            co_tpdo_build(node, n, &f);
+            CHECK_EQ(f.dlc, len[n]);
+        }
+    }
+    h_drain(d);
+    h_rx(d, 0x000, "01 00");
+    h_rx(d, 0x080, "");
+    h_advance(d, 150000);
+    h_rx(d, 0x080, "");
+    h_advance(d, 150000);
+    unsigned seen = 0;
+    for (const co_frame_t *f = h_next(d); f != NULL; f = h_next(d)) {
+        for (unsigned n = 0; n < CO_TPDO_MAX; n++) {
+            if (cob[n] != 0u && f->id == cob[n] && !f->rtr) {
+                CHECK_EQ(f->dlc, len[n]);
+                seen++;
+            }
+        }
+    }
+    return seen;
+}
+
+/* Every product, every node, every TPDO: the frame is as long as its
+ * mapping (the DST and GSH-A map all 8 bytes of their fixed frames), and
+ * each mapped length is its object's. */
+static void test_mapped_length_is_the_dlc(void)
+{
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        h_boot(d, product_list[i], false);
+        for (unsigned k = 0; k < d->nnodes; k++) {
+            if (check_sent_lengths(k) == 0u) {
+                fprintf(stderr, "  %s node %u: no TPDO sent\n", product_list[i]->id, k);
+                FAIL("no TPDO to check");
+            }
+        }
+    }
+}
+
+/* Expedited SDO download of len bytes to node 0; the answer's command byte. */
+static uint8_t sdo_write(uint16_t index, uint8_t sub, uint32_t value, unsigned len)
+{
+    co_frame_t f = {.id = (uint16_t)(0x600u + d->node->node_id), .dlc = 8};
+    f.data[0] = (uint8_t)(0x23u | ((4u - len) << 2));
+    co_put_u16(&f.data[1], index);
+    f.data[3] = sub;
+    co_put_u32(&f.data[4], value);
+    h_drain(d);
+    h_rx_frame(d, &f);
+    for (const co_frame_t *r = h_next(d); r != NULL; r = h_next(d)) {
+        if (r->id == 0x580u + d->node->node_id) {
+            return r->data[0];
+        }
+    }
+    return 0;
+}
+
+/* The products whose mapping a master may write (JD, P+F): after a new
+ * mapping of one object, what the device sends has that object's length. */
+static void test_written_mapping_sets_the_dlc(void)
+{
+    unsigned writable = 0;
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        h_boot(d, product_list[i], false);
+        const co_od_entry_t *m1 = co_node_entry(d->node, 0x1A00, 1);
+        if (m1 == NULL || (m1->attr & CO_A_W) == 0u) {
+            continue;
+        }
+        writable++;
+        uint32_t first = (uint32_t)h_read(d, 0x1A00, 1);
+        uint32_t cob = (uint32_t)h_read(d, 0x1800, 1);
+        CHECK_EQ(sdo_write(0x1800, 1, cob | 0x80000000u, 4), 0x60); /* invalid first */
+        CHECK_EQ(sdo_write(0x1A00, 0, 0, 1), 0x60);
+        CHECK_EQ(sdo_write(0x1A00, 0, 1, 1), 0x60); /* sub 1 alone */
+        CHECK_EQ(sdo_write(0x1800, 1, cob & 0x7FFFFFFFu, 4), 0x60);
+        CHECK_EQ(mapped_bytes(d->node, 0), (first & 0xFFu) / 8u);
+        CHECK(check_sent_lengths(0) > 0u);
+    }
+    CHECK(writable >= 2u); /* JD1, JD2, INX, INY */
+}
+
 int main(void)
 {
     RUN(test_registry);
@@ -218,5 +346,7 @@ int main(void)
     RUN(test_pf_resolution_fixed);
     RUN(test_pf_leds);
     RUN(test_pf_stored_set_unusable);
+    RUN(test_mapped_length_is_the_dlc);
+    RUN(test_written_mapping_sets_the_dlc);
     return h_finish();
 }
