@@ -22,10 +22,13 @@ set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 # switches here are shorter as compares than as a table with libgcc's
 # __gnu_thumb1_case_uqi). Not -fno-inline-functions-called-once: 32 bytes
 # less, but the idle poll then takes 23 instructions (target 20).
-# A build directory configured before keeps its old flags (CMake caches
-# them): configure it anew (rm -rf build-nucleo-f042k6 ...) to get these.
+# Given as directory options, not in the cached CMAKE_C_FLAGS: a build
+# directory configured before gets them at its next configure too.
 set(CO_M0_SIZE_OPT "-fno-move-loop-invariants -fno-tree-loop-im -fno-code-hoisting -fira-loop-pressure -fno-tree-sra -fno-tree-forwprop -fno-ssa-phiopt -fno-jump-tables")
-set(CO_MCU_OPT "-Os -flto -fmerge-all-constants -fno-early-inlining -g ${CO_M0_SIZE_OPT}")
+separate_arguments(CO_M0_SIZE_OPT_LIST UNIX_COMMAND "${CO_M0_SIZE_OPT}")
+add_compile_options(${CO_M0_SIZE_OPT_LIST})
+add_link_options(${CO_M0_SIZE_OPT_LIST})
+set(CO_MCU_OPT "-Os -flto -fmerge-all-constants -fno-early-inlining -g")
 set(CMAKE_C_FLAGS_INIT "-mcpu=cortex-m0 -mthumb ${CO_MCU_OPT} -ffunction-sections -fdata-sections")
 set(CMAKE_EXE_LINKER_FLAGS_INIT "-mcpu=cortex-m0 -mthumb ${CO_MCU_OPT} -nostdlib -Wl,--gc-sections")
 set(CO_BOARD nucleo-f042k6 CACHE STRING "MCU board")
