@@ -303,6 +303,50 @@ static bool cmd_can(serial_link_t *s, tokens_t *t, serial_put_fn put)
     return true;
 }
 
+/* `get`: "ok NAME=VALUE ..." in the product's input order, thousandths,
+ * as the Linux program answers it but without its "nmt=" word: the line
+ * sees the inputs, not the node (its NMT state is on the bus, in the
+ * heartbeat). Returns false (answered "error") for words after it. */
+static bool cmd_get(const serial_link_t *s, tokens_t *t, serial_put_fn put)
+{
+    if (next_token(t) != NULL) {
+        return fail(put, "get takes nothing after it", "", "");
+    }
+    put_str(put, "ok");
+    for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && s->prod->inputs[i].name != NULL; i++) {
+        int32_t v = s->values[i];
+        uint32_t m = v < 0 ? 0u - (uint32_t)v : (uint32_t)v;
+        put(' ');
+        put_str(put, s->prod->inputs[i].name);
+        put_str(put, v < 0 ? "=-" : "=");
+        put_uint(put, m / 1000u);
+        m %= 1000u;
+        put('.');
+        put((char)('0' + m / 100u));
+        put((char)('0' + m / 10u % 10u));
+        put((char)('0' + m % 10u));
+    }
+    put('\r');
+    return true;
+}
+
+/* The Linux program's commands this image does not have, each answered
+ * "error: 'WORD' is not on this target (...)" rather than "unknown
+ * command": ramp, sine and noise are motion generators of the simulation
+ * that would need a clock and per-input state in the image (a master
+ * scripts the same motion as a series of `set` lines); replay reads a
+ * file, and the image has no file system; quit: the image runs until QEMU
+ * ends (tools/emu, SIGTERM). */
+static bool not_here(const char *cmd)
+{
+    static const char *const words[] = {"ramp", "sine", "noise", "replay", "quit"};
+    bool found = false;
+    for (unsigned i = 0; i < sizeof(words) / sizeof(words[0]); i++) {
+        found = found || equal(cmd, words[i]);
+    }
+    return found;
+}
+
 /* One complete input line, NUL-terminated in s->line. */
 static void input_line(serial_link_t *s, serial_put_fn put)
 {
@@ -318,8 +362,13 @@ static void input_line(serial_link_t *s, serial_put_fn put)
         ok = cmd_fault(s, &t, put);
     } else if (equal(cmd, "can")) {
         ok = cmd_can(s, &t, put);
+    } else if (equal(cmd, "get")) {
+        (void)cmd_get(s, &t, put);
+        return; /* answered: "ok ..." or "error: ..." */
+    } else if (not_here(cmd)) {
+        ok = fail(put, "'", cmd, "' is not on this target (set, fault, can, get)");
     } else {
-        ok = fail(put, "unknown command '", cmd, "' (set, fault, can)");
+        ok = fail(put, "unknown command '", cmd, "' (set, fault, can, get)");
     }
     if (ok) {
         put_str(put, "ok\r");

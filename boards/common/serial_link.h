@@ -10,6 +10,13 @@
  *                                    (default 0, at most 60), then the
  *                                    controller is back after 128 x 11 bits
  *   can passive|warning|active       the controller's error state
+ *   get                              "ok NAME=VALUE ..." the true inputs
+ *                                    (thousandths; no "nmt=": the line
+ *                                    does not see the node)
+ *
+ * ramp, sine, noise, replay and quit, which the Linux program also takes,
+ * are answered "error: 'WORD' is not on this target (...)" (why: see
+ * not_here() in serial_link.c).
  *
  * Each input line is answered on the line with "ok" or "error: <cause>"
  * (python-can's slcan ignores lines that are not frames; an answer holds

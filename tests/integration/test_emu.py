@@ -11,6 +11,7 @@ The boards: rv32-virt, and microbit once its toolchain file
 (cmake/microbit.cmake) is in the tree. The images come from build-<board>
 (ctest's fixtures emu.images_<board> build them; tools/emu says how when
 one is missing)."""
+import fcntl
 import os
 import pathlib
 import random
@@ -19,6 +20,7 @@ import signal
 import socket
 import struct
 import subprocess
+import sys
 import tempfile
 import time
 import zlib
@@ -416,3 +418,152 @@ def test_help_documents_the_interface():
     for word in ("--board", "--product", "--port", "--flash", "rv32-virt", "microbit",
                  "SIGKILL", "Exit status"):
         assert word in r.stdout
+
+
+def test_ready_is_a_line_of_its_own(tmp_path):
+    """QEMU's "waiting for connection" line comes in two pieces (a stand-in
+    for QEMU writes it so, as a busy pipe may deliver it): tools/emu passes
+    QEMU's output on whole lines only, so "emu: ready" starts a line and
+    QEMU's line stays whole."""
+    port = free_port()
+    fake = tmp_path / "qemu-system-riscv32"
+    fake.write_text(
+        "#!/usr/bin/env python3\n"
+        "import sys, time\n"
+        f"sys.stderr.write('qemu: info: QEMU waiting for connection on: disconnected:tcp:127.0.0.1:{port}')\n"
+        "sys.stderr.flush(); time.sleep(0.5)\n"
+        "sys.stderr.write(',server=on\\n'); sys.stderr.flush()\n"
+        "print('from its standard output', flush=True)\n"
+        "sys.stderr.write('a last line without its end'); sys.stderr.flush()\n"
+        "time.sleep(0.5)\n")
+    fake.chmod(0o755)
+    image = tmp_path / "image.elf"
+    image.write_bytes(b"")
+    env = dict(os.environ, PATH=f"{tmp_path}:{os.environ['PATH']}")
+    r = subprocess.run([EMU, "--board", "rv32-virt", "--product", PRODUCT, "--port", str(port),
+                        "--image", str(image)], capture_output=True, timeout=30, env=env)
+    lines = r.stderr.decode().splitlines()
+    assert f"emu: ready: tcp:127.0.0.1:{port}" in lines, lines
+    assert (f"qemu: info: QEMU waiting for connection on: disconnected:tcp:127.0.0.1:{port}"
+            ",server=on") in lines, lines
+    assert lines.index(f"emu: ready: tcp:127.0.0.1:{port}") > 0
+    # QEMU's standard output comes the same way, and its last piece of a
+    # line is ended before tools/emu's own last word.
+    assert "from its standard output" in lines
+    assert "a last line without its end" in lines
+    assert lines[-1].startswith("emu: QEMU ended by itself")
+
+
+def test_ends_with_its_parent(tmp_path):
+    """A parent killed with SIGKILL (a test runner that dies): tools/emu
+    notices within a second, ends as at SIGTERM, and QEMU with it; the port
+    and the flash file are free again."""
+    flash = tmp_path / "flash.bin"
+    port = free_port()
+    parent = subprocess.Popen([
+        sys.executable, "-c",
+        "import subprocess, sys, time\n"
+        "p = subprocess.Popen(sys.argv[1:], stderr=subprocess.PIPE)\n"
+        "err = b''\n"
+        "while b'emu: ready' not in err:\n"
+        "    c = p.stderr.read1(4096)\n"
+        "    if not c: sys.exit(1)\n"
+        "    err += c\n"
+        "print(p.pid, flush=True)\n"
+        "time.sleep(600)\n",
+        EMU, "--board", "rv32-virt", "--product", PRODUCT, "--port", str(port),
+        "--flash", str(flash)], stdout=subprocess.PIPE, start_new_session=True)
+    try:
+        line = parent.stdout.readline()
+        assert line, "tools/emu did not get ready"
+        emu = int(line)
+        qemu = [int(p.name) for p in pathlib.Path("/proc").iterdir() if p.name.isdigit()
+                and _ppid(p.name) == emu]
+        assert len(qemu) == 1
+        os.kill(parent.pid, signal.SIGKILL)
+        parent.wait()
+        end = time.monotonic() + 5
+        while time.monotonic() < end and any(_alive(p) for p in [emu] + qemu):
+            time.sleep(0.1)
+        assert not any(_alive(p) for p in [emu] + qemu), "tools/emu or QEMU outlived its parent"
+        with open(flash, "rb") as f:
+            fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)  # raises while held
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", port))
+    finally:
+        for group in (parent.pid, emu):  # tools/emu leads a group of its own
+            try:
+                os.killpg(group, signal.SIGKILL)
+            except (ProcessLookupError, TypeError):
+                pass
+        flash.unlink(missing_ok=True)
+
+
+def _ppid(pid):
+    try:
+        stat = pathlib.Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    return int(stat.rsplit(")", 1)[1].split()[1])
+
+
+def _alive(pid):
+    """A process that exists and is not a zombie (a zombie holds nothing)."""
+    try:
+        stat = pathlib.Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return False
+    return stat.rsplit(")", 1)[1].split()[0] != "Z"
+
+
+def test_flash_file_of_zeros_takes_saves(board, emus, tmp_path):
+    """A flash file of zeros (truncate -s SIZE): flash whose every bit is
+    programmed. The image reports the stored set as corrupt (no valid
+    record), and a save erases the block it needs and works; the value
+    survives a restart. rv32-virt took such a file for no flash at all (its
+    last word reads 0, as QEMU's bank without a drive does) and refused
+    every save with 06060000h."""
+    flash = tmp_path / "flash.bin"
+    with open(flash, "wb") as f:
+        f.truncate(BOARDS[board]["size"])
+    e = emus(flash, board)
+    sdo = e.start()
+    assert errors(sdo) & ERR_CHECKSUM, "a flash of zeros holds no valid set"
+    set_heartbeat(sdo, 1234)
+    save(sdo)
+    assert e.stop() == 0
+    sdo = e.start()
+    assert u16(sdo, 0x1017) == 1234
+    assert e.stop() == 0
+    # The PARA set is whole; the DST's LSS set (slots 2 and 3) still holds
+    # zeros, and is reported by the same bit until it is stored too.
+    assert slots(flash, board)[:2].count("valid") == 1
+
+
+def ask(bus, line, timeout=5):
+    """One input line on the serial line, its answer (frames meanwhile read
+    and dropped)."""
+    while not bus.answers.empty():
+        bus.answers.get_nowait()
+    bus.write_line(line)
+    end = time.monotonic() + timeout
+    while bus.answers.empty():
+        assert time.monotonic() < end, f"no answer to {line!r}"
+        bus.recv(timeout=0.05)
+    return bus.answers.get_nowait()
+
+
+def test_get_and_the_commands_not_on_this_target(board, emus):
+    """The image takes `get` as the Linux program does (the true inputs,
+    without its nmt= word), and answers the Linux program's commands it does
+    not have by name, not as unknown ones."""
+    e = emus(None, board)
+    e.start()
+    assert ask(e.bus, "set x=12.5 y=-3") == "ok"
+    assert ask(e.bus, "get") == "ok x=12.500 y=-3.000"
+    for word, line in (("ramp", "ramp x=30 in 5s"), ("sine", "sine x amp=1 period=2s"),
+                       ("noise", "noise x sd=0.1"), ("replay", "replay motion.csv"),
+                       ("quit", "quit")):
+        assert ask(e.bus, line) == f"error: '{word}' is not on this target (set, fault, can, get)"
+    assert ask(e.bus, "get") == "ok x=12.500 y=-3.000"  # nothing of them changed anything
+    assert e.stop() == 0

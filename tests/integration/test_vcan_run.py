@@ -6,14 +6,17 @@ signal, SIGKILL). Run on the host (not inside vcan-run), with
 VCAN_RUN_MODE=uml: the path taken where the kernel has no CAN."""
 import os
 import pathlib
+import pty
+import select
 import shutil
 import signal
+import socket
 import subprocess
 import time
 
 import pytest
 
-from conftest import ROOT
+from conftest import BINARY, ROOT
 
 VCAN_RUN = str(ROOT / "tools" / "vcan-run")
 BOOT = 60    # s: User-Mode Linux boots in about 3 s; generous for a loaded machine
@@ -126,14 +129,133 @@ def test_command_ignoring_the_signal_gets_the_grace_time(tmp_path):
     assert_torn_down(f"vcanrun{p.pid}", tmp_path)
 
 
-def test_sigkill_of_vcan_run_leaves_no_uml(tmp_path):
-    """Nothing can be trapped: UML's parent-death signal ends it."""
-    p = start(tmp_path, "echo ready > $D/ready; sleep 60")
-    wait_file(tmp_path / "ready", p)
+def test_sigkill_of_vcan_run_leaves_nothing(tmp_path):
+    """Nothing can be trapped: UML's parent-death signal ends it, and
+    vcan-run's janitor removes its work directory, copy of the caller's
+    environment and all. That copy is its owner's alone while it exists
+    (mode 0600; the command inside removes it once read)."""
+    p = start(tmp_path, "echo ready > $D/ready; sleep 60", VCAN_RUN_SECRET="s3cret")
+    modes = set()
+    end = time.monotonic() + BOOT
+    while not (tmp_path / "ready").exists():
+        assert p.poll() is None, p.communicate()
+        assert time.monotonic() < end, "the command did not start inside User-Mode Linux"
+        for f in (tmp_path / "tmp").glob("vcan-run.*/*"):
+            try:
+                modes.add((f.name, f.stat().st_mode & 0o777))
+            except FileNotFoundError:
+                pass
+        time.sleep(0.005)
+    assert ("env", 0o600) in modes, modes
+    # What vcan-run writes there (the command's words, directory and the
+    # scripts too); User-Mode Linux's own files (its pid, its mconsole
+    # socket) take the caller's umask, as the command's files do.
+    ours = {"env", "cmd", "cwd", "init", "run"}
+    assert all(m & 0o077 == 0 for name, m in modes if name in ours), modes
+    envs = list((tmp_path / "tmp").glob("vcan-run.*/env"))
+    assert envs == [], "the environment's copy is still there while the command runs"
     umid = f"vcanrun{p.pid}"
     p.kill()
     p.communicate(timeout=30)
     end = time.monotonic() + PROMPT
-    while uml_pids(umid) and time.monotonic() < end:
+    while (uml_pids(umid) or list((tmp_path / "tmp").iterdir())) and time.monotonic() < end:
         time.sleep(0.1)
-    assert uml_pids(umid) == [], f"linux.uml processes of {umid} left running"
+    assert_torn_down(umid, tmp_path)
+
+
+class Terminal:
+    """vcan-run --shell on a pseudo-terminal, as a person at a terminal
+    runs it: what is typed goes in, what the screen shows comes out."""
+
+    def __init__(self, tmp_path, args):
+        work = tmp_path / "tmp"
+        work.mkdir(exist_ok=True)
+        env = dict(os.environ, VCAN_RUN_MODE="uml", TMPDIR=str(work))
+        self.master, slave = pty.openpty()
+        self.proc = subprocess.Popen([VCAN_RUN, "--shell"] + args, stdin=slave, stdout=slave,
+                                     stderr=slave, env=env, start_new_session=True)
+        os.close(slave)
+        self.screen = b""
+
+    def wait_for(self, text, timeout=20):
+        end = time.monotonic() + timeout
+        while text.encode() not in self.screen:
+            left = end - time.monotonic()
+            assert left > 0, f"{text!r} not on the screen:\n{self.screen.decode(errors='replace')}"
+            if select.select([self.master], [], [], left)[0]:
+                try:
+                    self.screen += os.read(self.master, 4096)
+                except OSError:  # the terminal's other side is gone
+                    assert text.encode() in self.screen, self.screen.decode(errors="replace")
+
+    def type(self, text):
+        os.write(self.master, text.encode())
+
+    def close(self):
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGKILL)
+            self.proc.wait()
+        os.close(self.master)
+
+
+def test_shell_next_to_a_sensor_on_a_terminal(tmp_path):
+    """A newcomer's bus: vcan-run --shell COMMAND gives a shell inside
+    User-Mode Linux with the command (a sensor) running as its job %1, and
+    candump, cansend and the sensor's TCP control socket at hand there.
+    The port is not reachable from this machine. Ctrl-C stops the shell's
+    foreground job, not the session; exit ends it, and nothing of it is
+    left."""
+    with socket.socket() as s:  # a port nothing listens on here
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    t = Terminal(tmp_path, [BINARY, "--product", "dst-x730-xy30", "--iface", "vcan0",
+                            "--on-eof", "run", "--control", f"tcp:{port}"])
+    try:
+        t.wait_for("candump and cansend at hand", timeout=BOOT)
+        t.wait_for("(vcan-run) ")
+        t.type("jobs\n")
+        t.wait_for("canopen-sensor")
+        # An SDO upload of 1000h: the sensor's answer as candump shows it.
+        t.type("candump -n1 vcan0,5FF:7FF & sleep 0.5; cansend vcan0 67F#4000100000000000; wait %2\n")
+        t.wait_for("5FF   [8]  43 00 10 00")
+        # The control socket, from inside the same User-Mode Linux.
+        t.type(f"{ROOT}/build/venv/bin/python -c 'import socket, time\n"
+               "for i in range(50):\n"
+               "    try:\n"
+               f"        s = socket.create_connection((\"127.0.0.1\", {port})); break\n"
+               "    except OSError: time.sleep(0.1)\n"
+               "s.sendall(b\"set x=12.5\\nget\\n\"); time.sleep(0.5); print(s.recv(200).decode())'\n")
+        t.wait_for("ok x=12.500")
+        # User-Mode Linux's network is its own: the port is not on this
+        # machine's loopback (what the README says a runner outside meets).
+        with pytest.raises(ConnectionRefusedError):
+            socket.create_connection(("127.0.0.1", port), timeout=5).close()
+        # (Each echo's output differs from the line typed, which the
+        # terminal shows too.)
+        t.type("sleep 30; echo sl''ept\n")
+        time.sleep(1)
+        t.type("\x03")  # Ctrl-C: to the foreground job inside
+        # (The terminal drops what was typed ahead of an interrupt: wait.)
+        time.sleep(1)
+        t.type("echo after-$((6 * 7))\n")
+        t.wait_for("after-42", timeout=10)
+        assert b"slept" not in t.screen
+        t.type("exit\n")
+        assert t.proc.wait(timeout=PROMPT + 10) == 0
+    finally:
+        t.close()
+    assert_torn_down(f"vcanrun{t.proc.pid}", tmp_path)
+
+
+def test_shell_reads_commands_from_a_pipe(tmp_path):
+    """Standard input not a terminal: the commands are read to the end,
+    then run as a script inside, with vcan up; its status comes back."""
+    work = tmp_path / "tmp"
+    work.mkdir()
+    env = dict(os.environ, VCAN_RUN_MODE="uml", TMPDIR=str(work))
+    r = subprocess.run([VCAN_RUN, "--shell"], input="candump -n1 vcan1 &\nsleep 0.5\n"
+                       "cansend vcan1 123#1122\nwait\nexit 3\n", capture_output=True, text=True,
+                       env=env, timeout=BOOT)
+    assert r.returncode == 3, r.stderr
+    assert "vcan1  123   [2]  11 22" in r.stdout
+    assert list(work.iterdir()) == []

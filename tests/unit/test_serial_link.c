@@ -151,7 +151,7 @@ static void test_set(void)
     CHECK_EQ(FEED("set x=12,5\xb0 \a\r", &f), 0);
     CHECK(same(out, "error: '12,5?': not a number within +-3600 (3 decimals at most)\r"));
     CHECK_EQ(FEED("\at1FF8AABBCCDDEEFF0011 z\r", &f), 0);
-    CHECK(same(out, "error: unknown command '?t1FF8AABBCCDDEEFF0011' (set, fault, can)\r"));
+    CHECK(same(out, "error: unknown command '?t1FF8AABBCCDDEEFF0011' (set, fault, can, get)\r"));
 }
 
 static void test_fault_and_unknown(void)
@@ -184,7 +184,9 @@ static void test_fault_and_unknown(void)
     }
     CHECK(same(out, "error: this product has no simulated faults\r"));
     CHECK_EQ(FEED("quit\r", &f), 0);
-    CHECK(same(out, "error: unknown command 'quit' (set, fault, can)\r"));
+    CHECK(same(out, "error: 'quit' is not on this target (set, fault, can, get)\r"));
+    CHECK_EQ(FEED("tilt 5\r", &f), 0);
+    CHECK(same(out, "error: unknown command 'tilt' (set, fault, can, get)\r"));
     CHECK_EQ(FEED("   \r", &f), 0); /* blank input line: no answer */
     CHECK_EQ(out[0], '\0');
     /* Too long, or a NUL byte: an error, the line is not applied. */
@@ -197,6 +199,46 @@ static void test_fault_and_unknown(void)
     /* The next line is whole again. */
     CHECK_EQ(FEED("set x=2\r", &f), 0);
     CHECK_EQ(s.values[0], 2000);
+}
+
+/* `get` answers the true inputs as the Linux program does (without its
+ * nmt= word); the Linux program's other commands are "not on this target",
+ * each by name, and change nothing. */
+static void test_get_and_commands_not_here(void)
+{
+    serial_link_init(&s, &jd2xxx);
+    co_frame_t f;
+    CHECK_EQ(FEED("set x=10.5 y=-0.25 temp=-40\r", &f), 0);
+    CHECK_EQ(FEED("get\r", &f), 0);
+    CHECK(same(out, "ok x=10.500 y=-0.250 temp=-40.000\r"));
+    CHECK_EQ(FEED(" get \r", &f), 0);
+    CHECK(same(out, "ok x=10.500 y=-0.250 temp=-40.000\r"));
+    CHECK_EQ(FEED("set x=-3600 y=0.001\r", &f), 0);
+    CHECK_EQ(FEED("get\r", &f), 0);
+    CHECK(same(out, "ok x=-3600.000 y=0.001 temp=-40.000\r"));
+    CHECK_EQ(FEED("get x\r", &f), 0);
+    CHECK(same(out, "error: get takes nothing after it\r"));
+    serial_link_init(&s, &gsh_a);
+    CHECK_EQ(FEED("get\r", &f), 0);
+    CHECK(starts(out, "ok length="));
+    static const char *const lines[] = {"ramp x=30 in 5s", "sine x amp=1 period=1s",
+                                        "noise x sd=1", "replay a.csv", "quit"};
+    static const char *const answers[] = {
+        "error: 'ramp' is not on this target (set, fault, can, get)\r",
+        "error: 'sine' is not on this target (set, fault, can, get)\r",
+        "error: 'noise' is not on this target (set, fault, can, get)\r",
+        "error: 'replay' is not on this target (set, fault, can, get)\r",
+        "error: 'quit' is not on this target (set, fault, can, get)\r"};
+    serial_link_init(&s, &jd2xxx);
+    for (unsigned i = 0; i < sizeof(lines) / sizeof(lines[0]); i++) {
+        char line[64];
+        size_t n = length(lines[i]);
+        memcpy(line, lines[i], n);
+        line[n] = '\r';
+        CHECK_EQ(feed(line, n + 1u, &f), 0);
+        CHECK(same(out, answers[i]));
+        CHECK_EQ(s.values[0], jd2xxx.inputs[0].initial);
+    }
 }
 
 static void test_can_state_and_bitrate(void)
@@ -270,6 +312,7 @@ int main(void)
     RUN(test_frames_out);
     RUN(test_set);
     RUN(test_fault_and_unknown);
+    RUN(test_get_and_commands_not_here);
     RUN(test_can_state_and_bitrate);
     return h_finish();
 }
