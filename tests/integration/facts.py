@@ -108,7 +108,7 @@ class Facts:
     corrupt: Corrupt
     node_id_change: NodeIdChange
     tpdo_cob: ID = ID(0x180)
-    sdo_segmented: bool = True   # SDO segmented and block download (CiA 301)
+    sdo_block: bool = True       # SDO block download (CiA 301)
     sync_cobid_writable: bool = True  # 1005h rw (where the product has SYNC types)
     dynamic_mapping: bool = False  # 0x1A00.. writable (CiA 301 dynamic mapping)
 
@@ -159,7 +159,7 @@ DST = Facts(
     # B-41..B-44: both copies, stored by the device itself, active after a reset.
     node_id_change=NodeIdChange(steps=(("sdo", 0x20F0, 0, u8(6)), ("sdo", 0x20F1, 0, u8(6)),
                                        ("power-cycle",)), new_id=6),
-    sdo_segmented=False,                                   # expedited only (README)
+    sdo_block=False,                                       # expedited and segmented (README)
     sync_cobid_writable=False,                             # 1005h constant (README)
 )
 
