@@ -153,7 +153,7 @@ static const uint8_t no_mux[4] = {0, 0, 0, 0};
  * A download segment of a transfer download_initiate() began. Toggle bit
  * wrong: 05030000h; more than 4 bytes in all: 06070012h, as an expedited
  * write of that length to any object of the product (none is longer).
- * The cost of this path and download_initiate's segmented branch: 252
+ * The cost of this path and download_initiate's segmented branch: 268
  * bytes of the DST X730 image's flash on the Cortex-M0 (sdo_segment.c,
  * which would also bring upload, is 504).
  */
