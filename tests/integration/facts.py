@@ -140,7 +140,7 @@ DST = Facts(
         Abort("w", 0x1017, 0, 0x06090030, u16(10)),        # 1..19 not accepted (B-17)
         Abort("w", 0x1800, 2, 0x06090030, u8(255)),        # 1..240, 254 only (C-18)
         Abort("w", 0x20F0, 0, 0x06090032, u8(0)),          # node-ID 1..127 (B-42)
-        Abort("w", 0x2001, 0, 0x05040001, bytes(9)),       # expedited only (B-33): segmented refused
+        Abort("w", 0x2001, 0, 0x06070012, bytes(9)),       # segmented, longer than the object
     ),
     sync_type=2,
     sync_refused=None,
