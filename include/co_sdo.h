@@ -23,8 +23,9 @@ typedef struct co_node co_node_t;
 /* Largest object a segmented or block download can write, or a block
  * upload can read (bytes); the RAM cost of the SDO server is about this.
  * An MCU image may set less (its table sizes in od/<family>/family.cmake).
- * 4..889: at least an expedited transfer's 4 bytes (a product that offers
- * expedited SDO only, the DST, needs no more), at most one block: 127
+ * 4..889: at least an expedited transfer's 4 bytes (a product without
+ * co_sdo_segmented, the DST, needs no more: its segmented downloads carry
+ * at most 4 bytes), at most one block: 127
  * segments of 7 bytes (CiA 301's largest blksize; sdo_block.c sends a
  * buffer as one block of (CO_SDO_BUF + 6) / 7 segments). */
 #ifndef CO_SDO_BUF
@@ -57,7 +58,9 @@ typedef struct co_sdo {
 typedef bool (*co_sdo_proto_fn)(co_node_t *node, const uint8_t *d);
 
 /* SDO segmented transfer (sdo_segment.c): set as co_node_cfg_t.sdo_segmented
- * to offer it. Needed by any product with an object of more than 4 bytes. */
+ * to offer it. Needed by any product with an object of more than 4 bytes.
+ * Without it the server still takes segmented downloads of at most 4 bytes
+ * in all (sdo.c); segmented uploads are refused with 0x05040001. */
 bool co_sdo_segmented(co_node_t *node, const uint8_t *d);
 
 /* SDO block transfer (sdo_block.c): set as co_node_cfg_t.sdo_block to offer it. */

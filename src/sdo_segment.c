@@ -2,8 +2,9 @@
  * sdo_segment.c - SDO segmented transfer (CiA 301 7.2.4.3.3-7), optional:
  * linked where a product's config sets .sdo_segmented = co_sdo_segmented.
  * A product whose objects all fit 4 bytes may leave it out (the DSTs: the
- * manuals use expedited transfer only); the server then answers segmented
- * requests with abort 0x05040001.
+ * manuals use expedited transfer only); the server then takes segmented
+ * downloads of up to 4 bytes itself (sdo.c) and answers the other
+ * segmented requests with abort 0x05040001.
  */
 #include <string.h>
 

@@ -108,7 +108,7 @@ class Facts:
     corrupt: Corrupt
     node_id_change: NodeIdChange
     tpdo_cob: ID = ID(0x180)
-    sdo_segmented: bool = True   # SDO segmented and block download (CiA 301)
+    sdo_block: bool = True       # SDO block download (CiA 301)
     sync_cobid_writable: bool = True  # 1005h rw (where the product has SYNC types)
     dynamic_mapping: bool = False  # 0x1A00.. writable (CiA 301 dynamic mapping)
 
@@ -140,7 +140,7 @@ DST = Facts(
         Abort("w", 0x1017, 0, 0x06090030, u16(10)),        # 1..19 not accepted (B-17)
         Abort("w", 0x1800, 2, 0x06090030, u8(255)),        # 1..240, 254 only (C-18)
         Abort("w", 0x20F0, 0, 0x06090032, u8(0)),          # node-ID 1..127 (B-42)
-        Abort("w", 0x2001, 0, 0x05040001, bytes(9)),       # expedited only (B-33): segmented refused
+        Abort("w", 0x2001, 0, 0x06070012, bytes(9)),       # segmented, longer than the object
     ),
     sync_type=2,
     sync_refused=None,
@@ -159,7 +159,7 @@ DST = Facts(
     # B-41..B-44: both copies, stored by the device itself, active after a reset.
     node_id_change=NodeIdChange(steps=(("sdo", 0x20F0, 0, u8(6)), ("sdo", 0x20F1, 0, u8(6)),
                                        ("power-cycle",)), new_id=6),
-    sdo_segmented=False,                                   # expedited only (README)
+    sdo_block=False,                                       # expedited and segmented (README)
     sync_cobid_writable=False,                             # 1005h constant (README)
 )
 

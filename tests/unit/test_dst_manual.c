@@ -446,16 +446,174 @@ static void test_derived_rejections(void)
     SDO(d, "23 14 10 00 FF 00 00 40", "80 14 10 00 30 00 09 06"); /* bit 30 */
     SDO(d, "22 01 20 00 01 00 00 00", "60 01 20 00 00 00 00 00"); /* B-39 */
     SDO(d, "2B 01 20 00 01 00 00 00", "80 01 20 00 12 00 07 06"); /* length high */
-    /* B-33, B-36: expedited transfer only; segmented and block requests
-     * are unsupported command specifiers, and change nothing. */
-    SDO(d, "21 01 20 00 01 00 00 00", "80 01 20 00 01 00 04 05"); /* segmented download */
-    SDO(d, "20 01 20 00 00 00 00 00", "80 01 20 00 01 00 04 05"); /* size not indicated */
+    /* B-33, B-36: the manuals use expedited transfer only. A segmented
+     * download is taken too (CiA 301, test_segmented_download); a segment
+     * out of turn, upload segments and block transfer are unsupported
+     * command specifiers, and change nothing. */
     SDO(d, "00 02 00 00 00 00 00 00", "80 02 00 00 01 00 04 05"); /* a download segment */
     SDO(d, "60 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05"); /* an upload segment */
     SDO(d, "C6 01 20 00 01 00 00 00", "80 01 20 00 01 00 04 05"); /* block download */
     SDO(d, "A4 08 10 00 7F 00 00 00", "80 08 10 00 01 00 04 05"); /* block upload */
     SDO(d, "40 01 20 00 00 00 00 00", "4F 01 20 00 01 00 00 00"); /* 0x2001 kept */
     SDO(d, "40 08 10 00 00 00 00 00", "47 08 10 00 47 49 42 00"); /* "GIB" still expedited */
+}
+
+/* One request to the node; its answer: 0 for success, else the abort code
+ * (answers of neither kind fail the check and count as 1). */
+static uint32_t sdo_answer(const uint8_t req[8], uint8_t ok)
+{
+    co_frame_t f = {.id = (uint16_t)(0x600u + d->node->node_id), .dlc = 8};
+    memcpy(f.data, req, 8);
+    h_drain(d);
+    h_rx_frame(d, &f);
+    const co_frame_t *r;
+    while ((r = h_next(d)) != NULL && r->id != 0x580u + d->node->node_id) {
+    }
+    CHECK(r != NULL && (r->data[0] == 0x80u || r->data[0] == ok));
+    return r == NULL ? 1u : r->data[0] == 0x80u ? co_get_u32(&r->data[4]) : r->data[0] == ok ? 0u : 1u;
+}
+
+/* len bytes at v into index/sub, expedited (segmented false) or as one
+ * segmented download with the size indicated; the answer (sdo_answer). */
+static uint32_t write_as(uint16_t index, uint8_t sub, const uint8_t *v, unsigned len, bool segmented)
+{
+    uint8_t req[8] = {0, (uint8_t)index, (uint8_t)(index >> 8), sub};
+    if (!segmented) {
+        req[0] = (uint8_t)(0x23u | ((4u - len) << 2));
+        memcpy(&req[4], v, len);
+        return sdo_answer(req, 0x60);
+    }
+    req[0] = 0x21;
+    co_put_u32(&req[4], len);
+    uint32_t r = sdo_answer(req, 0x60);
+    if (r != 0u) {
+        return r;
+    }
+    uint8_t seg[8] = {(uint8_t)(((7u - len) << 1) | 1u)};
+    memcpy(&seg[1], v, len);
+    return sdo_answer(seg, 0x20);
+}
+
+/*
+ * Every object either model can write takes the same bytes by segmented
+ * download as by expedited (CiA 301): the same answer (success or the same
+ * abort code) and the same value read back, for the value it holds, all
+ * ones, and 4 bytes where the object is shorter. Each write on a fresh
+ * device, so that one write cannot decide the next one's answer.
+ */
+static void test_segmented_as_expedited(void)
+{
+    boot(M->xy90);
+    const co_od_t *od = d->node->cfg->od;
+    unsigned writable = 0;
+    unsigned taken = 0;
+    for (uint16_t k = 0; k < od->count; k++) {
+        boot(M->xy90);
+        const co_od_entry_t *e = &od->entries[k];
+        if ((e->attr & CO_A_W) == 0u) {
+            continue;
+        }
+        writable++;
+        long long now = h_read(d, e->index, e->sub);
+        uint8_t held[4];
+        co_put_u32(held, now < 0 ? 0u : (uint32_t)now);
+        static const uint8_t ones[4] = {0xFF, 0xFF, 0xFF, 0xFF};
+        const struct {
+            const uint8_t *v;
+            unsigned len;
+        } cases[] = {{held, e->size}, {ones, e->size}, {held, 4u}};
+        for (unsigned c = 0; c < 3; c++) {
+            long long after[2];
+            uint32_t answer[2];
+            for (unsigned way = 0; way < 2; way++) {
+                boot(M->xy90);
+                answer[way] = write_as(e->index, e->sub, cases[c].v, cases[c].len, way == 1u);
+                after[way] = h_read(d, e->index, e->sub);
+            }
+            if (answer[0] != answer[1] || after[0] != after[1]) {
+                fprintf(stderr, "%s %04Xh/%u case %u: expedited %08lX -> %lld, segmented %08lX -> %lld\n",
+                        M->name, e->index, e->sub, c, (unsigned long)answer[0], after[0],
+                        (unsigned long)answer[1], after[1]);
+            }
+            CHECK(answer[0] == answer[1] && after[0] == after[1]);
+            taken += answer[1] == 0u;
+        }
+    }
+    CHECK(writable >= 10u && taken >= writable); /* the value held is taken back at least */
+}
+
+/* CiA 301 segmented download, frame by frame (the conformance tool's case
+ * first): toggle, the last segment's unused bytes, sizes that disagree, a
+ * new initiate, the timeout. */
+static void test_segmented_download(void)
+{
+    boot(M->xy90);
+    SDO(d, "21 17 10 00 02 00 00 00", "60 17 10 00 00 00 00 00"); /* 1017h, 2 bytes */
+    SDO(d, "0B E8 03 00 00 00 00 00", "20 00 00 00 00 00 00 00"); /* 5 unused, last */
+    CHECK_EQ(h_read(d, 0x1017, 0), 1000);
+    /* Size not indicated, one byte a segment: the toggle alternates. */
+    SDO(d, "20 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "0C F4 00 00 00 00 00 00", "20 00 00 00 00 00 00 00");
+    SDO(d, "1D 01 00 00 00 00 00 00", "30 00 00 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x1017, 0), 500);
+    /* A wrong toggle: 05030000h, and the transfer is over. */
+    SDO(d, "20 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "0C 64 00 00 00 00 00 00", "20 00 00 00 00 00 00 00");
+    SDO(d, "0D 00 00 00 00 00 00 00", "80 17 10 00 00 00 03 05");
+    SDO(d, "1D 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05");
+    CHECK_EQ(h_read(d, 0x1017, 0), 500);
+    SDO(d, "21 17 10 00 02 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "1B E8 03 00 00 00 00 00", "80 17 10 00 00 00 03 05"); /* first must be 0 */
+    /* Size indicated against the object's: at the initiate. */
+    SDO(d, "21 17 10 00 04 00 00 00", "80 17 10 00 12 00 07 06");
+    SDO(d, "21 17 10 00 01 00 00 00", "80 17 10 00 13 00 07 06");
+    /* Bytes received against the size indicated (the object's). */
+    SDO(d, "21 17 10 00 02 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "09 01 02 03 00 00 00 00", "80 17 10 00 12 00 07 06"); /* 3 bytes */
+    SDO(d, "21 17 10 00 02 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "0D 01 00 00 00 00 00 00", "80 17 10 00 13 00 07 06"); /* 1 byte */
+    SDO(d, "20 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "0F 00 00 00 00 00 00 00", "80 17 10 00 13 00 07 06"); /* none */
+    /* More than 4 bytes: too long for any object, as expedited 4 bytes to 1017h. */
+    SDO(d, "20 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "01 01 02 03 04 05 06 07", "80 17 10 00 12 00 07 06");
+    SDO(d, "20 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "06 01 02 03 04 00 00 00", "20 00 00 00 00 00 00 00");
+    SDO(d, "1D 05 00 00 00 00 00 00", "80 17 10 00 12 00 07 06");
+    SDO(d, "23 17 10 00 01 02 03 04", "80 17 10 00 12 00 07 06");
+    CHECK_EQ(h_read(d, 0x1017, 0), 500);
+    /* What a write would answer: a range, read-only, no object. */
+    SDO(d, "21 00 18 05 02 00 00 00", "60 00 18 05 00 00 00 00");
+    SDO(d, "0B 00 00 00 00 00 00 00", "20 00 00 00 00 00 00 00"); /* event timer 0 */
+    SDO(d, "21 00 10 00 04 00 00 00", "80 00 10 00 02 00 01 06");
+    SDO(d, "20 00 30 00 00 00 00 00", "80 00 30 00 00 00 02 06");
+    /* A new initiate replaces an unfinished transfer without a word. */
+    SDO(d, "21 17 10 00 02 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "2B 17 10 00 2C 01 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "0B E8 03 00 00 00 00 00", "80 E8 03 00 01 00 04 05"); /* none in progress */
+    CHECK_EQ(h_read(d, 0x1017, 0), 300);
+    SDO(d, "21 17 10 00 02 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "60 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05"); /* an upload segment */
+    SDO(d, "0B E8 03 00 00 00 00 00", "80 E8 03 00 01 00 04 05"); /* that ended it */
+    /* The client's abort ends it silently. */
+    SDO(d, "21 17 10 00 02 00 00 00", "60 17 10 00 00 00 00 00");
+    h_rx(d, 0x67F, "80 17 10 00 00 00 04 05");
+    EXPECT_NONE(d);
+    SDO(d, "0B E8 03 00 00 00 00 00", "80 E8 03 00 01 00 04 05");
+    /* The SDO timeout (1 s) between segments, restarted by each one
+     * (no heartbeat meanwhile: 1017h = 0). */
+    SDO(d, "2B 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "20 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");
+    h_advance(d, 900000);
+    SDO(d, "0C 10 00 00 00 00 00 00", "20 00 00 00 00 00 00 00");
+    h_advance(d, 900000);
+    EXPECT_NONE(d);
+    h_advance(d, 200000);
+    EXPECT(d, 0x5FF, "80 17 10 00 00 00 04 05");
+    SDO(d, "1D 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05");
+    CHECK_EQ(h_read(d, 0x1017, 0), 0);
+    /* Uploads stay expedited (CiA 301 lets a server answer so). */
+    SDO(d, "40 17 10 00 00 00 00 00", "4B 17 10 00 00 00 00 00");
 }
 
 static void test_derived_pdo_coding(void)
@@ -662,6 +820,8 @@ int main(void)
         RUN(test_derived_limits_and_emcy);
         RUN(test_error_behaviour);
         RUN(test_emcy_cobid);
+        RUN(test_segmented_as_expedited);
+        RUN(test_segmented_download);
     }
     M = &x730;
     RUN(test_derived_pdo_coding); /* D19: X730 only */
