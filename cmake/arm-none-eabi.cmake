@@ -20,11 +20,13 @@ set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 # and branches turned into conditional moves, which Thumb-1 lacks
 # (-fno-tree-forwprop, -fno-ssa-phiopt), and case tables (the small
 # switches here are shorter as compares than as a table with libgcc's
-# __gnu_thumb1_case_uqi). Not -fno-inline-functions-called-once: 32 bytes
+# __gnu_thumb1_case_uqi). -fno-tree-ccp and -fno-tree-tail-merge: 4 bytes
+# each on the same image, which the DSTs' segmented download had taken
+# 8 bytes past its target (10248 -> 10240). Not -fno-inline-functions-called-once: 32 bytes
 # less, but the idle poll then takes 23 instructions (target 20).
 # Given as directory options, not in the cached CMAKE_C_FLAGS: a build
 # directory configured before gets them at its next configure too.
-set(CO_M0_SIZE_OPT "-fno-move-loop-invariants -fno-tree-loop-im -fno-code-hoisting -fira-loop-pressure -fno-tree-sra -fno-tree-forwprop -fno-ssa-phiopt -fno-jump-tables")
+set(CO_M0_SIZE_OPT "-fno-move-loop-invariants -fno-tree-loop-im -fno-code-hoisting -fira-loop-pressure -fno-tree-sra -fno-tree-forwprop -fno-ssa-phiopt -fno-jump-tables -fno-tree-ccp -fno-tree-tail-merge")
 separate_arguments(CO_M0_SIZE_OPT_LIST UNIX_COMMAND "${CO_M0_SIZE_OPT}")
 add_compile_options(${CO_M0_SIZE_OPT_LIST})
 add_link_options(${CO_M0_SIZE_OPT_LIST})
