@@ -499,6 +499,56 @@ def test_ends_with_its_parent(tmp_path):
         flash.unlink(missing_ok=True)
 
 
+def test_ends_with_a_parent_killed_at_once(tmp_path):
+    """A parent killed before tools/emu reached its main() (the
+    interpreter's start takes about 0.3 s): tools/emu still ends rather
+    than run on for nobody (it took init for a parent that never ends and
+    kept the port and the flash file)."""
+    flash = tmp_path / "flash.bin"
+    port = free_port()
+    parent = subprocess.Popen([
+        sys.executable, "-c",
+        "import os, signal, subprocess, sys\n"
+        "p = subprocess.Popen(sys.argv[1:], stdout=subprocess.DEVNULL,\n"
+        "                     stderr=subprocess.DEVNULL)\n"
+        "print(p.pid, flush=True)\n"
+        "os.kill(os.getpid(), signal.SIGKILL)\n",
+        EMU, "--board", "rv32-virt", "--product", PRODUCT, "--port", str(port),
+        "--flash", str(flash)], stdout=subprocess.PIPE, start_new_session=True)
+    emu = None
+    try:
+        emu = int(parent.stdout.readline())
+        assert parent.wait() == -signal.SIGKILL
+        end = time.monotonic() + 10
+        while time.monotonic() < end and (_alive(emu) or _group(parent.pid) or _group(emu)):
+            time.sleep(0.1)
+        assert not (_alive(emu) or _group(parent.pid) or _group(emu)), \
+            "tools/emu or QEMU outlived its parent"
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", port))
+    finally:
+        for group in (parent.pid, emu):
+            try:
+                os.killpg(group, signal.SIGKILL)
+            except (ProcessLookupError, TypeError):
+                pass
+        flash.unlink(missing_ok=True)
+
+
+def _group(pgid):
+    """The live processes of process group pgid (QEMU included, which init
+    inherits if tools/emu dies first)."""
+    found = []
+    for p in pathlib.Path("/proc").iterdir():
+        if p.name.isdigit() and _alive(p.name):
+            try:
+                if os.getpgid(int(p.name)) == pgid:
+                    found.append(int(p.name))
+            except ProcessLookupError:
+                pass
+    return found
+
+
 def _ppid(pid):
     try:
         stat = pathlib.Path(f"/proc/{pid}/stat").read_text()
