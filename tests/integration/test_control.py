@@ -368,6 +368,32 @@ def test_ctl_client(tmp_path):
         assert proc.wait(timeout=5) == 0
 
 
+def test_ctl_client_passes_bytes_that_are_not_utf8(tmp_path):
+    """tools/ctl sends a line that is not UTF-8 (standard input or an
+    argument) as its bytes and goes on with the next; it died with a
+    UnicodeEncodeError traceback, the lines after it never sent."""
+    ctl = os.path.join(os.path.dirname(__file__), "..", "..", "tools", "ctl")
+    path = str(tmp_path / "c.sock")
+    proc = subprocess.Popen([BINARY, "--iface", IFACE, "--node", "jd2xxx@0x22", "--node",
+                             "inx360d@0x23", "--control", f"unix:{path}", "--on-eof", "run"],
+                            stdin=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        Client(path).close()  # listening
+        r = subprocess.run([ctl, f"unix:{path}"], input=b"0x22 get\n\xff\xfe get\n0x23 get\n",
+                           capture_output=True, timeout=10)
+        lines = r.stdout.splitlines()
+        assert r.returncode == 1 and b"Traceback" not in r.stderr, r
+        assert len(lines) == 3 and lines[0].startswith(b"ok x=") and lines[2].startswith(b"ok x=")
+        assert lines[1].startswith(b"error: unknown command"), lines
+        r = subprocess.run([ctl.encode(), path.encode(), b"0x22", b"\xff"], capture_output=True,
+                           timeout=10)
+        assert r.returncode == 1 and b"Traceback" not in r.stderr, r
+        assert r.stdout.startswith(b"error: ") and r.stdout.count(b"\n") == 1, r
+    finally:
+        proc.terminate()
+        assert proc.wait(timeout=5) == 0
+
+
 def test_selectors_on_standard_input(tmp_path):
     """Standard input takes the control socket's selectors: 0xNN, @N, @all
     (a line without one acts on the first instance, as before); a selected
