@@ -1424,7 +1424,8 @@ static void control_replay(app_t *a, const char *args, unsigned k0, unsigned k1,
         }
     }
     if (!a->stdin_line) {
-        lp_log("control: %s", line);
+        char shown_line[4u * CTL_LINE_MAX + 8u];
+        lp_log("control: %s", shown(line, shown_line, sizeof(shown_line)));
     }
     snprintf(reply, len, "ok");
 }
@@ -1494,10 +1495,22 @@ static void control_line(void *ctx, const char *line, char *reply, size_t len)
             a->sim.quit = true;
         }
     }
-    if (!a->stdin_line) {
-        lp_log("control: %s", line); /* standard input's are logged as such (report_line) */
+    if (!a->stdin_line) { /* standard input's are logged as such (report_line) */
+        char shown_line[4u * CTL_LINE_MAX + 8u];
+        lp_log("control: %s", shown(line, shown_line, sizeof(shown_line)));
     }
     snprintf(reply, len, "ok");
+}
+
+/* ctl_line_fn of the socket: control_line's answer with every byte that
+ * is not printable ASCII as \xNN (shown(), as standard input's rejections
+ * are), so that a client's escape sequences never come back raw to its
+ * terminal; an answer that grows past len is cut short. */
+static void control_socket_line(void *ctx, const char *line, char *reply, size_t len)
+{
+    char raw[CTL_REPLY_MAX + 1u];
+    control_line(ctx, line, raw, len < sizeof(raw) ? len : sizeof(raw));
+    (void)shown(raw, reply, len);
 }
 
 /* What epoll reported for src (EV_SIGNAL, EV_STDIN, or a node's socket). */
@@ -1523,7 +1536,7 @@ static void handle_event(app_t *a, uint32_t src, uint32_t t)
         }
     } else if (src >= EV_CLIENT && src < EV_CLIENT + CTL_CLIENTS) {
         unsigned k = src - EV_CLIENT;
-        if (ctl_read(&a->ctl, k, control_line, a)) { /* a closed fd leaves epoll */
+        if (ctl_read(&a->ctl, k, control_socket_line, a)) { /* a closed fd leaves epoll */
             /* Reading waits while answers wait (control.h). */
             uint32_t want = ctl_events(&a->ctl, k);
             if (want != a->ctl.cl[k].events) {

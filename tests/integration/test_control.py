@@ -338,6 +338,22 @@ def test_socket_removed_at_stop_only_when_ours(tmp_path):
     other.close()
 
 
+def test_answers_show_control_bytes_escaped(sim):
+    """An error answer showed the client's bytes raw (an escape sequence
+    sent came back to its terminal): bytes that are not printable ASCII
+    are \\xNN in it, as in standard input's rejections."""
+    proc, client = sim
+    c = client()
+    c.s.sendall(b"\x1b]0;pwned\x07get\n")
+    answer = c.f.readline()
+    assert answer.startswith(b"error: unknown command '\\x1B]0;pwned\\x07get'"), answer
+    assert b"\x1b" not in answer and b"\x07" not in answer
+    c.s.sendall(b"0x22 \xff\n")
+    answer = c.f.readline()
+    assert b"\\xFF" in answer and b"\xff" not in answer, answer
+    assert c.ask("0x22 get").startswith("ok x=")  # and nothing else disturbed
+
+
 def test_ctl_client(tmp_path):
     """tools/ctl: one command from its arguments, or lines from standard
     input; answers printed as they come; exit 0 / 1 (an error answer) / 2."""
@@ -406,17 +422,21 @@ def test_selectors_on_standard_input(tmp_path):
     try:
         c = Client(path)
         proc.stdin.write(b"0x23 set x=9\n@0 set x=4\n@1 get\n@all set x=1\n0x7E get\n"
-                         b"0x22 get\n")
+                         b"0x22 get\n0x22 set\ty=2\n")
         proc.stdin.flush()
         assert proc.stdout.readline().startswith(b"ok x=9.000 ")
         assert proc.stdout.readline().startswith(b"ok x=1.000 ")
         assert c.ask("0x23 get").startswith("ok x=1.000")
+        assert c.ask("0x22 set\tx=2") == "ok"
         c.close()
         proc.stdin.close()
         assert proc.wait(timeout=5) == 0
         assert "no node with node-ID 0x7E" in proc.stderr.read().decode()
         log = (tmp_path / "log").read_text()
         assert "stdin: 0x23 set x=9" in log and "control: 0x23 set x=9" not in log
+        # a control line's bytes as standard input's: \\xNN, never raw
+        assert "stdin: 0x22 set\\x09y=2" in log and "control: 0x22 set\\x09x=2" in log, log
+        assert "\t" not in log
     finally:
         if proc.poll() is None:
             proc.kill()
