@@ -10,9 +10,9 @@
  * quit, SIGINT, SIGTERM, SIGHUP, also while starting: main()); 1 when
  * something the command line names fails at start (no such CAN interface,
  * not CAN, no CAN in the kernel, an EEPROM file that cannot be read, GPIO)
- * or the event loop fails, or --eds / --list-products cannot write; 2 for
- * a wrong command line (including an option given twice, an --nvm that is
- * not a regular file or is in a missing directory, an EEPROM file another
+ * or the event loop fails, or --eds / --list-products / --help cannot
+ * write; 2 for a wrong command line (including an option given twice, an
+ * --nvm that is not a regular file or is in a missing directory, an EEPROM file another
  * user holds, a node-ID clash on one interface, more than 127 nodes, a
  * --control path that exists and is no stale socket, a directory as
  * standard input). Once running, nothing on the bus or the interface ends
@@ -143,6 +143,19 @@ static void usage(FILE *f)
         sim_describe(product_list[i], d, sizeof(d));
         fprintf(f, "  %-16s %s\n", product_list[i]->id, d);
     }
+}
+
+/* Standard output flushed after what option opt printed (--help,
+ * --list-products, --eds): 0, or 1 with one line on stderr when it could
+ * not be written (a full disk, a closed pipe), so that a caller never
+ * takes a cut list for a whole one. */
+static int stdout_done(const char *opt)
+{
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        fprintf(stderr, "canopen-sensor: %s: standard output: %s\n", opt, strerror(errno));
+        return 1;
+    }
+    return 0;
 }
 
 /* A wrong command line: one line with the cause on stderr. */
@@ -710,8 +723,8 @@ static int check_specs(options_t *o)
 }
 
 /* The command line into *o, checked: returns GO_ON, 0 after --help or
- * --list-products (printed), or 2 for a wrong command line (one line on
- * stderr). With --eds only the product is checked. Nothing is opened. */
+ * --list-products (printed; 1 when they could not be), or 2 for a wrong
+ * command line (one line on stderr). With --eds only the product is checked. Nothing is opened. */
 static int parse_options(int argc, char **argv, options_t *o)
 {
     memset(o, 0, sizeof(*o));
@@ -821,7 +834,7 @@ static int parse_options(int argc, char **argv, options_t *o)
             break;
         case 'h':
             usage(stdout);
-            return 0;
+            return stdout_done("--help");
         case ':':
             return USAGE_ERROR("option %s needs a value", argv[optind - 1]);
         default:
@@ -853,7 +866,7 @@ static int parse_options(int argc, char **argv, options_t *o)
                 printf("%-18s %s\n", product_list[i]->id, product_list[i]->summary);
             }
         }
-        return 0;
+        return stdout_done("--list-products");
     }
     if (product == NULL && (o->nspec == 0u || o->eds)) {
         return USAGE_ERROR("--product is missing");
@@ -900,11 +913,7 @@ static int print_eds(const product_t *prod)
         fprintf(stderr, "canopen-sensor: %s: EDS overrides that apply to no entry\n", prod->id);
         return 1;
     }
-    if (fflush(stdout) != 0 || ferror(stdout)) {
-        fprintf(stderr, "canopen-sensor: --eds: standard output: %s\n", strerror(errno));
-        return 1;
-    }
-    return 0;
+    return stdout_done("--eds");
 }
 
 /* The EEPROM file of instance k: --nvm for the --product instance, else
@@ -1415,7 +1424,8 @@ static void control_replay(app_t *a, const char *args, unsigned k0, unsigned k1,
         }
     }
     if (!a->stdin_line) {
-        lp_log("control: %s", line);
+        char shown_line[4u * CTL_LINE_MAX + 8u];
+        lp_log("control: %s", shown(line, shown_line, sizeof(shown_line)));
     }
     snprintf(reply, len, "ok");
 }
@@ -1485,10 +1495,22 @@ static void control_line(void *ctx, const char *line, char *reply, size_t len)
             a->sim.quit = true;
         }
     }
-    if (!a->stdin_line) {
-        lp_log("control: %s", line); /* standard input's are logged as such (report_line) */
+    if (!a->stdin_line) { /* standard input's are logged as such (report_line) */
+        char shown_line[4u * CTL_LINE_MAX + 8u];
+        lp_log("control: %s", shown(line, shown_line, sizeof(shown_line)));
     }
     snprintf(reply, len, "ok");
+}
+
+/* ctl_line_fn of the socket: control_line's answer with every byte that
+ * is not printable ASCII as \xNN (shown(), as standard input's rejections
+ * are), so that a client's escape sequences never come back raw to its
+ * terminal; an answer that grows past len is cut short. */
+static void control_socket_line(void *ctx, const char *line, char *reply, size_t len)
+{
+    char raw[CTL_REPLY_MAX + 1u];
+    control_line(ctx, line, raw, len < sizeof(raw) ? len : sizeof(raw));
+    (void)shown(raw, reply, len);
 }
 
 /* What epoll reported for src (EV_SIGNAL, EV_STDIN, or a node's socket). */
@@ -1514,7 +1536,7 @@ static void handle_event(app_t *a, uint32_t src, uint32_t t)
         }
     } else if (src >= EV_CLIENT && src < EV_CLIENT + CTL_CLIENTS) {
         unsigned k = src - EV_CLIENT;
-        if (ctl_read(&a->ctl, k, control_line, a)) { /* a closed fd leaves epoll */
+        if (ctl_read(&a->ctl, k, control_socket_line, a)) { /* a closed fd leaves epoll */
             /* Reading waits while answers wait (control.h). */
             uint32_t want = ctl_events(&a->ctl, k);
             if (want != a->ctl.cl[k].events) {

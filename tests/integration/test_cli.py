@@ -2,6 +2,8 @@
 import os
 import subprocess
 
+import pytest
+
 from conftest import BINARY
 
 VARIANTS = ["xy10", "xy15", "xy20", "xy30", "xy45", "xy60", "xy90", "z360"]
@@ -169,6 +171,21 @@ def test_eds_to_a_full_output():
     assert r.returncode == 1
     assert r.stderr.strip() == \
         "canopen-sensor: --eds: standard output: No space left on device"
+
+
+@pytest.mark.parametrize("args, opt", [
+    (["--list-products"], "--list-products"),
+    (["--list-products", "--product", "gsh-a"], "--list-products"),
+    (["--help"], "--help"),
+])
+def test_list_and_help_to_a_full_output(args, opt):
+    """--list-products (plain) and --help whose output cannot be written
+    exit 1 with the cause, as --eds does (they exited 0 silently)."""
+    with open("/dev/full", "w") as full:
+        r = subprocess.run([BINARY] + args, stdout=full, stderr=subprocess.PIPE, text=True,
+                           timeout=10)
+    assert r.returncode == 1
+    assert r.stderr.strip() == f"canopen-sensor: {opt}: standard output: No space left on device"
 
 
 def test_node_interface_that_is_not_can():

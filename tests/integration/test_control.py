@@ -338,6 +338,22 @@ def test_socket_removed_at_stop_only_when_ours(tmp_path):
     other.close()
 
 
+def test_answers_show_control_bytes_escaped(sim):
+    """An error answer showed the client's bytes raw (an escape sequence
+    sent came back to its terminal): bytes that are not printable ASCII
+    are \\xNN in it, as in standard input's rejections."""
+    proc, client = sim
+    c = client()
+    c.s.sendall(b"\x1b]0;pwned\x07get\n")
+    answer = c.f.readline()
+    assert answer.startswith(b"error: unknown command '\\x1B]0;pwned\\x07get'"), answer
+    assert b"\x1b" not in answer and b"\x07" not in answer
+    c.s.sendall(b"0x22 \xff\n")
+    answer = c.f.readline()
+    assert b"\\xFF" in answer and b"\xff" not in answer, answer
+    assert c.ask("0x22 get").startswith("ok x=")  # and nothing else disturbed
+
+
 def test_ctl_client(tmp_path):
     """tools/ctl: one command from its arguments, or lines from standard
     input; answers printed as they come; exit 0 / 1 (an error answer) / 2."""
@@ -368,6 +384,32 @@ def test_ctl_client(tmp_path):
         assert proc.wait(timeout=5) == 0
 
 
+def test_ctl_client_passes_bytes_that_are_not_utf8(tmp_path):
+    """tools/ctl sends a line that is not UTF-8 (standard input or an
+    argument) as its bytes and goes on with the next; it died with a
+    UnicodeEncodeError traceback, the lines after it never sent."""
+    ctl = os.path.join(os.path.dirname(__file__), "..", "..", "tools", "ctl")
+    path = str(tmp_path / "c.sock")
+    proc = subprocess.Popen([BINARY, "--iface", IFACE, "--node", "jd2xxx@0x22", "--node",
+                             "inx360d@0x23", "--control", f"unix:{path}", "--on-eof", "run"],
+                            stdin=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        Client(path).close()  # listening
+        r = subprocess.run([ctl, f"unix:{path}"], input=b"0x22 get\n\xff\xfe get\n0x23 get\n",
+                           capture_output=True, timeout=10)
+        lines = r.stdout.splitlines()
+        assert r.returncode == 1 and b"Traceback" not in r.stderr, r
+        assert len(lines) == 3 and lines[0].startswith(b"ok x=") and lines[2].startswith(b"ok x=")
+        assert lines[1].startswith(b"error: unknown command"), lines
+        r = subprocess.run([ctl.encode(), path.encode(), b"0x22", b"\xff"], capture_output=True,
+                           timeout=10)
+        assert r.returncode == 1 and b"Traceback" not in r.stderr, r
+        assert r.stdout.startswith(b"error: ") and r.stdout.count(b"\n") == 1, r
+    finally:
+        proc.terminate()
+        assert proc.wait(timeout=5) == 0
+
+
 def test_selectors_on_standard_input(tmp_path):
     """Standard input takes the control socket's selectors: 0xNN, @N, @all
     (a line without one acts on the first instance, as before); a selected
@@ -380,17 +422,21 @@ def test_selectors_on_standard_input(tmp_path):
     try:
         c = Client(path)
         proc.stdin.write(b"0x23 set x=9\n@0 set x=4\n@1 get\n@all set x=1\n0x7E get\n"
-                         b"0x22 get\n")
+                         b"0x22 get\n0x22 set\ty=2\n")
         proc.stdin.flush()
         assert proc.stdout.readline().startswith(b"ok x=9.000 ")
         assert proc.stdout.readline().startswith(b"ok x=1.000 ")
         assert c.ask("0x23 get").startswith("ok x=1.000")
+        assert c.ask("0x22 set\tx=2") == "ok"
         c.close()
         proc.stdin.close()
         assert proc.wait(timeout=5) == 0
         assert "no node with node-ID 0x7E" in proc.stderr.read().decode()
         log = (tmp_path / "log").read_text()
         assert "stdin: 0x23 set x=9" in log and "control: 0x23 set x=9" not in log
+        # a control line's bytes as standard input's: \\xNN, never raw
+        assert "stdin: 0x22 set\\x09y=2" in log and "control: 0x22 set\\x09x=2" in log, log
+        assert "\t" not in log
     finally:
         if proc.poll() is None:
             proc.kill()
