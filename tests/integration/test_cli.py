@@ -188,18 +188,6 @@ def test_list_and_help_to_a_full_output(args, opt):
     assert r.stderr.strip() == f"canopen-sensor: {opt}: standard output: No space left on device"
 
 
-def test_node_interface_that_is_not_can():
-    """The option that named the interface is the one blamed."""
-    r = run("--node", "jd2xxx@5/lo", "--iface", "vcan0")
-    assert r.returncode == 1
-    assert r.stderr.strip().splitlines()[-1] == \
-        "canopen-sensor: --node jd2xxx@5/lo: lo: not a CAN interface (SocketCAN: can0, vcan0, ...)"
-    r = run("--product", "gsh-a-redundant", "--iface", "vcan0,lo")
-    assert r.returncode == 1
-    assert r.stderr.strip().splitlines()[-1] == \
-        "canopen-sensor: --iface vcan0,lo: lo: not a CAN interface (SocketCAN: can0, vcan0, ...)"
-
-
 def test_directory_as_standard_input(tmp_path):
     """read() fails (EISDIR): it was taken for the end of input (exit 0, no word)."""
     fd = os.open(tmp_path, os.O_RDONLY)

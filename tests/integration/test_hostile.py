@@ -658,3 +658,20 @@ def test_bus_flood(tmp_path, procs):
     # the frames before the flood (SDO, NMT) count too. The other nodes'
     # frames never reached it.
     assert own - backlog_drops <= received + dropped <= own + 10
+
+
+def test_node_interface_that_is_not_can():
+    """The option that named the interface is the one blamed. Here, not in
+    test_cli.py: telling lo from a CAN interface needs a kernel with CAN
+    (without it socket(PF_CAN) fails before any name is looked at), which
+    integration.hostile has in tools/vcan-run and integration.cli may not."""
+    r = subprocess.run([BINARY, "--node", "jd2xxx@5/lo", "--iface", "vcan0"],
+                       capture_output=True, text=True, timeout=10)
+    assert r.returncode == 1
+    assert r.stderr.strip().splitlines()[-1] == \
+        "canopen-sensor: --node jd2xxx@5/lo: lo: not a CAN interface (SocketCAN: can0, vcan0, ...)"
+    r = subprocess.run([BINARY, "--product", "gsh-a-redundant", "--iface", "vcan0,lo"],
+                       capture_output=True, text=True, timeout=10)
+    assert r.returncode == 1
+    assert r.stderr.strip().splitlines()[-1] == \
+        "canopen-sensor: --iface vcan0,lo: lo: not a CAN interface (SocketCAN: can0, vcan0, ...)"
