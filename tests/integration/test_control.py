@@ -1,6 +1,7 @@
 """The control socket (--control unix:PATH | tcp:PORT): the stdin line
 language with a node selector, one answer line per line, several clients,
 bad input answered with `error:` and disturbing nothing."""
+import contextlib
 import os
 import socket
 import subprocess
@@ -354,16 +355,30 @@ def test_answers_show_control_bytes_escaped(sim):
     assert c.ask("0x22 get").startswith("ok x=")  # and nothing else disturbed
 
 
-def test_ctl_client(tmp_path):
-    """tools/ctl: one command from its arguments, or lines from standard
-    input; answers printed as they come; exit 0 / 1 (an error answer) / 2."""
-    ctl = os.path.join(os.path.dirname(__file__), "..", "..", "tools", "ctl")
+CTL = os.path.join(os.path.dirname(__file__), "..", "..", "tools", "ctl")
+
+
+@contextlib.contextmanager
+def ctl_beside_two_nodes(tmp_path):
+    """tools/ctl's path and a control socket's, the socket listening in a
+    process with a JD2 at 0x22 and an INX at 0x23; the process must end
+    cleanly (status 0) afterwards."""
     path = str(tmp_path / "c.sock")
     proc = subprocess.Popen([BINARY, "--iface", IFACE, "--node", "jd2xxx@0x22", "--node",
                              "inx360d@0x23", "--control", f"unix:{path}", "--on-eof", "run"],
                             stdin=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         Client(path).close()  # listening
+        yield CTL, path
+    finally:
+        proc.terminate()
+        assert proc.wait(timeout=5) == 0
+
+
+def test_ctl_client(tmp_path):
+    """tools/ctl: one command from its arguments, or lines from standard
+    input; answers printed as they come; exit 0 / 1 (an error answer) / 2."""
+    with ctl_beside_two_nodes(tmp_path) as (ctl, path):
         r = subprocess.run([ctl, f"unix:{path}", "0x22", "set", "x=5"], capture_output=True,
                            text=True, timeout=10)
         assert (r.returncode, r.stdout) == (0, "ok\n"), r.stderr
@@ -379,22 +394,13 @@ def test_ctl_client(tmp_path):
         assert r.returncode == 2 and "No such file or directory" in r.stderr
         r = subprocess.run([ctl], capture_output=True, text=True, timeout=10)
         assert r.returncode == 2 and "usage: tools/ctl" in r.stderr
-    finally:
-        proc.terminate()
-        assert proc.wait(timeout=5) == 0
 
 
 def test_ctl_client_passes_bytes_that_are_not_utf8(tmp_path):
     """tools/ctl sends a line that is not UTF-8 (standard input or an
     argument) as its bytes and goes on with the next; it died with a
     UnicodeEncodeError traceback, the lines after it never sent."""
-    ctl = os.path.join(os.path.dirname(__file__), "..", "..", "tools", "ctl")
-    path = str(tmp_path / "c.sock")
-    proc = subprocess.Popen([BINARY, "--iface", IFACE, "--node", "jd2xxx@0x22", "--node",
-                             "inx360d@0x23", "--control", f"unix:{path}", "--on-eof", "run"],
-                            stdin=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    try:
-        Client(path).close()  # listening
+    with ctl_beside_two_nodes(tmp_path) as (ctl, path):
         r = subprocess.run([ctl, f"unix:{path}"], input=b"0x22 get\n\xff\xfe get\n0x23 get\n",
                            capture_output=True, timeout=10)
         lines = r.stdout.splitlines()
@@ -405,9 +411,6 @@ def test_ctl_client_passes_bytes_that_are_not_utf8(tmp_path):
                            timeout=10)
         assert r.returncode == 1 and b"Traceback" not in r.stderr, r
         assert r.stdout.startswith(b"error: ") and r.stdout.count(b"\n") == 1, r
-    finally:
-        proc.terminate()
-        assert proc.wait(timeout=5) == 0
 
 
 def test_selectors_on_standard_input(tmp_path):

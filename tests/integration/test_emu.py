@@ -491,11 +491,7 @@ def test_ends_with_its_parent(tmp_path):
         with socket.socket() as s:
             s.bind(("127.0.0.1", port))
     finally:
-        for group in (parent.pid, emu):  # tools/emu leads a group of its own
-            try:
-                os.killpg(group, signal.SIGKILL)
-            except (ProcessLookupError, TypeError):
-                pass
+        _kill_groups(parent.pid, emu)  # tools/emu leads a group of its own
         flash.unlink(missing_ok=True)
 
 
@@ -527,12 +523,17 @@ def test_ends_with_a_parent_killed_at_once(tmp_path):
         with socket.socket() as s:
             s.bind(("127.0.0.1", port))
     finally:
-        for group in (parent.pid, emu):
-            try:
-                os.killpg(group, signal.SIGKILL)
-            except (ProcessLookupError, TypeError):
-                pass
+        _kill_groups(parent.pid, emu)
         flash.unlink(missing_ok=True)
+
+
+def _kill_groups(*groups):
+    """SIGKILL to each process group that still exists (None: not known)."""
+    for group in groups:
+        try:
+            os.killpg(group, signal.SIGKILL)
+        except (ProcessLookupError, TypeError):
+            pass
 
 
 def _group(pgid):

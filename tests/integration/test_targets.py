@@ -291,14 +291,20 @@ def test_tpdo_by_sync(dut, facts):
     assert len(got) == want, f"{len(got)} TPDOs for 6 SYNCs, want {want}"
 
 
-def test_tpdo_by_event_timer(dut, facts):
-    dut.power_on(facts.nodes)
-    n = facts.nodes[0]
-    cob = facts.tpdo_cob.of(n)
+def event_timer_tpdo(dut, facts, n):
+    """Node n pre-operational, its TPDO1 sent by the event timer every
+    EVENT_MS (the product's own steps to that mode first)."""
     nmt(dut, NMT_PREOP, n)
     for index, sub, data in facts.event_mode:
         down(dut, n, index, sub, data)
     down(dut, n, 0x1800, 5, struct.pack("<H", EVENT_MS))
+
+
+def test_tpdo_by_event_timer(dut, facts):
+    dut.power_on(facts.nodes)
+    n = facts.nodes[0]
+    cob = facts.tpdo_cob.of(n)
+    event_timer_tpdo(dut, facts, n)
     dut.frames.clear()
     assert not dut.frames.collect(cob, 0.15), "TPDO in pre-operational"
     nmt(dut, NMT_START, n)
@@ -324,10 +330,7 @@ def test_tpdo_length_is_the_mapped_length(dut, facts):
                 f"node {n:#x}: 1A00h:{sub} = {m:08X}h is not its object's length"
             total += bits // 8
         cob = facts.tpdo_cob.of(n)
-        nmt(dut, NMT_PREOP, n)
-        for index, sub, data in facts.event_mode:
-            down(dut, n, index, sub, data)
-        down(dut, n, 0x1800, 5, struct.pack("<H", EVENT_MS))
+        event_timer_tpdo(dut, facts, n)
         dut.frames.clear()
         nmt(dut, NMT_START, n)
         dut.frames.wait_for(cob, timeout=0.5)
