@@ -7,6 +7,7 @@
 #define BOARD_H
 
 #include "co_common.h"
+#include "co_node.h"
 #include "product.h"
 
 /* Clocks, pins, timer, the CAN controller's clock and receive interrupt;
@@ -30,5 +31,9 @@ void board_sensor(const product_t *p, int32_t values[], uint32_t *faults);
 uint32_t board_serial(unsigned node);
 /* Sleep until an interrupt or about us microseconds have passed. */
 void board_sleep(uint32_t us);
+/* Boards built with BOARD_RX_FILTER (a controller with acceptance
+ * filters): the nodes' receive lists together (co_node_rx_ids), after every
+ * main-loop pass; the board reprograms its filter when they changed. */
+void board_can_filter(const co_rx_id_t *ids, unsigned n);
 
 #endif /* BOARD_H */

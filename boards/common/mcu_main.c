@@ -46,6 +46,19 @@ static CO_NOINLINE uint32_t leds(co_node_t *node, uint32_t now)
     return next;
 }
 
+#ifdef BOARD_RX_FILTER
+/* The nodes' receive lists together, to the board's acceptance filter. */
+static CO_NOINLINE void rx_filter(co_node_t *const nodes[], unsigned n)
+{
+    co_rx_id_t ids[PRODUCT_MAX_NODES * CO_NODE_RX_IDS_MAX];
+    unsigned k = 0;
+    for (unsigned i = 0; i < n; i++) {
+        k += co_node_rx_ids(nodes[i], &ids[k], CO_NODE_RX_IDS_MAX); /* never more */
+    }
+    board_can_filter(ids, k);
+}
+#endif
+
 int main(void)
 {
     /* The instance: static storage of this image's one product, sized for it.
@@ -101,6 +114,9 @@ int main(void)
             co_node_set_can_state(nodes[i], (co_can_state_t)board_can_state());
             wait = co_min_u32(wait, co_node_poll(nodes[i], now));
         }
+#ifdef BOARD_RX_FILTER
+        rx_filter(nodes, p->nodes);
+#endif
         board_sleep(co_min_u32(wait, leds(nodes[0], now)));
     }
 }

@@ -125,6 +125,7 @@ typedef struct sja1000 {
     co_frame_t txq[SJA1000_TXQ_LEN];
     uint8_t tx_head;
     uint8_t tx_len;
+    bool tx_busy;       /* the head is in the transmit buffer */
     uint8_t state;      /* co_can_state_t, as of the last sja1000_service */
     uint32_t overruns;  /* data overruns (frames lost in the controller) */
     uint32_t filtered_out; /* frames the software check dropped */
@@ -134,10 +135,10 @@ typedef struct sja1000 {
 /*
  * BTR0 and BTR1 for kbps at oscillator clock_hz (data sheet, bus timing
  * registers: tscl = 2 x tCLK x (BRP + 1); a bit is 1 + (TSEG1 + 1) +
- * (TSEG2 + 1) time quanta). Chooses the most quanta per bit (8..25) that
- * divide the clock exactly, the sample point nearest 87.5 % (CiA 301's
- * recommendation) and SJW = min(TSEG2 quanta, 4). False (nothing written)
- * when no setting gives kbps exactly.
+ * (TSEG2 + 1) time quanta). Of the settings with 8..25 quanta per bit that
+ * give kbps exactly, the one whose sample point is nearest 87.5 % (CiA
+ * 301's recommendation), on a tie the one with more quanta; SJW =
+ * min(TSEG2 quanta, 4). False (nothing written) when none gives kbps.
  */
 bool sja1000_timing(uint32_t clock_hz, uint16_t kbps, uint8_t *btr0, uint8_t *btr1);
 

@@ -1,12 +1,19 @@
 /*
  * board.c - a RISC-V (rv32imac) port for QEMU's "virt" machine, the second
- * architecture the stack builds for. The machine has no CAN controller, so
- * frames travel as SLCAN text lines ("t1FF8...", Lawicel's serial-line CAN
- * protocol) on the 16550 UART, and the simulated sensor's input lines
- * ("set x=10", "fault sensor on") on the same line (serial_link.h); time
- * comes from the CLINT's mtime (10 MHz); the EEPROM is emulated in the
- * machine's CFI flash (cfi_flash.c, see the end of this file).
- * The serial line's state and the flash's description are the board's state.
+ * architecture the stack builds for. CAN goes one of two ways, found at
+ * start:
+ *  - an SJA1000 CAN controller on a PCI card (QEMU's kvaser_pci,
+ *    pcm3680_pci or mioe3680_pci; see "CAN controller" below), driven by
+ *    boards/common/sja1000.c: the image is then a node on whatever bus
+ *    QEMU connects the card to (a host SocketCAN interface), and the UART
+ *    carries the simulated sensor's input lines only;
+ *  - without a card, frames travel as SLCAN text lines ("t1FF8...",
+ *    Lawicel's serial-line CAN protocol) on the 16550 UART, beside the
+ *    input lines ("set x=10", "fault sensor on"; serial_link.h).
+ * Time comes from the CLINT's mtime (10 MHz); the EEPROM is emulated in the
+ * machine's CFI flash (cfi_flash.c, see the end of this file). The serial
+ * line's state, the controller's and the flash's description are the
+ * board's state.
  */
 #include "board.h"
 
@@ -14,6 +21,7 @@
 #include "co_port.h"
 #include "flash_ee.h"
 #include "serial_link.h"
+#include "sja1000.h"
 #include "uid_serial.h"
 
 #define UART 0x10000000u
@@ -26,6 +34,14 @@
 static serial_link_t link;
 static void put(char c);
 static void wake_sources_init(void);
+static bool can_probe(void);
+static bool have_card(void);
+static bool can_ready(void);
+static bool can_bitrate(uint16_t kbps);
+static bool can_rx_waiting(void);
+
+/* The controller (can.io set when a card was found at start). */
+static sja1000_t can;
 
 int main(void);
 void reset_c(void) __attribute__((used)); /* called from the assembly above: LTO must keep it */
@@ -63,13 +79,19 @@ uint32_t board_serial(unsigned node)
 
 bool board_init(void)
 {
+    (void)can_probe();
     wake_sources_init();
     return true;
 }
 
-/* Told on the line the way an SLCAN adapter is ("S6": 500 kbit/s). */
+/* The controller's bit timing, or, without one, told on the line the way
+ * an SLCAN adapter is ("S6": 500 kbit/s). */
 bool board_can_bitrate(uint16_t kbps)
 {
+    if (have_card()) {
+        link.kbps = kbps; /* the simulated bus-off's recovery time */
+        return can_bitrate(kbps);
+    }
     return serial_link_bitrate(&link, kbps, put);
 }
 
@@ -97,6 +119,22 @@ uint32_t board_now_us(void)
 #define UART_IRQ 10u /* the virt machine's UART0 at the PLIC */
 #define MIE_MTIE (1u << 7)
 #define MIE_MEIE (1u << 11)
+
+/* Claims and completes what the PLIC has pending: the UART's and the CAN
+ * card's sources, once each at most. A source whose line is still high
+ * (the SJA1000's until its interrupt register is read) is pending again at
+ * once, and the WFI after this returns at once: the main loop's next pass
+ * reads it (sja1000_service). */
+static void plic_done(void)
+{
+    for (unsigned i = 0; i < 2u; i++) {
+        uint32_t claimed = PLIC_CLAIM0;
+        if (claimed == 0u) {
+            return;
+        }
+        PLIC_CLAIM0 = claimed;
+    }
+}
 
 static void wake_sources_init(void)
 {
@@ -126,17 +164,11 @@ void board_sleep(uint32_t us)
     MTIMECMP_LO = 0xFFFFFFFFu; /* no moment with a deadline in the past */
     MTIMECMP_HI = dhi;
     MTIMECMP_LO = dlo;
-    uint32_t claimed = PLIC_CLAIM0; /* a UART interrupt seen before: done */
-    if (claimed != 0u) {
-        PLIC_CLAIM0 = claimed;
-    }
-    if ((UART_LSR & 1u) == 0u) {
+    plic_done(); /* interrupts seen before: done */
+    if ((UART_LSR & 1u) == 0u && !can_rx_waiting()) {
         __asm__ volatile("wfi");
     }
-    claimed = PLIC_CLAIM0;
-    if (claimed != 0u) {
-        PLIC_CLAIM0 = claimed;
-    }
+    plic_done();
 }
 
 static void put(char c)
@@ -149,23 +181,50 @@ static void put(char c)
 bool co_port_can_send(void *port, const co_frame_t *f)
 {
     (void)port;
+    if (have_card()) { /* false: queue full or bus-off, the stack counts it */
+        return can_ready() && sja1000_send(&can, f);
+    }
     serial_link_tx(f, put);
     return true;
 }
 
+/* The serial line's input lines first; then a frame from the controller,
+ * or, without one, a frame line from the serial line. With a controller an
+ * SLCAN frame line on the UART is ignored: the bus is the controller's. A
+ * simulated bus-off (`can bus-off` on the line) loses what arrives meanwhile. */
 bool board_can_receive(co_frame_t *f)
 {
     while ((UART_LSR & 1u) != 0u) {
-        if (serial_link_rx(&link, (char)UART_RBR, f, put)) {
+        if (serial_link_rx(&link, (char)UART_RBR, f, put) && !have_card()) {
+            return true;
+        }
+    }
+    while (can_ready() && sja1000_receive(&can, f)) {
+        if (link.can_state != (uint8_t)CO_CAN_BUSOFF) {
             return true;
         }
     }
     return false;
 }
 
+/* The worse of the controller's state and the one the serial line
+ * simulates (`can passive`, `can bus-off`: a bench's fault injection on
+ * top of the real controller). */
 uint8_t board_can_state(void)
 {
-    return (uint8_t)serial_link_can_state(&link, board_now_us());
+    co_can_state_t s = serial_link_can_state(&link, board_now_us());
+    if (can_ready()) {
+        co_can_state_t hw = sja1000_service(&can);
+        s = hw > s ? hw : s;
+    }
+    return (uint8_t)s;
+}
+
+void board_can_filter(const co_rx_id_t *ids, unsigned n)
+{
+    if (can_ready()) {
+        sja1000_set_filter(&can, ids, n);
+    }
 }
 
 void board_leds(bool green, bool red)
@@ -234,4 +293,160 @@ bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
     (void)port;
     const flash_ee_t *fe = nvm();
     return fe != NULL && flash_ee_write(fe, addr, buf, len);
+}
+
+/* ---- CAN controller -------------------------------------------------------- */
+
+/*
+ * QEMU's virt machine has a PCIe host bridge (ECAM at 0x30000000, the I/O
+ * window at 0x03000000, INTA..INTD of slot s on PLIC sources 32 + (s +
+ * pin) mod 4). Nothing configures it before this image (no firmware runs
+ * first: the image is the -bios), so the image scans bus 0, gives the
+ * card's I/O BARs their addresses itself, and turns I/O decoding on.
+ * Cards known, all with one SJA1000 at 16 MHz (their data sheets; the
+ * first channel where a card has two):
+ *   Kvaser PCIcan (10e8:8406): BAR1, registers 1 byte apart; its PCI
+ *     bridge (S5920, BAR0) passes the controller's interrupt on only with
+ *     INTCSR's add-on interrupt enable bit set;
+ *   Advantech PCM-3680I (13fe:c002): BAR0, 1 byte apart;
+ *   Advantech MIOe-3680 (13fe:c302): BAR0, 4 bytes apart.
+ */
+#define ECAM 0x30000000u
+#define PCI_IO_WINDOW 0x03000000u
+#define PCI_IO_FIRST 0x1000u /* port addresses handed out from here up */
+#define PCI_IRQ_BASE 32u
+#define PLIC_ENABLE1 (*(volatile uint32_t *)0x0C002004u) /* sources 32..63 */
+#define SJA_CLOCK_HZ 16000000u
+#define S5920_INTCSR 0x38u
+#define S5920_ADDON_INT_ENABLE 0x2000u
+
+typedef struct can_card {
+    uint32_t vendor_device; /* vendor in the low half, as config space word 0 reads */
+    uint8_t bar;            /* the SJA1000's BAR */
+    uint8_t shift;          /* log2 of the register spacing */
+    bool s5920;             /* a Kvaser PCIcan: interrupt enable in BAR0 */
+} can_card_t;
+
+static const can_card_t cards[] = {
+    {0x840610E8u, 1u, 0u, true},
+    {0xC00213FEu, 0u, 0u, false},
+    {0xC30213FEu, 0u, 2u, false},
+};
+
+/* Where the controller's registers are: base (CPU address) and spacing. */
+typedef struct sja_port {
+    uint32_t base;
+    uint8_t shift;
+} sja_port_t;
+
+static sja_port_t sja_port;
+static uint32_t can_irq; /* its PLIC source, 0: none */
+
+static uint8_t sja_read(void *ctx, uint8_t reg)
+{
+    const sja_port_t *p = ctx;
+    return *(volatile uint8_t *)(uintptr_t)(p->base + ((uint32_t)reg << p->shift));
+}
+
+static void sja_write(void *ctx, uint8_t reg, uint8_t value)
+{
+    const sja_port_t *p = ctx;
+    *(volatile uint8_t *)(uintptr_t)(p->base + ((uint32_t)reg << p->shift)) = value;
+}
+
+static const sja1000_io_t sja_io = {sja_read, sja_write};
+
+static volatile uint32_t *cfg(uint32_t dev, uint32_t off)
+{
+    return (volatile uint32_t *)(uintptr_t)(ECAM + (dev << 15) + off);
+}
+
+/* Sizes and places the device's I/O BARs (memory BARs are left off: the
+ * cards here have none); returns the CPU address of BAR want (0: none). */
+static uint32_t assign_io_bars(uint32_t dev, unsigned want)
+{
+    static uint32_t next = PCI_IO_FIRST;
+    uint32_t found = 0;
+    for (unsigned b = 0; b < 6u; b++) {
+        volatile uint32_t *bar = cfg(dev, 0x10u + 4u * b);
+        *bar = 0xFFFFFFFFu;
+        uint32_t v = *bar;
+        if ((v & 1u) == 0u || (v & 0xFFFCu) == 0u) {
+            *bar = 0u;
+            continue; /* a memory BAR or none */
+        }
+        uint32_t size = (~(v & 0xFFFCu) + 1u) & 0xFFFFu;
+        next = (next + size - 1u) & ~(size - 1u);
+        *bar = next;
+        if (b == want) {
+            found = PCI_IO_WINDOW + next;
+        }
+        next += size;
+    }
+    *cfg(dev, 0x04u) |= 1u; /* command: I/O space decoding on */
+    return found;
+}
+
+/* The first known card on bus 0: its controller's registers and its PLIC
+ * source. */
+static bool can_probe(void)
+{
+    for (uint32_t dev = 0; dev < 32u; dev++) {
+        uint32_t id = *cfg(dev, 0u);
+        for (unsigned k = 0; k < sizeof cards / sizeof cards[0]; k++) {
+            if (id != cards[k].vendor_device) {
+                continue;
+            }
+            uint32_t base = assign_io_bars(dev, cards[k].bar);
+            if (base == 0u) {
+                return false;
+            }
+            if (cards[k].s5920) {
+                volatile uint32_t *intcsr =
+                    (volatile uint32_t *)(uintptr_t)(PCI_IO_WINDOW + (*cfg(dev, 0x10u) & 0xFFFCu) +
+                                                     S5920_INTCSR);
+                *intcsr = *intcsr | S5920_ADDON_INT_ENABLE;
+            }
+            uint32_t pin = (*cfg(dev, 0x3Cu) >> 8) & 0xFFu; /* 1: INTA */
+            can_irq = pin != 0u ? PCI_IRQ_BASE + (dev + pin - 1u) % 4u : 0u;
+            sja_port = (sja_port_t){.base = base, .shift = cards[k].shift};
+            return true;
+        }
+    }
+    return false;
+}
+
+static bool have_card(void)
+{
+    return sja_port.base != 0u;
+}
+
+/* The controller is up (its first bit rate taken). */
+static bool can_ready(void)
+{
+    return can.io != NULL;
+}
+
+/* The first bit rate brings the controller up; later ones retime it. A
+ * card that does not answer as an SJA1000 leaves the board without CAN. */
+static bool can_bitrate(uint16_t kbps)
+{
+    if (can.io == NULL) {
+        sja1000_t fresh;
+        if (!sja1000_init(&fresh, &sja_io, &sja_port, SJA_CLOCK_HZ, kbps)) {
+            return false;
+        }
+        can = fresh;
+        if (can_irq != 0u) {
+            PLIC_PRIORITY(can_irq) = 1u;
+            PLIC_ENABLE1 |= 1u << (can_irq - 32u);
+        }
+        return true;
+    }
+    return sja1000_set_bitrate(&can, kbps);
+}
+
+static bool can_rx_waiting(void)
+{
+    return can_ready() && (sja_read(&sja_port, SJA_SR) & SJA_SR_RBS) != 0u;
 }
