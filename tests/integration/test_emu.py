@@ -368,6 +368,17 @@ def test_rv32_read_only_flash_reads_but_refuses_saves(emus, tmp_path):
      "cmake --build build-rv32-virt --target fw-" + PRODUCT),
     (["--board", "rv32-virt", "--product", PRODUCT], "required"),
     (["--board", "microbit", "--product", PRODUCT, "--port", "1", "--flash", ""], "empty path"),
+    # --can: the micro:bit has no PCI bus for QEMU's CAN cards (refused
+    # before its image is looked for); an interface that is missing or is
+    # no CAN interface (lo, on every Linux) is refused before QEMU starts.
+    (["--board", "microbit", "--product", PRODUCT, "--port", "1", "--can", "vcan0"],
+     "the microbit board has no CAN controller"),
+    (["--board", "rv32-virt", "--product", PRODUCT, "--port", "1", "--can", "nosuchcan9"],
+     "--can nosuchcan9: no such network interface"),
+    (["--board", "rv32-virt", "--product", PRODUCT, "--port", "1", "--can", "lo"],
+     "--can lo: not a CAN interface"),
+    (["--board", "rv32-virt", "--product", PRODUCT, "--port", "1", "--can", "a/b"],
+     "not a network interface name"),
 ])
 def test_usage_errors(args, message):
     r = subprocess.run([EMU] + args, capture_output=True, text=True, timeout=30)
@@ -416,7 +427,7 @@ def test_help_documents_the_interface():
     r = subprocess.run([EMU, "--help"], capture_output=True, text=True, timeout=30)
     assert r.returncode == 0
     for word in ("--board", "--product", "--port", "--flash", "rv32-virt", "microbit",
-                 "SIGKILL", "Exit status"):
+                 "SIGKILL", "Exit status", "--can", "kvaser_pci", "wait=off"):
         assert word in r.stdout
 
 
