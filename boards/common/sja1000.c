@@ -209,7 +209,7 @@ bool sja1000_init(sja1000_t *c, const sja1000_io_t *io, void *ctx, uint32_t cloc
                      .state = (uint8_t)CO_CAN_ACTIVE};
     uint8_t btr0;
     uint8_t btr1;
-    if (!sja1000_timing(clock_hz, kbps, &btr0, &btr1) || !set_mode(c, SJA_MOD_RM)) {
+    if (!set_mode(c, SJA_MOD_RM) || !sja1000_timing(clock_hz, kbps, &btr0, &btr1)) {
         return false;
     }
     wr(c, SJA_CDR, SJA_CDR_PELICAN | SJA_CDR_CLKOFF);
