@@ -57,7 +57,8 @@
 #define CDR_RESET_ONLY 0xE8u
 #define CDR_PELICAN 0x80u
 
-static void violation(sja_model_t *m, const char *fmt, ...)
+__attribute__((format(printf, 2, 3))) static void violation(sja_model_t *m, const char *fmt,
+                                                                ...)
 {
     va_list ap;
     va_start(ap, fmt);

@@ -407,6 +407,7 @@ static void test_timing_every_rate_and_refusals(void)
                 CHECK_EQ(clocks[k] % (2u * ((b0 & 0x3Fu) + 1u) * n), 0);
                 CHECK_EQ((unsigned)abs((int)(8u * (1u + t1)) - (int)(7u * n)) * nq, num * n);
                 CHECK_EQ(n, nq);
+                CHECK_EQ((b0 >> 6) + 1u, t2 < 4u ? t2 : 4u);
             } else {
                 CHECK(b0 == 0xEE && b1 == 0xDD);
             }
@@ -420,6 +421,18 @@ static void test_timing_every_rate_and_refusals(void)
     CHECK(!sja1000_timing(16000000u, 1600, &b0, &b1)); /* 5 clocks a bit */
     CHECK(b0 == 0xEE && b1 == 0xDD);
 }
+
+/* One node's receive list (node-ID 5), as co_node_rx_ids gives it. */
+static const co_rx_id_t node5[] = {
+    {0x000, false}, /* NMT */
+    {0x080, false}, /* SYNC */
+    {0x605, false}, /* SDO request */
+    {0x7E5, false}, /* LSS master */
+    {0x705, true},  /* node guarding */
+    {0x185, true},  /* remote request on TPDO 1 */
+    {0x701, false}, /* heartbeat consumed from node 1 */
+};
+#define NODE5_N (sizeof node5 / sizeof node5[0])
 
 /* ---- start-up ----------------------------------------------------------- */
 
@@ -450,7 +463,7 @@ static void test_init(void)
     CHECK_EQ(m.ocr, 0x1A);           /* normal output mode, TX0 push-pull */
     /* receive, transmit, error warning, data overrun, error passive; not
      * bus error or arbitration lost (nor wake-up: sleep is never used) */
-    CHECK_EQ(m.ier & 0xEF, 0x2F);
+    CHECK_EQ(m.ier & 0xEFu, 0x2F);
     CHECK(filter_open());
     CHECK_EQ(c.kbps, 250);
     CHECK_EQ(c.tx_len, 0);
@@ -521,6 +534,12 @@ static void test_init_refused(void)
     CHECK_EQ(m.mod & 0x01, 0x01);
     co_frame_t f = frame(0x100, false, 0, 0);
     CHECK(!inject(&f));
+    /* a receive list given all the same: still off the bus, the bit
+     * timing registers as they were */
+    uint8_t btr0 = m.btr0, btr1 = m.btr1;
+    sja1000_set_filter(&c, node5, NODE5_N);
+    CHECK_EQ(m.mod & 0x01, 0x01);
+    CHECK(m.btr0 == btr0 && m.btr1 == btr1);
     up();
     CHECK(!sja1000_init(&c, &sja_model_io, &m, 16000000u, 7u));
     CHECK_EQ(m.mod & 0x01, 0x01);
@@ -529,16 +548,6 @@ static void test_init_refused(void)
 
 /* ---- bit rate change ------------------------------------------------------ */
 
-static const co_rx_id_t node5[] = {
-    {0x000, false}, /* NMT */
-    {0x080, false}, /* SYNC */
-    {0x605, false}, /* SDO request */
-    {0x7E5, false}, /* LSS master */
-    {0x705, true},  /* node guarding */
-    {0x185, true},  /* remote request on TPDO 1 */
-    {0x701, false}, /* heartbeat consumed from node 1 */
-};
-#define NODE5_N (sizeof node5 / sizeof node5[0])
 
 static void test_set_bitrate(void)
 {
@@ -582,6 +591,15 @@ static void test_set_bitrate(void)
         EXPECT_SENT(&f[i]);
     }
     CHECK(sja_model_next(&m) == NULL);
+    /* a frame the bus took before the driver saw it go: not sent twice */
+    CHECK(sja1000_send(&c, &f[0]));
+    sja1000_service(&c);
+    CHECK(sja_model_bus(&m));
+    CHECK(sja1000_set_bitrate(&c, 500));
+    EXPECT_SENT(&f[0]);
+    CHECK_EQ(bus_run(4), 0);
+    CHECK(sja_model_next(&m) == NULL);
+    CHECK_EQ(c.tx_len, 0);
     /* a rate the clock cannot make: nothing changes */
     resets = m.reset_entries;
     CHECK(!sja1000_set_bitrate(&c, 7));
@@ -706,13 +724,19 @@ static void check_list(const co_rx_id_t *ids, unsigned n, bool open)
     }
     CHECK_EQ(delivered, open ? 4096u : nk);
     CHECK_EQ(c.filtered_out - dropped0, hw_only);
-    if (!open && nu <= SJA1000_EXACT_IDS) {
+    if (!open) {
         unsigned best = fewest_passed(u, nu);
-        if (passed != best) {
+        if (nu <= SJA1000_EXACT_IDS && passed != best) {
             fprintf(stderr, "%u IDs: the filter passes %u CAN-IDs, %u could do\n", nu, passed,
                     best);
         }
-        CHECK_EQ(passed, best);
+        if (nu <= SJA1000_EXACT_IDS) {
+            CHECK_EQ(passed, best); /* every split tried: the fewest */
+        } else {
+            /* the greedy choice, which sja1000.h promises nothing of: no
+             * worse than now (4 x the fewest for two clusters of 8) */
+            CHECK(passed <= 4u * best);
+        }
     }
     /* extended frames: dropped, even those the hardware filter passes */
     const uint8_t d[8] = {1, 2, 3, 4, 5, 6, 7, 8};
@@ -786,6 +810,13 @@ static void test_filter_two_nodes_and_long_lists(void)
         many[k].rtr = (k % 3u) == 0u;
     }
     check_list(many, SJA1000_IDS_MAX, false);
+    /* two clusters of 8 (0x100.., 0x600..), each in order */
+    co_rx_id_t cl[16];
+    for (unsigned k = 0; k < 16u; k++) {
+        cl[k].id = (uint16_t)(k < 8u ? 0x100u + k : 0x600u + k - 8u);
+        cl[k].rtr = false;
+    }
+    check_list(cl, 16, false);
     check_list(many, SJA1000_EXACT_IDS, false);
     check_list(many, SJA1000_EXACT_IDS + 1u, false);
     /* one more: the filter opens, nothing is dropped */
