@@ -292,8 +292,9 @@ void sja1000_set_filter(sja1000_t *c, const co_rx_id_t *ids, unsigned n)
     }
     uint8_t btr0;
     uint8_t btr1;
-    (void)sja1000_timing(c->clock_hz, c->kbps, &btr0, &btr1); /* taken by init */
-    (void)reprogram(c, btr0, btr1);
+    if (sja1000_timing(c->clock_hz, c->kbps, &btr0, &btr1)) { /* not after a refused init */
+        (void)reprogram(c, btr0, btr1);
+    }
 }
 
 /* ---- transmit ---------------------------------------------------------- */
