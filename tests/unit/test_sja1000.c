@@ -607,6 +607,14 @@ static void test_set_bitrate(void)
     CHECK(m.btr0 == b0 && m.btr1 == b1);
     CHECK_EQ(c.kbps, 500);
     CHECK_EQ(m.mod & 0x01, 0x00);
+    /* a controller that no longer enters reset mode: refused, and nothing
+     * written that reset mode guards (the model would record it) */
+    m.stuck_operating = true;
+    CHECK(!sja1000_set_bitrate(&c, 250));
+    CHECK(m.btr0 == b0 && m.btr1 == b1);
+    CHECK_EQ(m.mod & 0x01, 0x00);
+    CLEAN();
+    m.stuck_operating = false;
     /* and down to 10 kbit/s */
     CHECK(sja1000_set_bitrate(&c, 10));
     CHECK(sja1000_timing(16000000u, 10, &b0, &b1));
@@ -760,6 +768,15 @@ static void test_filter_one_node(void)
     unsigned resets = m.reset_entries;
     sja1000_set_filter(&c, node5, NODE5_N);
     CHECK_EQ(m.reset_entries, resets);
+    /* the same IDs in another order, with duplicates: the same list */
+    co_rx_id_t shuffled[NODE5_N + 2u];
+    for (unsigned k = 0; k < NODE5_N; k++) {
+        shuffled[k] = node5[NODE5_N - 1u - k];
+    }
+    shuffled[NODE5_N] = node5[0];
+    shuffled[NODE5_N + 1u] = node5[4];
+    sja1000_set_filter(&c, shuffled, NODE5_N + 2u);
+    CHECK_EQ(m.reset_entries, resets);
     /* a changed list (the SDO COB-ID of node-ID 6): once */
     co_rx_id_t moved[NODE5_N];
     memcpy(moved, node5, sizeof node5);
@@ -847,6 +864,35 @@ static void test_filter_every_product(void)
     }
 }
 
+/* A list change goes through reset mode, which aborts a transmission:
+ * the frame in the transmit buffer goes again, the queue behind it in order. */
+static void test_filter_change_keeps_transmit(void)
+{
+    up();
+    sja1000_set_filter(&c, node5, NODE5_N);
+    co_frame_t out[3] = {frame(0x185, false, 4, 3), frame(0x705, false, 1, 4),
+                         frame(0x285, true, 2, 0)};
+    m.no_ack = true;
+    for (unsigned i = 0; i < 3u; i++) {
+        CHECK(sja1000_send(&c, &out[i]));
+        sja1000_service(&c);
+    }
+    CHECK(m.tx_pending);
+    co_rx_id_t moved[NODE5_N];
+    memcpy(moved, node5, sizeof node5);
+    moved[2].id = 0x606;
+    unsigned resets = m.reset_entries;
+    sja1000_set_filter(&c, moved, NODE5_N);
+    CHECK_EQ(m.reset_entries, resets + 1u);
+    m.no_ack = false;
+    CHECK_EQ(bus_run(8), 3);
+    for (unsigned i = 0; i < 3u; i++) {
+        EXPECT_SENT(&out[i]);
+    }
+    CHECK(sja_model_next(&m) == NULL);
+    CLEAN();
+}
+
 /* ---- transmit ----------------------------------------------------------- */
 
 static void test_transmit_queue(void)
@@ -901,6 +947,10 @@ static void test_transmit_queue(void)
 }
 
 /* ---- receive ------------------------------------------------------------ */
+
+/* SJA1000_SERVICE_BOUND_US against the FIFO: at 1 Mbit/s 5 frames of 8
+ * data bytes (the model stores 5, not 6) last 5 x 111 bit times at least. */
+_Static_assert(SJA1000_SERVICE_BOUND_US <= 5u * 111u, "the service bound outlasts the FIFO");
 
 static void test_receive_fifo_and_overrun(void)
 {
@@ -1125,6 +1175,7 @@ int main(void)
     RUN(test_filter_one_node);
     RUN(test_filter_two_nodes_and_long_lists);
     RUN(test_filter_every_product);
+    RUN(test_filter_change_keeps_transmit);
     RUN(test_transmit_queue);
     RUN(test_receive_fifo_and_overrun);
     RUN(test_receive_skips_bounded);
