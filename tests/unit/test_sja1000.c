@@ -548,7 +548,6 @@ static void test_init_refused(void)
 
 /* ---- bit rate change ------------------------------------------------------ */
 
-
 static void test_set_bitrate(void)
 {
     up();
