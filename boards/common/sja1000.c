@@ -233,6 +233,19 @@ bool sja1000_init(sja1000_t *c, const sja1000_io_t *io, void *ctx, uint32_t cloc
     return true;
 }
 
+/* A new filter into the controller once its RX FIFO is empty: reset mode
+ * would empty it, losing frames received on IDs both lists hold. Until
+ * then the software check holds the new list already. */
+static void apply_filter(sja1000_t *c)
+{
+    uint8_t btr0;
+    uint8_t btr1;
+    if (c->filter_pending && (rd(c, SJA_SR) & SJA_SR_RBS) == 0u &&
+        sja1000_timing(c->clock_hz, c->kbps, &btr0, &btr1)) { /* not after a refused init */
+        c->filter_pending = !reprogram(c, btr0, btr1);
+    }
+}
+
 bool sja1000_set_bitrate(sja1000_t *c, uint16_t kbps)
 {
     uint8_t btr0;
@@ -240,8 +253,11 @@ bool sja1000_set_bitrate(sja1000_t *c, uint16_t kbps)
     if (!sja1000_timing(c->clock_hz, kbps, &btr0, &btr1)) {
         return false;
     }
+    if (!reprogram(c, btr0, btr1)) {
+        return false;
+    }
     c->kbps = kbps;
-    return reprogram(c, btr0, btr1);
+    return true;
 }
 
 void sja1000_set_filter(sja1000_t *c, const co_rx_id_t *ids, unsigned n)
@@ -261,40 +277,37 @@ void sja1000_set_filter(sja1000_t *c, const co_rx_id_t *ids, unsigned n)
             }
         }
     }
-    bool same = c->filtered == !open && (open || c->nids == m);
-    for (unsigned k = 0; same && !open && k < m; k++) {
+    bool filtered = !open && m > 0u;
+    bool same = c->filtered == filtered && (!filtered || c->nids == m);
+    for (unsigned k = 0; same && filtered && k < m; k++) {
         same = listed(c, list[k].id, list[k].rtr);
     }
-    if (same) {
-        return;
-    }
-    c->filtered = !open && m > 0u;
-    c->nids = (uint8_t)(open ? 0u : m);
-    uint16_t u[SJA1000_IDS_MAX];
-    unsigned nu = 0;
-    for (unsigned k = 0; k < c->nids; k++) { /* the IDs without their RTR kind */
-        bool dup = false;
-        for (unsigned j = 0; j < nu; j++) {
-            dup = dup || u[j] == list[k].id;
+    if (!same) {
+        c->filtered = filtered;
+        c->nids = (uint8_t)(filtered ? m : 0u);
+        uint16_t u[SJA1000_IDS_MAX];
+        unsigned nu = 0;
+        for (unsigned k = 0; k < c->nids; k++) { /* the IDs without their RTR kind */
+            bool dup = false;
+            for (unsigned j = 0; j < nu; j++) {
+                dup = dup || u[j] == list[k].id;
+            }
+            if (!dup) {
+                u[nu++] = list[k].id;
+            }
+            c->ids[k] = list[k];
         }
-        if (!dup) {
-            u[nu++] = list[k].id;
+        if (nu == 0u) {
+            for (unsigned i = 0; i < 4u; i++) {
+                c->acr[i] = 0x00u;
+                c->amr[i] = 0xFFu;
+            }
+        } else {
+            choose_filters(c, u, nu);
         }
-        c->ids[k] = list[k];
+        c->filter_pending = true;
     }
-    if (nu == 0u) {
-        for (unsigned i = 0; i < 4u; i++) {
-            c->acr[i] = 0x00u;
-            c->amr[i] = 0xFFu;
-        }
-    } else {
-        choose_filters(c, u, nu);
-    }
-    uint8_t btr0;
-    uint8_t btr1;
-    if (sja1000_timing(c->clock_hz, c->kbps, &btr0, &btr1)) { /* not after a refused init */
-        (void)reprogram(c, btr0, btr1);
-    }
+    apply_filter(c);
 }
 
 /* ---- transmit ---------------------------------------------------------- */
@@ -398,6 +411,7 @@ co_can_state_t sja1000_service(sja1000_t *c)
         s = CO_CAN_WARNING;
     }
     c->state = (uint8_t)s;
+    apply_filter(c);
     kick(c);
     return s;
 }

@@ -892,6 +892,58 @@ static void test_filter_change_keeps_transmit(void)
     CLEAN();
 }
 
+/* A list change waits until the RX FIFO is empty: reset mode would empty it,
+ * and frames received on IDs both lists hold (SYNC, NMT) would be lost. The
+ * software check takes the new list at once; the hardware one follows at the
+ * service after the FIFO has been read. */
+static void test_filter_change_keeps_received(void)
+{
+    up();
+    sja1000_set_filter(&c, node5, NODE5_N);
+    co_frame_t in[3] = {frame(0x080, false, 0, 1), frame(0x000, false, 2, 2),
+                        frame(0x605, false, 8, 3)};
+    for (unsigned i = 0; i < 3u; i++) {
+        CHECK(inject(&in[i]));
+    }
+    co_rx_id_t moved[NODE5_N];
+    memcpy(moved, node5, sizeof node5);
+    moved[2].id = 0x606;
+    unsigned resets = m.reset_entries;
+    sja1000_set_filter(&c, moved, NODE5_N);
+    CHECK_EQ(m.reset_entries, resets); /* frames waiting: not yet */
+    co_frame_t g;
+    CHECK(sja1000_receive(&c, &g) && same_frame(&g, &in[0]));
+    CHECK(sja1000_receive(&c, &g) && same_frame(&g, &in[1]));
+    CHECK(!sja1000_receive(&c, &g)); /* 0x605 left the list: dropped */
+    CHECK_EQ(c.filtered_out, 1u);
+    sja1000_set_filter(&c, moved, NODE5_N); /* the same list: applied now */
+    CHECK_EQ(m.reset_entries, resets + 1u);
+    sja1000_service(&c);
+    CHECK_EQ(m.reset_entries, resets + 1u);
+    CLEAN();
+}
+
+/* A change waiting for the FIFO is applied by the service once it is empty. */
+static void test_filter_change_applied_by_service(void)
+{
+    up();
+    sja1000_set_filter(&c, node5, NODE5_N);
+    co_frame_t in = frame(0x080, false, 0, 1);
+    CHECK(inject(&in));
+    co_rx_id_t moved[NODE5_N];
+    memcpy(moved, node5, sizeof node5);
+    moved[2].id = 0x606;
+    unsigned resets = m.reset_entries;
+    sja1000_set_filter(&c, moved, NODE5_N);
+    sja1000_service(&c);
+    CHECK_EQ(m.reset_entries, resets);
+    co_frame_t g;
+    CHECK(sja1000_receive(&c, &g) && same_frame(&g, &in));
+    sja1000_service(&c);
+    CHECK_EQ(m.reset_entries, resets + 1u);
+    CLEAN();
+}
+
 /* ---- transmit ----------------------------------------------------------- */
 
 static void test_transmit_queue(void)
@@ -1175,6 +1227,8 @@ int main(void)
     RUN(test_filter_two_nodes_and_long_lists);
     RUN(test_filter_every_product);
     RUN(test_filter_change_keeps_transmit);
+    RUN(test_filter_change_keeps_received);
+    RUN(test_filter_change_applied_by_service);
     RUN(test_transmit_queue);
     RUN(test_receive_fifo_and_overrun);
     RUN(test_receive_skips_bounded);
