@@ -118,8 +118,9 @@ static void put_filter(sja1000_t *c, unsigned k, uint16_t code, uint16_t mask)
 /*
  * Two code/mask pairs covering the distinct IDs u[0..m-1] with as few
  * other IDs as they can: every split into two groups when there are few
- * (u[0] stays in the first, so each split is tried once), else each ID to
- * the group whose mask it widens least.
+ * (u[0] stays in the first, so each split is tried once); else the ID
+ * farthest from u[0] (most bits apart) starts the second group, and each
+ * other ID goes to the group whose mask it widens least.
  */
 static void choose_filters(sja1000_t *c, const uint16_t *u, unsigned m)
 {
@@ -128,17 +129,21 @@ static void choose_filters(sja1000_t *c, const uint16_t *u, unsigned m)
     uint32_t best = UINT32_MAX;
     bool exact = m <= SJA1000_EXACT_IDS;
     uint32_t splits = exact ? 1u << (m - 1u) : 1u;
+    uint16_t far = u[0];
+    for (unsigned i = 1; i < m && !exact; i++) {
+        far = bits11((uint32_t)(u[i] ^ u[0])) > bits11((uint32_t)(far ^ u[0])) ? u[i] : far;
+    }
     for (uint32_t s = 0; s < splits; s++) {
         uint16_t mk[2] = {0, 0};
-        uint16_t first[2] = {u[0], u[0]};
-        bool used = false; /* the second group has an ID */
+        uint16_t first[2] = {u[0], far};
+        bool used = !exact; /* the second group has an ID */
         for (unsigned i = 1; i < m; i++) {
             unsigned g;
             if (exact) {
                 g = (s >> (i - 1u)) & 1u;
-            } else { /* greedy: where the mask grows least, a new group first */
-                g = !used || bits11((uint32_t)(mk[1] | (u[i] ^ first[1]))) <
-                                 bits11((uint32_t)(mk[0] | (u[i] ^ first[0])))
+            } else { /* greedy: where the mask grows least */
+                g = bits11((uint32_t)(mk[1] | (u[i] ^ first[1]))) <
+                            bits11((uint32_t)(mk[0] | (u[i] ^ first[0])))
                         ? 1u
                         : 0u;
             }

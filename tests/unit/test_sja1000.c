@@ -741,8 +741,9 @@ static void check_list(const co_rx_id_t *ids, unsigned n, bool open)
             CHECK_EQ(passed, best); /* every split tried: the fewest */
         } else {
             /* the greedy choice, which sja1000.h promises nothing of: no
-             * worse than now (4 x the fewest for two clusters of 8) */
-            CHECK(passed <= 4u * best);
+             * worse than now (the fewest for two clusters of 8; 2 x for
+             * the 13 and 16 scattered IDs) */
+            CHECK(passed <= 2u * best);
         }
     }
     /* extended frames: dropped, even those the hardware filter passes */
