@@ -118,8 +118,9 @@ static void put_filter(sja1000_t *c, unsigned k, uint16_t code, uint16_t mask)
 /*
  * Two code/mask pairs covering the distinct IDs u[0..m-1] with as few
  * other IDs as they can: every split into two groups when there are few
- * (u[0] stays in the first, so each split is tried once), else each ID to
- * the group whose mask it widens least.
+ * (u[0] stays in the first, so each split is tried once); else the ID
+ * farthest from u[0] (most bits apart) starts the second group, and each
+ * other ID goes to the group whose mask it widens least.
  */
 static void choose_filters(sja1000_t *c, const uint16_t *u, unsigned m)
 {
@@ -128,17 +129,21 @@ static void choose_filters(sja1000_t *c, const uint16_t *u, unsigned m)
     uint32_t best = UINT32_MAX;
     bool exact = m <= SJA1000_EXACT_IDS;
     uint32_t splits = exact ? 1u << (m - 1u) : 1u;
+    uint16_t far = u[0];
+    for (unsigned i = 1; i < m && !exact; i++) {
+        far = bits11((uint32_t)(u[i] ^ u[0])) > bits11((uint32_t)(far ^ u[0])) ? u[i] : far;
+    }
     for (uint32_t s = 0; s < splits; s++) {
         uint16_t mk[2] = {0, 0};
-        uint16_t first[2] = {u[0], u[0]};
-        bool used = false; /* the second group has an ID */
+        uint16_t first[2] = {u[0], far};
+        bool used = !exact; /* the second group has an ID */
         for (unsigned i = 1; i < m; i++) {
             unsigned g;
             if (exact) {
                 g = (s >> (i - 1u)) & 1u;
-            } else { /* greedy: where the mask grows least, a new group first */
-                g = !used || bits11((uint32_t)(mk[1] | (u[i] ^ first[1]))) <
-                                 bits11((uint32_t)(mk[0] | (u[i] ^ first[0])))
+            } else { /* greedy: where the mask grows least */
+                g = bits11((uint32_t)(mk[1] | (u[i] ^ first[1]))) <
+                            bits11((uint32_t)(mk[0] | (u[i] ^ first[0])))
                         ? 1u
                         : 0u;
             }
@@ -209,7 +214,7 @@ bool sja1000_init(sja1000_t *c, const sja1000_io_t *io, void *ctx, uint32_t cloc
                      .state = (uint8_t)CO_CAN_ACTIVE};
     uint8_t btr0;
     uint8_t btr1;
-    if (!sja1000_timing(clock_hz, kbps, &btr0, &btr1) || !set_mode(c, SJA_MOD_RM)) {
+    if (!set_mode(c, SJA_MOD_RM) || !sja1000_timing(clock_hz, kbps, &btr0, &btr1)) {
         return false;
     }
     wr(c, SJA_CDR, SJA_CDR_PELICAN | SJA_CDR_CLKOFF);
@@ -233,6 +238,19 @@ bool sja1000_init(sja1000_t *c, const sja1000_io_t *io, void *ctx, uint32_t cloc
     return true;
 }
 
+/* A new filter into the controller once its RX FIFO is empty: reset mode
+ * would empty it, losing frames received on IDs both lists hold. Until
+ * then the software check holds the new list already. */
+static void apply_filter(sja1000_t *c)
+{
+    uint8_t btr0;
+    uint8_t btr1;
+    if (c->filter_pending && (rd(c, SJA_SR) & SJA_SR_RBS) == 0u &&
+        sja1000_timing(c->clock_hz, c->kbps, &btr0, &btr1)) { /* not after a refused init */
+        c->filter_pending = !reprogram(c, btr0, btr1);
+    }
+}
+
 bool sja1000_set_bitrate(sja1000_t *c, uint16_t kbps)
 {
     uint8_t btr0;
@@ -240,8 +258,11 @@ bool sja1000_set_bitrate(sja1000_t *c, uint16_t kbps)
     if (!sja1000_timing(c->clock_hz, kbps, &btr0, &btr1)) {
         return false;
     }
+    if (!reprogram(c, btr0, btr1)) {
+        return false;
+    }
     c->kbps = kbps;
-    return reprogram(c, btr0, btr1);
+    return true;
 }
 
 void sja1000_set_filter(sja1000_t *c, const co_rx_id_t *ids, unsigned n)
@@ -261,39 +282,37 @@ void sja1000_set_filter(sja1000_t *c, const co_rx_id_t *ids, unsigned n)
             }
         }
     }
-    bool same = c->filtered == !open && (open || c->nids == m);
-    for (unsigned k = 0; same && !open && k < m; k++) {
+    bool filtered = !open && m > 0u;
+    bool same = c->filtered == filtered && (!filtered || c->nids == m);
+    for (unsigned k = 0; same && filtered && k < m; k++) {
         same = listed(c, list[k].id, list[k].rtr);
     }
-    if (same) {
-        return;
-    }
-    c->filtered = !open && m > 0u;
-    c->nids = (uint8_t)(open ? 0u : m);
-    uint16_t u[SJA1000_IDS_MAX];
-    unsigned nu = 0;
-    for (unsigned k = 0; k < c->nids; k++) { /* the IDs without their RTR kind */
-        bool dup = false;
-        for (unsigned j = 0; j < nu; j++) {
-            dup = dup || u[j] == list[k].id;
+    if (!same) {
+        c->filtered = filtered;
+        c->nids = (uint8_t)(filtered ? m : 0u);
+        uint16_t u[SJA1000_IDS_MAX];
+        unsigned nu = 0;
+        for (unsigned k = 0; k < c->nids; k++) { /* the IDs without their RTR kind */
+            bool dup = false;
+            for (unsigned j = 0; j < nu; j++) {
+                dup = dup || u[j] == list[k].id;
+            }
+            if (!dup) {
+                u[nu++] = list[k].id;
+            }
+            c->ids[k] = list[k];
         }
-        if (!dup) {
-            u[nu++] = list[k].id;
+        if (nu == 0u) {
+            for (unsigned i = 0; i < 4u; i++) {
+                c->acr[i] = 0x00u;
+                c->amr[i] = 0xFFu;
+            }
+        } else {
+            choose_filters(c, u, nu);
         }
-        c->ids[k] = list[k];
+        c->filter_pending = true;
     }
-    if (nu == 0u) {
-        for (unsigned i = 0; i < 4u; i++) {
-            c->acr[i] = 0x00u;
-            c->amr[i] = 0xFFu;
-        }
-    } else {
-        choose_filters(c, u, nu);
-    }
-    uint8_t btr0;
-    uint8_t btr1;
-    (void)sja1000_timing(c->clock_hz, c->kbps, &btr0, &btr1); /* taken by init */
-    (void)reprogram(c, btr0, btr1);
+    apply_filter(c);
 }
 
 /* ---- transmit ---------------------------------------------------------- */
@@ -397,6 +416,7 @@ co_can_state_t sja1000_service(sja1000_t *c)
         s = CO_CAN_WARNING;
     }
     c->state = (uint8_t)s;
+    apply_filter(c);
     kick(c);
     return s;
 }

@@ -8,8 +8,9 @@
  * is here, with no global state: the driver's state is sja1000_t.
  *
  * What it does:
- *  - init: reset mode, PeliCAN mode (clock divider CDR.7), all interrupts
- *    but bus error and arbitration lost enabled, output control normal,
+ *  - init: reset mode, PeliCAN mode (clock divider CDR.7), the receive,
+ *    transmit, error warning, data overrun and error passive interrupts
+ *    enabled (not wake-up, bus error, arbitration lost), output control normal,
  *    acceptance filter open, bit timing, then operating mode;
  *  - bit timing (BTR0/BTR1) for every CiA 301 bit rate from the controller's
  *    clock, by the data sheet's formula (sja1000_timing);
@@ -92,6 +93,8 @@ enum {
  * together, without duplicates); a longer list opens the hardware filter
  * and leaves it to the software check. */
 #define SJA1000_IDS_MAX (2u * CO_NODE_RX_IDS_MAX)
+_Static_assert(SJA1000_IDS_MAX <= 255u && SJA1000_TXQ_LEN <= 255u,
+              "nids, tx_head and tx_len are bytes");
 /* At most this many IDs get the exact two-filter choice (2^(n-1)
  * partitions are tried); more get a greedy one. */
 #define SJA1000_EXACT_IDS 12u
@@ -119,6 +122,7 @@ typedef struct sja1000 {
     co_rx_id_t ids[SJA1000_IDS_MAX];
     uint8_t nids;
     bool filtered;
+    bool filter_pending; /* acr/amr not yet in the controller */
     uint8_t acr[4]; /* the acceptance code and mask as programmed */
     uint8_t amr[4];
     /* Transmit queue: frames waiting for the transmit buffer, oldest at head. */
@@ -159,9 +163,12 @@ bool sja1000_set_bitrate(sja1000_t *c, uint16_t kbps);
 /*
  * The receive list: the nodes' co_node_rx_ids() together (n entries;
  * duplicates allowed). Reprograms the acceptance filter only when the
- * list differs from the last one (a change goes through reset mode, which
- * loses a frame arriving meanwhile). More than SJA1000_IDS_MAX distinct
- * IDs: the hardware filter is opened and nothing is dropped.
+ * list differs from the last one. A change goes through reset mode, which
+ * empties the RX FIFO: it waits until the FIFO is empty (this call or a
+ * later sja1000_service), and only a frame arriving during the change
+ * itself is lost; the software check takes the new list at once. More
+ * than SJA1000_IDS_MAX distinct IDs: the hardware filter is opened and
+ * nothing is dropped.
  */
 void sja1000_set_filter(sja1000_t *c, const co_rx_id_t *ids, unsigned n);
 
@@ -180,7 +187,8 @@ bool sja1000_receive(sja1000_t *c, co_frame_t *f);
 /*
  * The interrupt's work, from the main loop: reads the interrupt register
  * (which releases the interrupt line), counts and clears a data overrun,
- * moves the next queued frame into a free transmit buffer, updates the
+ * moves the next queued frame into a free transmit buffer, puts a waiting
+ * filter change into the controller (sja1000_set_filter), updates the
  * error state, and restarts the controller after bus-off (the queue is
  * kept). Returns the state.
  */
