@@ -22,10 +22,13 @@ IFACE = "vcan0"
 
 def pytest_addoption(parser):
     """test_targets.py runs on one target, for a list of products."""
-    group = parser.getgroup("targets", "the one suite on three targets (test_targets.py)")
-    group.addoption("--target", default="linux", choices=("linux", "rv32-virt", "microbit"),
+    group = parser.getgroup("targets", "the one suite on four targets (test_targets.py)")
+    group.addoption("--target", default="linux",
+                    choices=("linux", "rv32-virt", "microbit", "rv32-can"),
                     help="where the products run: linux (canopen-sensor on vcan0, through "
-                         "tools/vcan-run) or an emulated board (tools/emu, qemu)")
+                         "tools/vcan-run), an emulated board on its SLCAN serial line "
+                         "(tools/emu, qemu), or rv32-can (the rv32-virt image's SJA1000 "
+                         "on vcan0: tools/emu --can, through tools/vcan-run)")
     group.addoption("--products", default=os.environ.get("CO_TEST_PRODUCTS", "ci"),
                     help="ci (one of each family, facts.CI_PRODUCTS), all, or IDs "
                          "separated by commas; default $CO_TEST_PRODUCTS, else ci "

@@ -294,6 +294,9 @@ CI_PRODUCTS = {
     "linux": ("dst-x730-xy30", "dst-x710-z360", "gsh-a", "gsh-a-redundant", "jd2xxx", "inx360d"),
     "rv32-virt": ("dst-x730-xy10", "dst-x710-xy45", "gsh-a", "gsh-a-redundant", "jd1xxx",
                   "iny360d"),
+    # The same image as rv32-virt, its frames through the SJA1000 on vcan0.
+    "rv32-can": ("dst-x730-xy10", "dst-x710-xy45", "gsh-a", "gsh-a-redundant", "jd1xxx",
+                 "iny360d"),
     "microbit": ("dst-x730-z360", "dst-x710-xy90", "gsh-a", "gsh-a-redundant", "jd2xxx",
                  "inx360d"),
 }

@@ -1,0 +1,219 @@
+"""tools/emu --can on a real SocketCAN bus, inside tools/vcan-run: the
+rv32-virt image's SJA1000 (QEMU's Kvaser PCIcan) bridged to vcan0. The
+image starts at once (nobody on its serial line) and is a node on vcan0;
+its serial line answers the input language and carries no frames; an
+interface that is down is refused. Then a mixed bus: the image, two
+canopen-sensor processes and the master on one vcan0, every node's
+heartbeats and event-timer TPDOs each on time, none missing, none doubled.
+
+The runs that need no CAN interface (--can on the micro:bit, a missing or
+non-CAN interface) are in test_emu.py, on the host."""
+import socket
+import statistics
+import struct
+import subprocess
+import sys
+import time
+
+import can
+import pytest
+
+from conftest import IFACE, Sensor
+from facts import PRODUCTS
+from targets import EMU, CanEmuTarget, Frames, Master, free_port
+
+IMAGE = "jd1xxx"  # node 10; the mixed bus adds the Linux program's
+OTHERS = ("gsh-a", "dst-x730-xy30")  # nodes 0x13 and 0x7F
+
+
+@pytest.fixture(autouse=True)
+def vcan():
+    if not (subprocess.run(["ip", "link", "show", IFACE], capture_output=True).returncode == 0):
+        pytest.fail(f"{IFACE} is not up: run these tests through tools/vcan-run")
+
+
+def emu_can(port, iface=IFACE, flash=None):
+    """tools/emu --can (by this interpreter: see CanEmuTarget._command)."""
+    cmd = [sys.executable, str(EMU), "--board", "rv32-virt", "--product", IMAGE,
+           "--port", str(port), "--can", iface]
+    if flash is not None:
+        cmd += ["--flash", str(flash)]
+    return subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            start_new_session=True)
+
+
+def read_line_until(proc, prefix, timeout):
+    """tools/emu's standard error up to a line that starts with prefix."""
+    end = time.monotonic() + timeout
+    seen = []
+    while time.monotonic() < end:
+        line = proc.stderr.readline().decode()
+        if not line:
+            break
+        seen.append(line)
+        if line.startswith(prefix):
+            return seen
+    pytest.fail(f"no line {prefix!r} from tools/emu: {''.join(seen)}")
+
+
+def test_boots_onto_the_bus_with_nobody_on_its_serial_line(tmp_path):
+    """The boot-up comes on vcan0 with nobody connected to the serial line
+    (wait=off), the node answers SDO there; then the serial line answers
+    an input line and carries no frame though the node sends heartbeats.
+    Three starts: the time from tools/emu's start to the boot-up is
+    printed (a figure of README)."""
+    node = PRODUCTS[IMAGE].nodes[0]
+    bus = can.Bus(interface="socketcan", channel=IFACE)
+    times = []
+    try:
+        for _ in range(3):
+            port = free_port()
+            t0 = time.monotonic()
+            proc = emu_can(port, flash=tmp_path / "flash.bin")
+            try:
+                boot = None
+                end = t0 + 30
+                while boot is None and time.monotonic() < end:
+                    m = bus.recv(0.5)
+                    if m is not None and m.arbitration_id == 0x700 + node:
+                        boot = m
+                    assert proc.poll() is None, proc.stderr.read().decode()
+                assert boot is not None and bytes(boot.data) == b"\0", \
+                    f"no boot-up of node {node:#x} on {IFACE} within 30 s"
+                times.append(time.monotonic() - t0)
+                # The ready line came before (a whole line; the image runs).
+                read_line_until(proc, "emu: ready: ", 5)
+                bus.send(can.Message(arbitration_id=0x600 + node, is_extended_id=False,
+                                     data=bytes.fromhex("4000100000000000")))
+                end = time.monotonic() + 2
+                answer = None
+                while answer is None and time.monotonic() < end:
+                    m = bus.recv(0.5)
+                    if m is not None and m.arbitration_id == 0x580 + node:
+                        answer = m
+                assert answer is not None and answer.data[0] == 0x43, f"SDO answer {answer}"
+                assert struct.unpack_from("<I", answer.data, 4)[0] == PRODUCTS[IMAGE].device_type
+                # Heartbeats every 20 ms: none of them on the serial line.
+                bus.send(can.Message(arbitration_id=0x600 + node, is_extended_id=False,
+                                     data=bytes.fromhex("2B17100014000000")))
+                with socket.create_connection(("127.0.0.1", port), timeout=5) as s:
+                    s.sendall(b"get\r")
+                    got = b""
+                    end = time.monotonic() + 1.0
+                    while time.monotonic() < end:
+                        s.settimeout(max(0.01, end - time.monotonic()))
+                        try:
+                            chunk = s.recv(4096)
+                        except socket.timeout:
+                            break
+                        if not chunk:
+                            break
+                        got += chunk
+                lines = [l for l in got.decode(errors="replace").split("\r") if l.strip()]
+                assert lines and lines[0].startswith("ok "), lines
+                assert len(lines) == 1, f"more than the answer on the serial line: {lines}"
+                beats = []
+                end = time.monotonic() + 0.3
+                while time.monotonic() < end:
+                    m = bus.recv(0.05)
+                    if m is not None and m.arbitration_id == 0x700 + node:
+                        beats.append(m)
+                assert beats, "no heartbeat on vcan0 after 1017h := 20 ms"
+            finally:
+                proc.terminate()
+                rc = proc.wait(timeout=15)
+            assert rc == 0
+    finally:
+        bus.shutdown()
+        (tmp_path / "flash.bin").unlink(missing_ok=True)
+    print(f"tools/emu --can: start to boot-up {', '.join(f'{t:.2f}' for t in times)} s, "
+          f"median {statistics.median(times):.2f} s")
+
+
+def test_refuses_an_interface_that_is_down():
+    """vcan1 taken down: a usage error that says so (exit 2), QEMU never
+    started; up again, accepted."""
+    subprocess.run(["ip", "link", "set", "vcan1", "down"], check=True)
+    try:
+        r = subprocess.run([sys.executable, str(EMU), "--board", "rv32-virt", "--product", IMAGE,
+                            "--port", str(free_port()), "--can", "vcan1"],
+                           capture_output=True, text=True, timeout=60)
+    finally:
+        subprocess.run(["ip", "link", "set", "vcan1", "up"], check=True)
+    assert r.returncode == 2, r.stderr
+    assert "vcan1: the interface is down (ip link set vcan1 up)" in r.stderr
+    proc = emu_can(free_port(), iface="vcan1")
+    try:
+        read_line_until(proc, "emu: ready: ", 30)
+    finally:
+        proc.terminate()
+        assert proc.wait(timeout=15) == 0
+
+
+# The mixed bus's periods and window: every node's heartbeat and TPDO1
+# counted over WINDOW_S. Timing inside User-Mode Linux: see the asserts.
+MIX_HB_MS, MIX_EVENT_MS, MIX_WINDOW_S = 100, 50, 3.0
+
+
+def streams(frames, cob_ids):
+    """Arrival times of each CAN-ID's frames (remote frames left out)."""
+    got = {c: [] for c in cob_ids}
+    for t, m in frames:
+        if m.arbitration_id in got and not m.is_remote_frame:
+            got[m.arbitration_id].append((t, bytes(m.data)))
+    return got
+
+
+def test_mixed_bus(tmp_path):
+    """The image, two canopen-sensor processes and the master on vcan0:
+    every boot-up seen, every node answers SDO, and over a window each
+    node's heartbeats (100 ms) and event-timer TPDO1s (50 ms) come at
+    their period, as many as the window holds, none missing (no gap of
+    1.5 periods) and none doubled (no two within half a period)."""
+    image_dir, a_dir, b_dir = (tmp_path / d for d in ("image", "a", "b"))
+    for d in (image_dir, a_dir, b_dir):
+        d.mkdir()
+    master = Master(CanEmuTarget(IMAGE, image_dir))
+    sensors = [Sensor(p, d) for p, d in zip(OTHERS, (a_dir, b_dir))]
+    try:
+        master.power_on(PRODUCTS[IMAGE].nodes)
+        for s in sensors:
+            master.frames.clear()
+            s.start()
+            for n in PRODUCTS[s.product].nodes:
+                m = master.frames.wait_for(0x700 + n, timeout=3, pred=lambda m: bytes(m.data) == b"\0")
+                assert m is not None, f"{s.product}: no boot-up of node {n:#x}"
+        facts = {n: PRODUCTS[p] for p in (IMAGE,) + OTHERS for n in PRODUCTS[p].nodes}
+        assert len(facts) == 3
+        for n, f in facts.items():
+            sdo = master.node(n).sdo
+            assert bytes(sdo.upload(0x1000, 0)) == struct.pack("<I", f.device_type), f"node {n:#x}"
+            master.send(0x000, bytes([0x80, n]))  # pre-operational: the event mode's writes
+            for index, sub, data in f.event_mode:
+                sdo.download(index, sub, data)
+            sdo.download(0x1800, 5, struct.pack("<H", MIX_EVENT_MS))
+            sdo.download(0x1017, 0, struct.pack("<H", MIX_HB_MS))
+        master.send(0x000, bytes([0x01, 0]))  # all operational
+        time.sleep(0.5)
+        master.frames.clear()
+        got = list(master.frames.stream(MIX_WINDOW_S))
+        wrong = []
+        for n, f in facts.items():
+            for what, cob, ms in (("heartbeat", 0x700 + n, MIX_HB_MS),
+                                  ("TPDO1", f.tpdo_cob.of(n), MIX_EVENT_MS)):
+                times = [t for t, _ in streams(got, [cob])[cob]]
+                want = MIX_WINDOW_S * 1000 / ms
+                gaps = [(b - a) * 1000 for a, b in zip(times, times[1:])]
+                if not want - 1 <= len(times) <= want + 1:
+                    wrong.append(f"node {n:#x} {what}: {len(times)} in {MIX_WINDOW_S} s, "
+                                 f"want {want:.0f}")
+                elif min(gaps) < ms / 2 or max(gaps) > ms * 1.5:
+                    wrong.append(f"node {n:#x} {what}: gaps {min(gaps):.1f}..{max(gaps):.1f} ms "
+                                 f"at {ms} ms")
+                print(f"node {n:#x} {what}: {len(times)} frames, gaps "
+                      f"{min(gaps):.1f}..{max(gaps):.1f} ms, mean {statistics.mean(gaps):.1f} ms")
+        assert not wrong, "; ".join(wrong)
+    finally:
+        for s in sensors:
+            s.stop()
+        master.close()
