@@ -15,7 +15,9 @@ import fcntl
 import os
 import pathlib
 import random
+import re
 import select
+import shutil
 import signal
 import socket
 import struct
@@ -463,6 +465,47 @@ def test_ready_is_a_line_of_its_own(tmp_path):
     assert "from its standard output" in lines
     assert "a last line without its end" in lines
     assert lines[-1].startswith("emu: QEMU ended by itself")
+
+
+def test_stale_temporary_directories_of_this_kernel_only(tmp_path):
+    """A killed emulator's temporary directory is removed by the next one;
+    one named for another kernel's process numbers (another User-Mode
+    Linux sharing /tmp, whose emulator may be running) stays, though no
+    process here has its PID. A stand-in for QEMU prints its arguments: the
+    -qmp socket's directory names this kernel's."""
+    fake = tmp_path / "qemu-system-riscv32"
+    fake.write_text("#!/usr/bin/env python3\nimport sys\nprint(' '.join(sys.argv), flush=True)\n")
+    fake.chmod(0o755)
+    image = tmp_path / "image.elf"
+    image.write_bytes(b"")
+    # A short temporary directory of its own: the QMP socket's path in it
+    # must fit a unix socket's 108 bytes.
+    tmp = pathlib.Path(tempfile.mkdtemp(prefix="stale-"))
+    env = dict(os.environ, PATH=f"{tmp_path}:{os.environ['PATH']}", TMPDIR=str(tmp))
+
+    def run():
+        r = subprocess.run([EMU, "--board", "rv32-virt", "--product", PRODUCT, "--port",
+                            str(free_port()), "--image", str(image)], capture_output=True,
+                           text=True, timeout=30, env=env)
+        qmp = next(w for w in r.stderr.split() if w.startswith("unix:"))
+        return pathlib.Path(qmp[len("unix:"):]).parent.name
+
+    name = run()
+    m = re.fullmatch(r"emu-(\d+)-k([0-9a-f]+)-\w+", name)
+    assert m, name
+    dead = subprocess.Popen(["true"])
+    dead.wait()  # its PID is no process now
+    other = "f" + m[2][1:] if m[2][0] != "f" else "0" + m[2][1:]
+    ours = tmp / f"emu-{dead.pid}-k{m[2]}-killed"
+    theirs = tmp / f"emu-{dead.pid}-k{other}-running"
+    ours.mkdir()
+    theirs.mkdir()
+    try:
+        run()
+        assert not ours.exists(), "a killed emulator's directory left behind"
+        assert theirs.exists(), "another kernel's emulator's directory removed"
+    finally:
+        shutil.rmtree(tmp)
 
 
 def test_ends_with_its_parent(tmp_path):
