@@ -1,9 +1,11 @@
-"""One suite, three targets: the same master checks against the Linux
-program on vcan and against the bare-metal images in qemu (rv32-virt,
-microbit) over their SLCAN serial line.
+"""One suite, four targets: the same master checks against the Linux
+program on vcan, against the bare-metal images in qemu (rv32-virt,
+microbit) over their SLCAN serial line, and against the rv32-virt image
+on vcan through its SJA1000 (rv32-can).
 
     tools/vcan-run build/venv/bin/python -m pytest tests/integration/test_targets.py
     build/venv/bin/python -m pytest tests/integration/test_targets.py --target rv32-virt
+    tools/vcan-run build/venv/bin/python -m pytest tests/integration/test_targets.py --target rv32-can
     ... --products all | --products gsh-a,jd1xxx
 
 Every check runs once per product (--products, default the CI set of
