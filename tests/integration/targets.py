@@ -385,7 +385,7 @@ class CanEmuTarget(EmuTarget):
     # Every other answer came within 1.4 ms (median) to 22 ms.
     RESPONSE_TIMEOUT = 2.0
     # From tools/emu's start to its "emu: ready" line: inside User-Mode
-    # Linux the interpreter's start alone takes 1-4 s (hostfs).
+    # Linux 1.2-1.6 s, 2.3-3 s with a new flash file (32 MiB written).
     READY_TIMEOUT = 30.0
 
     def __init__(self, product, tmp_path):

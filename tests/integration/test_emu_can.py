@@ -23,7 +23,7 @@ from facts import PRODUCTS
 from targets import EMU, CanEmuTarget, Frames, Master, free_port
 
 IMAGE = "jd1xxx"  # node 10; the mixed bus adds the Linux program's
-OTHERS = ("gsh-a", "dst-x730-xy30")  # nodes 0x13 and 0x7F
+OTHERS = ("dst-x730-xy30", "inx360d")  # nodes 0x7F and 1: SYNC types, as the JD
 
 
 @pytest.fixture(autouse=True)
@@ -68,18 +68,21 @@ def test_boots_onto_the_bus_with_nobody_on_its_serial_line(tmp_path):
     try:
         for _ in range(3):
             port = free_port()
+            while bus.recv(0) is not None:
+                pass  # the last run's heartbeats
             t0 = time.monotonic()
             proc = emu_can(port, flash=tmp_path / "flash.bin")
             try:
-                boot = None
+                first = None  # the node's first frame
                 end = t0 + 30
-                while boot is None and time.monotonic() < end:
+                while first is None and time.monotonic() < end:
                     m = bus.recv(0.5)
-                    if m is not None and m.arbitration_id == 0x700 + node:
-                        boot = m
+                    if m is not None and m.arbitration_id & 0x7F == node:
+                        first = m
                     assert proc.poll() is None, proc.stderr.read().decode()
-                assert boot is not None and bytes(boot.data) == b"\0", \
-                    f"no boot-up of node {node:#x} on {IFACE} within 30 s"
+                assert first is not None, f"nothing from node {node:#x} on {IFACE} within 30 s"
+                assert first.arbitration_id == 0x700 + node and bytes(first.data) == b"\0", \
+                    f"the first frame of node {node:#x} is no boot-up: {first}"
                 times.append(time.monotonic() - t0)
                 # The ready line came before (a whole line; the image runs).
                 read_line_until(proc, "emu: ready: ", 5)
@@ -150,26 +153,25 @@ def test_refuses_an_interface_that_is_down():
         assert proc.wait(timeout=15) == 0
 
 
-# The mixed bus's periods and window: every node's heartbeat and TPDO1
-# counted over WINDOW_S. Timing inside User-Mode Linux: see the asserts.
-MIX_HB_MS, MIX_EVENT_MS, MIX_WINDOW_S = 100, 50, 3.0
-
-
-def streams(frames, cob_ids):
-    """Arrival times of each CAN-ID's frames (remote frames left out)."""
-    got = {c: [] for c in cob_ids}
-    for t, m in frames:
-        if m.arbitration_id in got and not m.is_remote_frame:
-            got[m.arbitration_id].append((t, bytes(m.data)))
-    return got
+# The mixed bus: every node's heartbeat counted over MIX_WINDOW_S (one more
+# or less at the window's ends, the mean period to a fifth, as the one
+# suite's check), and its TPDO1 by SYNC counted exactly. Measured here
+# inside User-Mode Linux, with the machine busy (load 6 on 2 cores): single
+# frames 30-45 ms late at a 50 ms period, so gaps between frames tell a
+# late frame from a missing or doubled one only on a quiet machine; a
+# TPDO per SYNC does at any load: one lost or doubled SYNC or TPDO changes
+# the count.
+MIX_HB_MS, MIX_WINDOW_S = 100, 3.0
+MIX_SYNCS, MIX_SYNC_GAP_S = 40, 0.025
 
 
 def test_mixed_bus(tmp_path):
     """The image, two canopen-sensor processes and the master on vcan0:
-    every boot-up seen, every node answers SDO, and over a window each
-    node's heartbeats (100 ms) and event-timer TPDO1s (50 ms) come at
-    their period, as many as the window holds, none missing (no gap of
-    1.5 periods) and none doubled (no two within half a period)."""
+    every boot-up seen, every node answers SDO, each node's heartbeats
+    come at their period, and MIX_SYNCS SYNCs make exactly MIX_SYNCS /
+    its SYNC type TPDO1s of every node: no SYNC lost or doubled on its way
+    to a node (the image's through QEMU's bridge and its controller), no
+    TPDO lost or doubled on its way to the master."""
     image_dir, a_dir, b_dir = (tmp_path / d for d in ("image", "a", "b"))
     for d in (image_dir, a_dir, b_dir):
         d.mkdir()
@@ -184,34 +186,41 @@ def test_mixed_bus(tmp_path):
                 m = master.frames.wait_for(0x700 + n, timeout=3, pred=lambda m: bytes(m.data) == b"\0")
                 assert m is not None, f"{s.product}: no boot-up of node {n:#x}"
         facts = {n: PRODUCTS[p] for p in (IMAGE,) + OTHERS for n in PRODUCTS[p].nodes}
-        assert len(facts) == 3
+        assert len(facts) == 3 and all(f.sync_type for f in facts.values())
         for n, f in facts.items():
             sdo = master.node(n).sdo
             assert bytes(sdo.upload(0x1000, 0)) == struct.pack("<I", f.device_type), f"node {n:#x}"
-            master.send(0x000, bytes([0x80, n]))  # pre-operational: the event mode's writes
-            for index, sub, data in f.event_mode:
-                sdo.download(index, sub, data)
-            sdo.download(0x1800, 5, struct.pack("<H", MIX_EVENT_MS))
+            sdo.download(0x1800, 2, bytes([f.sync_type]))
             sdo.download(0x1017, 0, struct.pack("<H", MIX_HB_MS))
         master.send(0x000, bytes([0x01, 0]))  # all operational
-        time.sleep(0.5)
+        time.sleep(0.3)
         master.frames.clear()
         got = list(master.frames.stream(MIX_WINDOW_S))
         wrong = []
+        for n in facts:
+            times = [t for t, m in got if m.arbitration_id == 0x700 + n]
+            want = MIX_WINDOW_S * 1000 / MIX_HB_MS
+            mean = (times[-1] - times[0]) / (len(times) - 1) * 1000 if len(times) > 1 else 0
+            print(f"node {n:#x}: {len(times)} heartbeats in {MIX_WINDOW_S} s, mean {mean:.1f} ms")
+            if not want - 1 <= len(times) <= want + 1 or abs(mean - MIX_HB_MS) > MIX_HB_MS / 5:
+                wrong.append(f"node {n:#x}: {len(times)} heartbeats in {MIX_WINDOW_S} s "
+                             f"at {MIX_HB_MS} ms, mean period {mean:.1f} ms")
+        cobs = {f.tpdo_cob.of(n) for n, f in facts.items()}
+        early = sorted({m.arbitration_id for _, m in got if m.arbitration_id in cobs})
+        if early:
+            wrong.append(f"TPDO1 without SYNC on {', '.join(f'{c:03X}h' for c in early)}")
+        master.frames.clear()
+        for _ in range(MIX_SYNCS):
+            master.send(0x080)
+            time.sleep(MIX_SYNC_GAP_S)
+        got = list(master.frames.stream(0.5))
         for n, f in facts.items():
-            for what, cob, ms in (("heartbeat", 0x700 + n, MIX_HB_MS),
-                                  ("TPDO1", f.tpdo_cob.of(n), MIX_EVENT_MS)):
-                times = [t for t, _ in streams(got, [cob])[cob]]
-                want = MIX_WINDOW_S * 1000 / ms
-                gaps = [(b - a) * 1000 for a, b in zip(times, times[1:])]
-                if not want - 1 <= len(times) <= want + 1:
-                    wrong.append(f"node {n:#x} {what}: {len(times)} in {MIX_WINDOW_S} s, "
-                                 f"want {want:.0f}")
-                elif min(gaps) < ms / 2 or max(gaps) > ms * 1.5:
-                    wrong.append(f"node {n:#x} {what}: gaps {min(gaps):.1f}..{max(gaps):.1f} ms "
-                                 f"at {ms} ms")
-                print(f"node {n:#x} {what}: {len(times)} frames, gaps "
-                      f"{min(gaps):.1f}..{max(gaps):.1f} ms, mean {statistics.mean(gaps):.1f} ms")
+            count = sum(1 for _, m in got if m.arbitration_id == f.tpdo_cob.of(n)
+                        and not m.is_remote_frame)
+            print(f"node {n:#x}: {count} TPDO1s for {MIX_SYNCS} SYNCs, type {f.sync_type}")
+            if count != MIX_SYNCS // f.sync_type:
+                wrong.append(f"node {n:#x}: {count} TPDO1s for {MIX_SYNCS} SYNCs, "
+                             f"want {MIX_SYNCS // f.sync_type}")
         assert not wrong, "; ".join(wrong)
     finally:
         for s in sensors:
