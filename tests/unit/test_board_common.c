@@ -71,6 +71,7 @@ static void test_libc_min(void)
 /* ---- mcu_main.c on a fake board ------------------------------------------- */
 
 #define main mcu_main_any
+#define BOARD_RX_FILTER /* as rv32-virt builds it: the receive lists to board_can_filter */
 #define PRODUCT_SYM dst_x730_xy30
 #define PRODUCT_HEADER "dst.h"
 #define PRODUCT_INST_SIZE sizeof(dst_dev_t)
@@ -106,6 +107,10 @@ static struct board {
     bool green_seen[2]; /* green off / on seen */
     unsigned red_limit; /* leave after this many red-only calls (0: never) */
     unsigned serial_calls; /* board_serial() calls */
+    co_rx_id_t filter[2u * CO_NODE_RX_IDS_MAX]; /* the last board_can_filter() list */
+    unsigned nfilter;
+    unsigned filter_calls;
+    unsigned sleeps_at_filter; /* board_sleep() calls before the last board_can_filter() */
 } bd;
 
 static void board_reset(bool init_ok, bool bitrate_ok, uint32_t run_us)
@@ -196,6 +201,24 @@ void board_sleep(uint32_t us)
     }
 }
 
+void board_can_filter(const co_rx_id_t *ids, unsigned n)
+{
+    bd.filter_calls++;
+    bd.sleeps_at_filter = bd.sleeps;
+    bd.nfilter = n <= 2u * CO_NODE_RX_IDS_MAX ? n : 0u;
+    memcpy(bd.filter, ids, bd.nfilter * sizeof ids[0]);
+}
+
+static bool in_filter(uint16_t id, bool rtr)
+{
+    for (unsigned k = 0; k < bd.nfilter; k++) {
+        if (bd.filter[k].id == id && bd.filter[k].rtr == rtr) {
+            return true;
+        }
+    }
+    return false;
+}
+
 bool co_port_can_send(void *port, const co_frame_t *frame)
 {
     (void)port;
@@ -274,6 +297,22 @@ static void test_main_loop_runs_the_product(void)
     CHECK(bd.green_seen[0] && bd.green_seen[1]);
     CHECK_EQ(bd.red_only, 0);
     CHECK_EQ(sent_on(0x1FF, 0, start), 0); /* no PDO before NMT start */
+}
+
+/* A board that filters (BOARD_RX_FILTER) gets the node's receive list after
+ * every pass of the loop, before it sleeps: the DST X730 at node 0x7F
+ * consumes NMT, SYNC and its SDO request, nothing else. */
+static void test_main_loop_receive_list(void)
+{
+    board_reset(true, true, 100000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_any();
+    }
+    CHECK(bd.filter_calls >= bd.sleeps && bd.filter_calls > 0u);
+    CHECK_EQ(bd.sleeps_at_filter + 1u, bd.sleeps); /* the last pass's list came before its sleep */
+    CHECK_EQ(bd.nfilter, 3);
+    CHECK(in_filter(0x000, false) && in_filter(0x080, false) && in_filter(0x67F, false));
 }
 
 /* The node answers 1018h:04 with the board's serial number (the LSS
@@ -399,6 +438,7 @@ int main(void)
     RUN(test_main_loop_runs_the_product);
     RUN(test_main_loop_nmt_start);
     RUN(test_main_loop_serial_from_board);
+    RUN(test_main_loop_receive_list);
     RUN(test_uid_serial);
     RUN(test_main_loop_bitrate_refused);
     RUN(test_port_bitrate_default);
