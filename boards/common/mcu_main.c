@@ -110,6 +110,12 @@ int main(void)
                 co_node_poll(nodes[i], now); /* what the frame left to do, before the next one */
             }
         }
+#ifdef BOARD_RX_FILTER
+        /* Before the board sends what the frames just received produced
+         * (board_can_state): a boot-up under a new node-ID leaves with the
+         * filter passing its SDO requests. */
+        rx_filter(nodes, p->nodes);
+#endif
         for (unsigned i = 0; i < p->nodes; i++) {
             co_node_set_can_state(nodes[i], (co_can_state_t)board_can_state());
             wait = co_min_u32(wait, co_node_poll(nodes[i], now));

@@ -191,6 +191,7 @@ static bool listed(const sja1000_t *c, uint16_t id, bool rtr)
 /* ---- modes ------------------------------------------------------------- */
 
 static void tx_released(sja1000_t *c, uint8_t sr);
+static void kick(sja1000_t *c);
 
 /* Reset mode, write what reset mode guards, back to operating mode. A
  * frame cut short in the transmit buffer is written again by kick(). */
@@ -313,6 +314,7 @@ void sja1000_set_filter(sja1000_t *c, const co_rx_id_t *ids, unsigned n)
         c->filter_pending = true;
     }
     apply_filter(c);
+    kick(c);
 }
 
 /* ---- transmit ---------------------------------------------------------- */
@@ -355,7 +357,6 @@ bool sja1000_send(sja1000_t *c, const co_frame_t *f)
     }
     c->txq[(c->tx_head + c->tx_len) % SJA1000_TXQ_LEN] = *f;
     c->tx_len++;
-    kick(c);
     return true;
 }
 

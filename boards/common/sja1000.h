@@ -168,12 +168,18 @@ bool sja1000_set_bitrate(sja1000_t *c, uint16_t kbps);
  * later sja1000_service), and only a frame arriving during the change
  * itself is lost; the software check takes the new list at once. More
  * than SJA1000_IDS_MAX distinct IDs: the hardware filter is opened and
- * nothing is dropped.
+ * nothing is dropped. Then moves the next queued frame into a free
+ * transmit buffer, as sja1000_service does.
  */
 void sja1000_set_filter(sja1000_t *c, const co_rx_id_t *ids, unsigned n);
 
-/* Queues f for sending (in order behind the frames queued before).
- * False when the queue is full or the controller is bus-off: f is not sent. */
+/* Queues f for sending (in order behind the frames queued before); it goes
+ * into the transmit buffer at the next sja1000_service or
+ * sja1000_set_filter, not here: a board that filters changes its filter
+ * before what the same main-loop pass produced leaves (a node's boot-up
+ * under a new node-ID goes out with the filter already passing the new
+ * SDO request, which a master sends at once). False when the queue is
+ * full or the controller is bus-off: f is not sent. */
 bool sja1000_send(sja1000_t *c, const co_frame_t *f);
 
 /*
