@@ -714,6 +714,59 @@ static void test_emcy_table_and_history(void)
     EXPECT(d, 0xA0, "34 12 00 00 00 00 00 00");
 }
 
+/* The error table cleared out of order, and the history kept within its
+ * CO_EMCY_HIST_MAX entries however many errors come (tools/mutate's
+ * survivors: find() answering index 0, the history's bounds). */
+static void test_emcy_clear_order_and_history_bound(void)
+{
+    boot();
+    h_drain(d);
+    CHECK(co_emcy_error(d->node, 0x4210, CO_ER_TEMPERATURE, true, NULL));
+    CHECK(co_emcy_error(d->node, 0x2310, CO_ER_CURRENT, true, NULL));
+    h_drain(d);
+    CHECK(!co_emcy_error(d->node, 0x2310, CO_ER_CURRENT, true, NULL)); /* active already */
+    CHECK(!co_emcy_error(d->node, 0x6000, 0, false, NULL)); /* never active: nothing to clear */
+    /* The second entry cleared first: the first one's bit stays. */
+    CHECK(co_emcy_error(d->node, 0x2310, 0, false, NULL));
+    CHECK(co_emcy_active(d->node, 0x4210));
+    CHECK(!co_emcy_active(d->node, 0x2310));
+    CHECK_EQ(h_read(d, 0x1001, 0), CO_ER_GENERIC | CO_ER_TEMPERATURE);
+    EXPECT_NONE(d);
+    CHECK(co_emcy_error(d->node, 0x4210, 0, false, NULL));
+    EXPECT(d, 0x90, "00 00 00 00 00 00 00 00");
+
+    /* More errors than the history holds: the newest CO_EMCY_HIST_MAX,
+     * newest first, and nothing written past the history (the guarding
+     * state behind it in the node stays as it was). */
+    SDO(d, "2F 03 10 00 00 00 00 00", "60 03 10 00 00 00 00 00");
+    co_guard_t guard = d->node->guard;
+    unsigned n = CO_EMCY_HIST_MAX + 3u;
+    for (unsigned i = 0; i < n; i++) {
+        CHECK(co_emcy_send(d->node, (uint16_t)(0x1000u + i), 0, NULL));
+    }
+    h_drain(d);
+    CHECK_EQ(d->node->emcy.nhist, CO_EMCY_HIST_MAX);
+    for (unsigned k = 0; k < CO_EMCY_HIST_MAX; k++) {
+        CHECK_EQ(d->node->emcy.hist[k], 0x1000u + n - 1u - k);
+    }
+    CHECK(memcmp(&guard, &d->node->guard, sizeof(guard)) == 0);
+    CHECK_EQ(h_read(d, 0x1003, 0), 2); /* as deep as the dictionary */
+    CHECK_EQ(h_read(d, 0x1003, 2), 0x1000u + n - 2u);
+}
+
+/* The EMCY COB-ID's CAN-ID may not change while valid, odd CAN-IDs too
+ * (only bit 31 says valid). */
+static void test_emcy_cobid_odd_id(void)
+{
+    boot();
+    SDO(d, "23 14 10 00 91 00 00 00", "80 14 10 00 30 00 09 06"); /* valid: no change */
+    SDO(d, "23 14 10 00 91 00 00 80", "60 14 10 00 00 00 00 00");
+    SDO(d, "23 14 10 00 91 00 00 00", "60 14 10 00 00 00 00 00"); /* 0x91, valid */
+    SDO(d, "23 14 10 00 A1 00 00 00", "80 14 10 00 30 00 09 06"); /* odd to odd: refused */
+    SDO(d, "23 14 10 00 A0 00 00 00", "80 14 10 00 30 00 09 06"); /* odd to even: refused */
+    CHECK_EQ(h_read(d, 0x1014, 0), 0x91);
+}
+
 static void test_tpdo_rtr_and_types(void)
 {
     boot();
@@ -1082,6 +1135,8 @@ int main(void)
     RUN(test_two_nodes_one_process);
     RUN(test_node_guarding);
     RUN(test_emcy_table_and_history);
+    RUN(test_emcy_clear_order_and_history_bound);
+    RUN(test_emcy_cobid_odd_id);
     RUN(test_tpdo_rtr_and_types);
     RUN(test_tpdo_events_and_inhibit);
     RUN(test_tpdo_cobid_and_mapping_rules);
