@@ -96,6 +96,15 @@ static void test_incl_limit_edges(void)
         CHECK_EQ(co_incl_slope(&in, 1), cases[i].out);
         CHECK_EQ(co_incl_beyond(&in), cases[i].beyond);
     }
+    /* Any limit but 0 (none) is one, the smallest too. */
+    co_incl_t in;
+    co_incl_init(&in, &p, 2, 1, false);
+    int32_t a[2] = {5, -5};
+    co_incl_sample(&in, a);
+    CHECK(co_incl_beyond(&in));
+    CHECK(in.beyond[0] && in.beyond[1]);
+    CHECK_EQ(in.angle[0], 1);
+    CHECK_EQ(in.angle[1], -1);
 }
 
 static void test_incl_arithmetic(void)
