@@ -767,6 +767,44 @@ static void test_emcy_cobid_odd_id(void)
     CHECK_EQ(h_read(d, 0x1014, 0), 0x91);
 }
 
+/* The TPDO loops (start, stop, SYNC, RTR, poll) stay within the TPDO
+ * table: the active EMCY errors, kept right behind it in the node, are
+ * intact through every NMT change (tools/mutate's survivors: the loops
+ * running to n <= CO_TPDO_MAX). */
+static void codes_intact(void)
+{
+    CHECK(co_emcy_active(d->node, 0x2222));
+    CHECK(co_emcy_active(d->node, 0x3333));
+    CHECK(co_emcy_active(d->node, 0x5555));
+    CHECK_EQ(d->node->emcy.nactive, 3);
+    CHECK_EQ(co_emcy_register(d->node), CO_ER_GENERIC | CO_ER_CURRENT | CO_ER_TEMPERATURE);
+}
+
+static void test_tpdo_loops_stay_in_the_table(void)
+{
+    boot();
+    CHECK(co_emcy_error(d->node, 0x2222, CO_ER_CURRENT, true, NULL));
+    CHECK(co_emcy_error(d->node, 0x3333, CO_ER_TEMPERATURE, true, NULL));
+    CHECK(co_emcy_error(d->node, 0x5555, 0, true, NULL));
+    h_drain(d);
+    codes_intact();
+    for (unsigned k = 0; k < 2u; k++) {
+        h_rx(d, 0x000, "01 10"); /* start */
+        h_advance(d, 5000);
+        h_rx(d, 0x080, ""); /* SYNC */
+        co_frame_t rtr = {.id = 0x190, .rtr = true, .dlc = 0};
+        h_rx_frame(d, &rtr);
+        h_advance(d, 5000);
+        codes_intact();
+        h_rx(d, 0x000, "02 10"); /* stop */
+        codes_intact();
+        h_rx(d, 0x000, "80 10"); /* pre-operational */
+        h_advance(d, 5000);
+        codes_intact();
+        h_drain(d);
+    }
+}
+
 static void test_tpdo_rtr_and_types(void)
 {
     boot();
@@ -1137,6 +1175,7 @@ int main(void)
     RUN(test_emcy_table_and_history);
     RUN(test_emcy_clear_order_and_history_bound);
     RUN(test_emcy_cobid_odd_id);
+    RUN(test_tpdo_loops_stay_in_the_table);
     RUN(test_tpdo_rtr_and_types);
     RUN(test_tpdo_events_and_inhibit);
     RUN(test_tpdo_cobid_and_mapping_rules);
