@@ -444,6 +444,32 @@ static void test_heartbeat_timing(void)
     EXPECT_NONE(d);
 }
 
+/* A heartbeat polled late keeps its cadence: the next one is due a period
+ * after the last deadline, not after the late poll (tools/mutate's
+ * survivor: hb->next += period removed). The board's polls by hand. */
+static void test_heartbeat_late_poll_keeps_cadence(void)
+{
+    boot();
+    SDO(d, "2B 17 10 00 32 00 00 00", "60 17 10 00 00 00 00 00"); /* 50 ms */
+    uint32_t t0 = d->now;
+    h_drain(d);
+    CHECK_EQ(co_node_poll(d->node, t0 + 50300u), 49700); /* 300 us late: sent */
+    EXPECT(d, 0x710, "7F");
+    CHECK_EQ(co_node_poll(d->node, t0 + 100100u), 49900); /* the next deadline: t0 + 100 ms */
+    EXPECT(d, 0x710, "7F");
+    CHECK_EQ(co_node_poll(d->node, t0 + 160000u), 40000); /* 10 ms late: still t0 + 200 ms */
+    EXPECT(d, 0x710, "7F");
+    CHECK_EQ(co_node_poll(d->node, t0 + 199999u), 1);
+    EXPECT_NONE(d);
+    /* More than a period late: one heartbeat, the next a period after it
+     * (no burst to catch up). */
+    CHECK_EQ(co_node_poll(d->node, t0 + 260000u), 50000);
+    EXPECT(d, 0x710, "7F");
+    CHECK_EQ(co_node_poll(d->node, t0 + 309999u), 1);
+    EXPECT_NONE(d);
+    d->now = t0 + 309999u;
+}
+
 static unsigned count_id(h_dev_t *x, uint16_t id)
 {
     unsigned n = 0;
@@ -1176,6 +1202,7 @@ int main(void)
     RUN(test_emcy_clear_order_and_history_bound);
     RUN(test_emcy_cobid_odd_id);
     RUN(test_tpdo_loops_stay_in_the_table);
+    RUN(test_heartbeat_late_poll_keeps_cadence);
     RUN(test_tpdo_rtr_and_types);
     RUN(test_tpdo_events_and_inhibit);
     RUN(test_tpdo_cobid_and_mapping_rules);
