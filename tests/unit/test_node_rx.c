@@ -204,9 +204,20 @@ static void test_rx_ids_conditions(void)
     d->node->hbc.time_ms = 100;
     n = list(d->node, ids);
     CHECK(has(ids, n, 0x701, false));
+    d->node->hbc.time_ms = 1;
+    n = list(d->node, ids);
+    CHECK(has(ids, n, 0x701, false));
     d->node->hbc.time_ms = 0;
     n = list(d->node, ids);
     CHECK(!has(ids, n, 0x701, false));
+    /* A TPDO whose COB-ID forbids RTR (bit 30 set) is not listed for one. */
+    d->node->tpdo[0].valid = true;
+    d->node->tpdo[0].rtr_allowed = false;
+    n = list(d->node, ids);
+    CHECK(!has(ids, n, d->node->tpdo[0].cob_id, true));
+    d->node->tpdo[0].rtr_allowed = true;
+    n = list(d->node, ids);
+    CHECK(has(ids, n, d->node->tpdo[0].cob_id, true));
     /* A product without the RTR service (DST X730) lists no TPDO's RTR,
      * even with its COB-ID's bit 30 clear. */
     boot(&dst_x730_xy10);
