@@ -831,6 +831,63 @@ static void test_tpdo_loops_stay_in_the_table(void)
     }
 }
 
+/* Two event-driven TPDOs: each keeps its own timer through start, stop
+ * and start again (tools/mutate's survivors: a TPDO loop handling the
+ * first TPDO only). */
+static void test_tpdo_two_event_timers(void)
+{
+    boot();
+    SDO(d, "23 01 18 01 90 02 00 80", "60 01 18 01 00 00 00 00"); /* off to remap */
+    SDO(d, "2F 01 1A 00 00 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 1A 01 10 00 01 20", "60 01 1A 01 00 00 00 00"); /* 0x2001, 16 bits */
+    SDO(d, "2F 01 1A 00 01 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 18 01 90 02 00 00", "60 01 18 01 00 00 00 00");
+    SDO(d, "2F 01 18 02 FE 00 00 00", "60 01 18 02 00 00 00 00"); /* event-driven */
+    SDO(d, "2B 01 18 05 1E 00 00 00", "60 01 18 05 00 00 00 00"); /* 30 ms */
+    for (unsigned k = 0; k < 2u; k++) {
+        h_drain(d);
+        h_rx(d, 0x000, "01 10");
+        h_advance(d, 299999);
+        uint32_t n190 = 0, n290 = 0;
+        const co_frame_t *f;
+        while ((f = h_next(d)) != NULL) {
+            n190 += f->id == 0x190;
+            n290 += f->id == 0x290;
+        }
+        CHECK_EQ(n190, 3);  /* at the start, 100 and 200 ms */
+        CHECK_EQ(n290, 10); /* at the start and every 30 ms */
+        h_rx(d, 0x000, "02 10"); /* stop */
+        h_advance(d, 100000);
+        h_drain(d);
+    }
+}
+
+/* The event timer polled late keeps its cadence: the next send a period
+ * after the last deadline, not after the late poll; more than a period
+ * late, one send and the next a period after it (tools/mutate's
+ * survivors: the deadline from the poll's time). */
+static void test_tpdo_event_timer_cadence(void)
+{
+    boot();
+    h_drain(d);
+    uint32_t t0 = d->now;
+    h_rx(d, 0x000, "01 10"); /* TPDO1: event timer 100 ms, sent at the start */
+    CHECK_EQ(count_id(d, 0x190), 1);
+    co_node_poll(d->node, t0 + 100300u);
+    CHECK_EQ(count_id(d, 0x190), 1);
+    co_node_poll(d->node, t0 + 200100u);
+    CHECK_EQ(count_id(d, 0x190), 1); /* due at t0 + 200 ms, not 200.3 */
+    co_node_poll(d->node, t0 + 299999u);
+    CHECK_EQ(count_id(d, 0x190), 0);
+    co_node_poll(d->node, t0 + 450000u); /* 150 ms late */
+    CHECK_EQ(count_id(d, 0x190), 1);
+    co_node_poll(d->node, t0 + 549999u);
+    CHECK_EQ(count_id(d, 0x190), 0);
+    co_node_poll(d->node, t0 + 550000u);
+    CHECK_EQ(count_id(d, 0x190), 1);
+    d->now = t0 + 550000u;
+}
+
 static void test_tpdo_rtr_and_types(void)
 {
     boot();
@@ -1203,6 +1260,8 @@ int main(void)
     RUN(test_emcy_cobid_odd_id);
     RUN(test_tpdo_loops_stay_in_the_table);
     RUN(test_heartbeat_late_poll_keeps_cadence);
+    RUN(test_tpdo_two_event_timers);
+    RUN(test_tpdo_event_timer_cadence);
     RUN(test_tpdo_rtr_and_types);
     RUN(test_tpdo_events_and_inhibit);
     RUN(test_tpdo_cobid_and_mapping_rules);
