@@ -305,6 +305,40 @@ static void test_sdo_block_download(void)
     CHECK_EQ(h_read(d, 0x2001, 0), 7);
 }
 
+/* A block download's abort is its last word: nothing is written and
+ * nothing follows it (tools/mutate's survivors: the returns after the
+ * aborts of a wrong end command, a wrong length and an overflow). */
+static void test_sdo_block_download_abort_is_final(void)
+{
+    boot();
+    CHECK_EQ(h_read(d, 0x2000, 0), 100);
+    /* Size 4 announced, 2 bytes given (n = 5 of the last 7 unused). */
+    SDO(d, "C2 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    h_rx(d, 0x610, "81 F4 01 00 00 00 00 00");
+    SDO(d, "D5 00 00 00 00 00 00 00", "80 00 20 00 10 00 07 06");
+    EXPECT_NONE(d);
+    CHECK_EQ(h_read(d, 0x2000, 0), 100);
+    /* An end without its end bit: command unknown. */
+    SDO(d, "C2 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    h_rx(d, 0x610, "81 F4 01 00 00 00 00 00");
+    SDO(d, "C4 00 00 00 00 00 00 00", "80 00 20 00 01 00 04 05");
+    EXPECT_NONE(d);
+    CHECK_EQ(h_read(d, 0x2000, 0), 100);
+    /* More than the buffer: a full block of 10 segments (70 bytes) is
+     * acknowledged, the next segment aborts, even as the last one. */
+    SDO(d, "C0 00 20 00 00 00 00 00", "A4 00 20 00 0A 00 00 00");
+    h_drain(d);
+    for (unsigned k = 1; k <= 10u; k++) {
+        co_frame_t f = {.id = 0x610, .dlc = 8, .data = {(uint8_t)k, 1, 2, 3, 4, 5, 6, 7}};
+        h_rx_frame(d, &f);
+    }
+    EXPECT(d, 0x590, "A2 0A 0A 00 00 00 00 00");
+    h_rx(d, 0x610, "81 01 02 03 04 05 06 07");
+    EXPECT(d, 0x590, "80 00 20 00 12 00 07 06");
+    EXPECT_NONE(d);
+    CHECK_EQ(h_read(d, 0x2000, 0), 100);
+}
+
 static void test_sdo_block_upload(void)
 {
     boot();
@@ -1262,6 +1296,7 @@ int main(void)
     RUN(test_heartbeat_late_poll_keeps_cadence);
     RUN(test_tpdo_two_event_timers);
     RUN(test_tpdo_event_timer_cadence);
+    RUN(test_sdo_block_download_abort_is_final);
     RUN(test_tpdo_rtr_and_types);
     RUN(test_tpdo_events_and_inhibit);
     RUN(test_tpdo_cobid_and_mapping_rules);
