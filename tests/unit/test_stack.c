@@ -337,6 +337,15 @@ static void test_sdo_block_download_abort_is_final(void)
     EXPECT(d, 0x590, "80 00 20 00 12 00 07 06");
     EXPECT_NONE(d);
     CHECK_EQ(h_read(d, 0x2000, 0), 100);
+    /* The object refuses the value (above its 1000): its abort alone. */
+    SDO(d, "C2 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    h_rx(d, 0x610, "81 D0 07 00 00 00 00 00");
+    SDO(d, "CD 00 00 00 00 00 00 00", "80 00 20 00 31 00 09 06");
+    EXPECT_NONE(d);
+    CHECK_EQ(h_read(d, 0x2000, 0), 100);
+    /* A block upload of an object that does not exist: its abort alone. */
+    SDO(d, "A0 99 29 00 0A 00 00 00", "80 99 29 00 00 00 02 06");
+    EXPECT_NONE(d);
 }
 
 static void test_sdo_block_upload(void)
