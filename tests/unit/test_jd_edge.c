@@ -237,6 +237,35 @@ static void test_lss_store_edges(void)
     EXPECT_NONE(d); /* no boot-up */
 }
 
+/* LSS stores across power cycles: after several stores and a restart the
+ * next store is still the newest record (the write count read back at
+ * start covers the LSS class too; tools/mutate's survivor: the per-class
+ * loop of co_store_init stopping before the LSS class). */
+static void test_lss_stores_across_power_cycles(void)
+{
+    boot(&jd2xxx);
+    h_rx(d, 0x7E5, "04 01 00 00 00 00 00 00");
+    static const char *const ids[] = {"11 0B 00 00 00 00 00 00", "11 0C 00 00 00 00 00 00",
+                                      "11 0D 00 00 00 00 00 00"};
+    for (unsigned k = 0; k < 3u; k++) {
+        h_rx(d, 0x7E5, ids[k]);
+        h_drain(d);
+        h_rx(d, 0x7E5, "17 00 00 00 00 00 00 00");
+        EXPECT(d, 0x7E4, "17 00 00 00 00 00 00 00");
+    }
+    h_power_cycle(d);
+    EXPECT(d, 0x70D, "00");
+    h_rx(d, 0x7E5, "04 01 00 00 00 00 00 00");
+    h_rx(d, 0x7E5, "11 0E 00 00 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x7E5, "17 00 00 00 00 00 00 00");
+    EXPECT(d, 0x7E4, "17 00 00 00 00 00 00 00");
+    h_power_cycle(d);
+    EXPECT(d, 0x70E, "00");
+    h_power_cycle(d);
+    EXPECT(d, 0x70E, "00");
+}
+
 /* sin(deg) for 0..90 degrees without libm (the qemu builds link none):
  * its Taylor series to x^21, far below 1e-9 on a quarter turn. */
 static double sin_deg(int deg)
@@ -290,6 +319,7 @@ int main(void)
     RUN(test_jd1_moving_average_across_zero);
     RUN(test_leds);
     RUN(test_accel_sine_table);
+    RUN(test_lss_stores_across_power_cycles);
     RUN(test_lss_store_edges);
     return h_finish();
 }
