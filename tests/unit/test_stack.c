@@ -343,8 +343,15 @@ static void test_sdo_block_download_abort_is_final(void)
     SDO(d, "CD 00 00 00 00 00 00 00", "80 00 20 00 31 00 09 06");
     EXPECT_NONE(d);
     CHECK_EQ(h_read(d, 0x2000, 0), 100);
-    /* A block upload of an object that does not exist: its abort alone. */
+    /* A block upload of an object that does not exist, or of a write-only
+     * one: its abort alone. */
     SDO(d, "A0 99 29 00 0A 00 00 00", "80 99 29 00 00 00 02 06");
+    EXPECT_NONE(d);
+    SDO(d, "A0 10 10 01 0A 00 00 00", "80 10 10 01 01 00 01 06");
+    EXPECT_NONE(d);
+    /* A block upload answered with another command: one abort. */
+    SDO(d, "A0 00 20 00 0A 00 00 00", "C6 00 20 00 04 00 00 00");
+    SDO(d, "20 00 20 00 00 00 00 00", "80 00 20 00 01 00 04 05");
     EXPECT_NONE(d);
 }
 
