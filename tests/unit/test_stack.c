@@ -906,6 +906,10 @@ static void test_tpdo_two_event_timers(void)
         }
         CHECK_EQ(n190, 3);  /* at the start, 100 and 200 ms */
         CHECK_EQ(n290, 10); /* at the start and every 30 ms */
+        co_frame_t rtr = {.id = 0x290, .rtr = true, .dlc = 2};
+        h_rx_frame(d, &rtr); /* the second TPDO answers its RTR */
+        f = h_next(d);
+        CHECK(f != NULL && f->id == 0x290 && !f->rtr && f->dlc == 2);
         h_rx(d, 0x000, "02 10"); /* stop */
         h_advance(d, 100000);
         h_drain(d);
