@@ -238,9 +238,10 @@ static void test_lss_store_edges(void)
 }
 
 /* LSS stores across power cycles: after several stores and a restart the
- * next store is still the newest record (the write count read back at
- * start covers the LSS class too; tools/mutate's survivor: the per-class
- * loop of co_store_init stopping before the LSS class). */
+ * next store is still the newest record, and the write-cycle count (what a
+ * product's write limit is judged by) read back at start covers the LSS
+ * class too (tools/mutate's survivor: the per-class loop of co_store_init
+ * stopping before the LSS class). */
 static void test_lss_stores_across_power_cycles(void)
 {
     boot(&jd2xxx);
@@ -255,6 +256,7 @@ static void test_lss_stores_across_power_cycles(void)
     }
     h_power_cycle(d);
     EXPECT(d, 0x70D, "00");
+    CHECK_EQ(d->node->store.writes, 3); /* every save counted, LSS ones too */
     h_rx(d, 0x7E5, "04 01 00 00 00 00 00 00");
     h_rx(d, 0x7E5, "11 0E 00 00 00 00 00 00");
     h_drain(d);
@@ -264,6 +266,7 @@ static void test_lss_stores_across_power_cycles(void)
     EXPECT(d, 0x70E, "00");
     h_power_cycle(d);
     EXPECT(d, 0x70E, "00");
+    CHECK_EQ(d->node->store.writes, 4);
 }
 
 /* sin(deg) for 0..90 degrees without libm (the qemu builds link none):
