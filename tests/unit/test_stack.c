@@ -349,6 +349,24 @@ static void test_sdo_block_download_abort_is_final(void)
     EXPECT_NONE(d);
     SDO(d, "A0 10 10 01 0A 00 00 00", "80 10 10 01 01 00 01 06");
     EXPECT_NONE(d);
+    /* The client's next block size: 127 segments at most (CiA 301). */
+    for (unsigned blk = 127; blk <= 128u; blk++) {
+        SDO(d, "A0 00 20 00 0A 00 00 00", "C6 00 20 00 04 00 00 00");
+        h_rx(d, 0x610, "A3 00 00 00 00 00 00 00");
+        const co_frame_t *seg = h_next(d);
+        CHECK(seg != NULL && seg->data[0] == 0x81);
+        co_frame_t ack = {.id = 0x610, .dlc = 8, .data = {0xA2, 1, (uint8_t)blk}};
+        h_rx_frame(d, &ack);
+        const co_frame_t *f = h_next(d);
+        CHECK(f != NULL && f->data[0] == (blk == 127u ? 0xCD : 0x80));
+        if (blk == 128u) {
+            CHECK(f != NULL && co_get_u32(&f->data[4]) == 0x05040002u);
+            EXPECT_NONE(d);
+        } else {
+            h_rx(d, 0x610, "A1 00 00 00 00 00 00 00");
+            EXPECT_NONE(d);
+        }
+    }
     /* A block upload answered with another command: one abort. */
     SDO(d, "A0 00 20 00 0A 00 00 00", "C6 00 20 00 04 00 00 00");
     SDO(d, "20 00 20 00 00 00 00 00", "80 00 20 00 01 00 04 05");
