@@ -390,6 +390,23 @@ static void test_group_save(void)
     CHECK_EQ(h_read(d, 0x1800, 5), 500);
 }
 
+/* The write-cycle count (the 100 000 limit's, L308) survives a restart
+ * whole: a save writes the parameters and the LSS record (C-21), and the
+ * count read back at start takes the LSS record's too (tools/mutate's
+ * survivor: co_store_init's class loop stopping before the LSS class). */
+static void test_write_count_across_restart(void)
+{
+    boot(&gsh_a);
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00"); /* parameters */
+    SDO(d, "2F 01 30 00 14 00 00 00", "60 01 30 00 00 00 00 00"); /* node-ID 20 next time */
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00"); /* and the LSS record last */
+    uint32_t writes = d->node->store.writes;
+    CHECK(writes >= 2u);
+    h_power_cycle(d);
+    EXPECT_ID(d, 0x714, "00");
+    CHECK_EQ(d->node->store.writes, writes);
+}
+
 int main(void)
 {
     RUN(test_checksum_against_both_frames);
@@ -405,5 +422,6 @@ int main(void)
     RUN(test_rtr_answered);
     RUN(test_redundant_channels_are_independent);
     RUN(test_group_save);
+    RUN(test_write_count_across_restart);
     return h_finish();
 }

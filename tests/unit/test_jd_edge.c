@@ -237,6 +237,80 @@ static void test_lss_store_edges(void)
     EXPECT_NONE(d); /* no boot-up */
 }
 
+/* LSS stores across power cycles: after several stores and a restart the
+ * next store is still the newest record, and the write-cycle count (what a
+ * product's write limit is judged by) read back at start covers the LSS
+ * class too (tools/mutate's survivor: the per-class loop of co_store_init
+ * stopping before the LSS class). */
+static void test_lss_stores_across_power_cycles(void)
+{
+    boot(&jd2xxx);
+    h_rx(d, 0x7E5, "04 01 00 00 00 00 00 00");
+    static const char *const ids[] = {"11 0B 00 00 00 00 00 00", "11 0C 00 00 00 00 00 00",
+                                      "11 0D 00 00 00 00 00 00"};
+    for (unsigned k = 0; k < 3u; k++) {
+        h_rx(d, 0x7E5, ids[k]);
+        h_drain(d);
+        h_rx(d, 0x7E5, "17 00 00 00 00 00 00 00");
+        EXPECT(d, 0x7E4, "17 00 00 00 00 00 00 00");
+    }
+    h_power_cycle(d);
+    EXPECT(d, 0x70D, "00");
+    CHECK_EQ(d->node->store.writes, 3); /* every save counted, LSS ones too */
+    h_rx(d, 0x7E5, "04 01 00 00 00 00 00 00");
+    h_rx(d, 0x7E5, "11 0E 00 00 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x7E5, "17 00 00 00 00 00 00 00");
+    EXPECT(d, 0x7E4, "17 00 00 00 00 00 00 00");
+    h_power_cycle(d);
+    EXPECT(d, 0x70E, "00");
+    h_power_cycle(d);
+    EXPECT(d, 0x70E, "00");
+    CHECK_EQ(d->node->store.writes, 4);
+}
+
+/* sin(deg) for 0..90 degrees without libm (the qemu builds link none):
+ * its Taylor series to x^21, far below 1e-9 on a quarter turn. */
+static double sin_deg(int deg)
+{
+    double x = (double)deg * 3.14159265358979323846 / 180.0;
+    double term = x;
+    double sum = x;
+    for (int k = 1; k <= 10; k++) {
+        term = -term * x * x / (double)((2 * k) * (2 * k + 1));
+        sum += term;
+    }
+    return sum;
+}
+
+/* The accelerations (mg) at whole degrees are 1000 x sin and cos, rounded,
+ * both signs, on both axes of the JD2 and the JD1's two (tools/mutate's
+ * survivors: any entry of the sine table one off passed every test). */
+static void test_accel_sine_table(void)
+{
+    boot(&jd2xxx);
+    jd_dev_t *j = h_inst(d);
+    for (int deg = 0; deg <= 90; deg++) {
+        double s = sin_deg(deg) * 1000.0 + 0.5;
+        int32_t want = (int32_t)s;
+        int32_t v[3] = {deg * 1000, -deg * 1000, 25000};
+        d->prod->sample(j, v, 0);
+        CHECK_EQ(j->accel[0], want);
+        CHECK_EQ(j->accel[1], -want);
+        int32_t c = (int32_t)(sin_deg(90 - deg) * 1000.0 + 0.5);
+        CHECK_EQ(j->accel[2], c * c / 1000);
+    }
+    boot(&jd1xxx);
+    j = h_inst(d);
+    for (int deg = 0; deg <= 90; deg++) {
+        int32_t want = (int32_t)(sin_deg(deg) * 1000.0 + 0.5);
+        int32_t v[2] = {-deg * 1000, 25000};
+        d->prod->sample(j, v, 0);
+        CHECK_EQ(j->accel[0], -want);
+        CHECK_EQ(j->accel[1], -(int32_t)(sin_deg(90 - deg) * 1000.0 + 0.5));
+    }
+}
+
 int main(void)
 {
     RUN(test_lss_activate_bit_timing);
@@ -247,6 +321,8 @@ int main(void)
     RUN(test_temperature);
     RUN(test_jd1_moving_average_across_zero);
     RUN(test_leds);
+    RUN(test_accel_sine_table);
+    RUN(test_lss_stores_across_power_cycles);
     RUN(test_lss_store_edges);
     return h_finish();
 }

@@ -345,6 +345,31 @@ static void test_lss_selective_and_identify(void)
     LSS("49 FF FF FF FF 00 00 00", NULL);
     LSS("4A 02 D0 00 00 00 00 00", NULL); /* serial below the range */
     LSS("4B 00 D1 00 00 00 00 00", NULL);
+    /* Each sequence starts afresh at its vendor request: a matching one is
+     * answered after a mismatch, and again after that. */
+    for (unsigned k = 0; k < 2u; k++) {
+        LSS("46 6D 66 69 00 00 00 00", NULL);
+        LSS("47 00 00 00 00 00 00 00", NULL);
+        LSS("48 00 00 00 00 00 00 00", NULL);
+        LSS("49 FF FF FF FF 00 00 00", NULL);
+        LSS("4A 00 D0 00 00 00 00 00", NULL);
+        LSS("4B 00 D1 00 00 00 00 00", "4F 00 00 00 00 00 00 00");
+    }
+    /* A mismatch ends the sequence: the master repeating the step with a
+     * matching value gets no answer either, until a new vendor request. */
+    LSS("46 6D 66 69 00 00 00 00", NULL);
+    LSS("47 01 00 00 00 00 00 00", NULL); /* wrong product code */
+    LSS("47 00 00 00 00 00 00 00", NULL); /* the right one, too late */
+    LSS("48 00 00 00 00 00 00 00", NULL);
+    LSS("49 FF FF FF FF 00 00 00", NULL);
+    LSS("4A 00 D0 00 00 00 00 00", NULL);
+    LSS("4B 00 D1 00 00 00 00 00", NULL);
+    /* Out of order (product before vendor): no answer, whatever follows. */
+    LSS("47 00 00 00 00 00 00 00", NULL);
+    LSS("48 00 00 00 00 00 00 00", NULL);
+    LSS("49 FF FF FF FF 00 00 00", NULL);
+    LSS("4A 00 D0 00 00 00 00 00", NULL);
+    LSS("4B 00 D1 00 00 00 00 00", NULL);
     LSS("4C 00 00 00 00 00 00 00", NULL); /* configured: not "non-configured" */
 }
 

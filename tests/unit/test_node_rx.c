@@ -7,6 +7,7 @@
  * heartbeat consumer and the node-ID (LSS) changed.
  */
 #include "harness.h"
+#include "dst.h"
 #include "jd.h"
 #include "pf.h"
 
@@ -130,6 +131,103 @@ static void test_rx_ids_cut(void)
     CHECK(ids[2].rtr);
 }
 
+/* Each (CAN-ID, kind) once: two RTR TPDOs on one COB-ID give one entry
+ * (the node's TPDOs set by hand: the dictionary may allow it). And a list
+ * cut at max (no duplicates) counts every entry and never reads past max:
+ * the caller's entry there (here a copy of the third entry) is no reason
+ * to leave that ID out. */
+static void test_rx_ids_once_each(void)
+{
+    unsigned tried = 0;
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        boot(product_list[i]);
+        co_node_t *node = d->node;
+        co_rx_id_t ids[CO_NODE_RX_IDS_MAX];
+        unsigned n = list(node, ids);
+        CHECK(n >= 3u); /* NMT, SYNC, SDO at least */
+        co_rx_id_t cut[2] = {{0}, ids[2]};
+        CHECK_EQ(co_node_rx_ids(node, cut, 1), n);
+        CHECK_EQ(cut[0].id, 0x000);
+        CHECK(cut[1].id == ids[2].id && cut[1].rtr == ids[2].rtr);
+        for (unsigned k = 0; k < CO_TPDO_MAX; k++) {
+            co_tpdo_t *t = &node->tpdo[k];
+            if (!t->valid || !t->rtr_allowed || !has(ids, n, t->cob_id, true)) {
+                continue;
+            }
+            unsigned other = k == 0u ? 1u : 0u;
+            if (other >= CO_TPDO_MAX) {
+                break;
+            }
+            node->tpdo[other] = *t; /* the same COB-ID, RTR allowed */
+            n = list(node, ids);
+            unsigned count = 0;
+            for (unsigned a = 0; a < n; a++) {
+                count += ids[a].id == t->cob_id && ids[a].rtr ? 1u : 0u;
+                for (unsigned b = a + 1u; b < n; b++) {
+                    CHECK(ids[a].id != ids[b].id || ids[a].rtr != ids[b].rtr);
+                }
+            }
+            CHECK_EQ(count, 1);
+            tried++;
+            break;
+        }
+    }
+    CHECK(tried > 0u); /* some product answers RTRs */
+}
+
+/* A node without a node-ID (LSS: 255) takes no SDO requests (no 0x6FF);
+ * node-ID 127 does (0x67F). Guarding and the heartbeat consumer by their
+ * state (set by hand here). */
+static void test_rx_ids_conditions(void)
+{
+    boot(&jd2xxx);
+    co_rx_id_t ids[CO_NODE_RX_IDS_MAX];
+    uint8_t own = d->node->node_id;
+    d->node->node_id = 0xFF;
+    unsigned n = list(d->node, ids);
+    for (unsigned k = 0; k < n; k++) {
+        CHECK(ids[k].id < 0x600u || ids[k].id > 0x6FFu);
+    }
+    CHECK(!has(ids, n, 0x7FF, true)); /* nor guarding */
+    d->node->node_id = 127;
+    n = list(d->node, ids);
+    CHECK(has(ids, n, 0x67F, false));
+    d->node->node_id = own;
+    /* Guarding's RTR only while guarding runs; the heartbeat consumer's ID
+     * for any producer node-ID, 1 too. */
+    d->node->guard.enabled = false;
+    n = list(d->node, ids);
+    CHECK(!has(ids, n, (uint16_t)(0x700u + own), true));
+    d->node->guard.enabled = true;
+    n = list(d->node, ids);
+    CHECK(has(ids, n, (uint16_t)(0x700u + own), true));
+    d->node->hbc.node_id = 1;
+    d->node->hbc.time_ms = 100;
+    n = list(d->node, ids);
+    CHECK(has(ids, n, 0x701, false));
+    d->node->hbc.time_ms = 1;
+    n = list(d->node, ids);
+    CHECK(has(ids, n, 0x701, false));
+    d->node->hbc.time_ms = 0;
+    n = list(d->node, ids);
+    CHECK(!has(ids, n, 0x701, false));
+    /* A TPDO whose COB-ID forbids RTR (bit 30 set) is not listed for one. */
+    d->node->tpdo[0].valid = true;
+    d->node->tpdo[0].rtr_allowed = false;
+    n = list(d->node, ids);
+    CHECK(!has(ids, n, d->node->tpdo[0].cob_id, true));
+    d->node->tpdo[0].rtr_allowed = true;
+    n = list(d->node, ids);
+    CHECK(has(ids, n, d->node->tpdo[0].cob_id, true));
+    /* A product without the RTR service (DST X730) lists no TPDO's RTR,
+     * even with its COB-ID's bit 30 clear. */
+    boot(&dst_x730_xy10);
+    d->node->tpdo[0].valid = true;
+    d->node->tpdo[0].rtr_allowed = true;
+    n = list(d->node, ids);
+    CHECK(!has(ids, n, d->node->tpdo[0].cob_id, true));
+}
+
 /* The list follows SDO writes of the SYNC COB-ID, a TPDO COB-ID and the
  * heartbeat consumer, and a node-ID set by LSS at reset communication. */
 static void test_rx_ids_follow_changes(void)
@@ -197,6 +295,8 @@ int main(void)
 {
     RUN(test_rx_ids_every_product);
     RUN(test_rx_ids_cut);
+    RUN(test_rx_ids_once_each);
+    RUN(test_rx_ids_conditions);
     RUN(test_rx_ids_follow_changes);
     return h_finish();
 }

@@ -70,6 +70,43 @@ static void test_filter_through_the_device(void)
     CHECK_EQ(h_read(d, 0x6010, 0), 1000); /* fast: settled after 0.3 s */
 }
 
+/* The measuring range's limit: an angle exactly at +-limit is inside it
+ * (not beyond, output unchanged); one millidegree past it is beyond and
+ * clamped (tools/mutate's survivor: y <= -lim). Each value a fresh filter,
+ * primed by its first sample; 0.01 deg units. */
+static void test_incl_limit_edges(void)
+{
+    co_incl_para_t p = {.resolution = 10, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
+    static const struct {
+        int32_t in, out;
+        bool beyond;
+    } cases[] = {{-45000, -4500, false}, {45000, 4500, false}, {-45001, -4500, true},
+                 {45001, 4500, true}, {-45100, -4500, true}, {45100, 4500, true}, {0, 0, false}};
+    for (unsigned i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+        co_incl_t in;
+        co_incl_init(&in, &p, 2, 45000, false);
+        int32_t a[2] = {cases[i].in, 0};
+        co_incl_sample(&in, a);
+        CHECK_EQ(co_incl_slope(&in, 0), cases[i].out);
+        CHECK_EQ(co_incl_beyond(&in), cases[i].beyond);
+        a[0] = 0;
+        a[1] = cases[i].in; /* the other axis alone */
+        co_incl_init(&in, &p, 2, 45000, false);
+        co_incl_sample(&in, a);
+        CHECK_EQ(co_incl_slope(&in, 1), cases[i].out);
+        CHECK_EQ(co_incl_beyond(&in), cases[i].beyond);
+    }
+    /* Any limit but 0 (none) is one, the smallest too. */
+    co_incl_t in;
+    co_incl_init(&in, &p, 2, 1, false);
+    int32_t a[2] = {5, -5};
+    co_incl_sample(&in, a);
+    CHECK(co_incl_beyond(&in));
+    CHECK(in.beyond[0] && in.beyond[1]);
+    CHECK_EQ(in.angle[0], 1);
+    CHECK_EQ(in.angle[1], -1);
+}
+
 static void test_incl_arithmetic(void)
 {
     co_incl_para_t p = {.resolution = 50, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
@@ -364,6 +401,7 @@ int main(void)
     RUN(test_incl_wrap);
     RUN(test_incl_output_fits);
     RUN(test_incl_meas);
+    RUN(test_incl_limit_edges);
     RUN(test_incl_axis_bounds);
     RUN(test_incl_two_axes_circular);
     RUN(test_led_patterns);

@@ -305,6 +305,74 @@ static void test_sdo_block_download(void)
     CHECK_EQ(h_read(d, 0x2001, 0), 7);
 }
 
+/* A block download's abort is its last word: nothing is written and
+ * nothing follows it (tools/mutate's survivors: the returns after the
+ * aborts of a wrong end command, a wrong length and an overflow). */
+static void test_sdo_block_download_abort_is_final(void)
+{
+    boot();
+    CHECK_EQ(h_read(d, 0x2000, 0), 100);
+    /* Size 4 announced, 2 bytes given (n = 5 of the last 7 unused). */
+    SDO(d, "C2 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    h_rx(d, 0x610, "81 F4 01 00 00 00 00 00");
+    SDO(d, "D5 00 00 00 00 00 00 00", "80 00 20 00 10 00 07 06");
+    EXPECT_NONE(d);
+    CHECK_EQ(h_read(d, 0x2000, 0), 100);
+    /* An end without its end bit: command unknown. */
+    SDO(d, "C2 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    h_rx(d, 0x610, "81 F4 01 00 00 00 00 00");
+    SDO(d, "C4 00 00 00 00 00 00 00", "80 00 20 00 01 00 04 05");
+    EXPECT_NONE(d);
+    CHECK_EQ(h_read(d, 0x2000, 0), 100);
+    /* More than the buffer: a full block of 10 segments (70 bytes) is
+     * acknowledged, the next segment aborts, even as the last one. */
+    SDO(d, "C0 00 20 00 00 00 00 00", "A4 00 20 00 0A 00 00 00");
+    h_drain(d);
+    for (unsigned k = 1; k <= 10u; k++) {
+        co_frame_t f = {.id = 0x610, .dlc = 8, .data = {(uint8_t)k, 1, 2, 3, 4, 5, 6, 7}};
+        h_rx_frame(d, &f);
+    }
+    EXPECT(d, 0x590, "A2 0A 0A 00 00 00 00 00");
+    h_rx(d, 0x610, "81 01 02 03 04 05 06 07");
+    EXPECT(d, 0x590, "80 00 20 00 12 00 07 06");
+    EXPECT_NONE(d);
+    CHECK_EQ(h_read(d, 0x2000, 0), 100);
+    /* The object refuses the value (above its 1000): its abort alone. */
+    SDO(d, "C2 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    h_rx(d, 0x610, "81 D0 07 00 00 00 00 00");
+    SDO(d, "CD 00 00 00 00 00 00 00", "80 00 20 00 31 00 09 06");
+    EXPECT_NONE(d);
+    CHECK_EQ(h_read(d, 0x2000, 0), 100);
+    /* A block upload of an object that does not exist, or of a write-only
+     * one: its abort alone. */
+    SDO(d, "A0 99 29 00 0A 00 00 00", "80 99 29 00 00 00 02 06");
+    EXPECT_NONE(d);
+    SDO(d, "A0 10 10 01 0A 00 00 00", "80 10 10 01 01 00 01 06");
+    EXPECT_NONE(d);
+    /* The client's next block size: 127 segments at most (CiA 301). */
+    for (unsigned blk = 127; blk <= 128u; blk++) {
+        SDO(d, "A0 00 20 00 0A 00 00 00", "C6 00 20 00 04 00 00 00");
+        h_rx(d, 0x610, "A3 00 00 00 00 00 00 00");
+        const co_frame_t *seg = h_next(d);
+        CHECK(seg != NULL && seg->data[0] == 0x81);
+        co_frame_t ack = {.id = 0x610, .dlc = 8, .data = {0xA2, 1, (uint8_t)blk}};
+        h_rx_frame(d, &ack);
+        const co_frame_t *f = h_next(d);
+        CHECK(f != NULL && f->data[0] == (blk == 127u ? 0xCD : 0x80));
+        if (blk == 128u) {
+            CHECK(f != NULL && co_get_u32(&f->data[4]) == 0x05040002u);
+            EXPECT_NONE(d);
+        } else {
+            h_rx(d, 0x610, "A1 00 00 00 00 00 00 00");
+            EXPECT_NONE(d);
+        }
+    }
+    /* A block upload answered with another command: one abort. */
+    SDO(d, "A0 00 20 00 0A 00 00 00", "C6 00 20 00 04 00 00 00");
+    SDO(d, "20 00 20 00 00 00 00 00", "80 00 20 00 01 00 04 05");
+    EXPECT_NONE(d);
+}
+
 static void test_sdo_block_upload(void)
 {
     boot();
@@ -442,6 +510,32 @@ static void test_heartbeat_timing(void)
     SDO(d, "2B 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");
     h_advance(d, 500000);
     EXPECT_NONE(d);
+}
+
+/* A heartbeat polled late keeps its cadence: the next one is due a period
+ * after the last deadline, not after the late poll (tools/mutate's
+ * survivor: hb->next += period removed). The board's polls by hand. */
+static void test_heartbeat_late_poll_keeps_cadence(void)
+{
+    boot();
+    SDO(d, "2B 17 10 00 32 00 00 00", "60 17 10 00 00 00 00 00"); /* 50 ms */
+    uint32_t t0 = d->now;
+    h_drain(d);
+    CHECK_EQ(co_node_poll(d->node, t0 + 50300u), 49700); /* 300 us late: sent */
+    EXPECT(d, 0x710, "7F");
+    CHECK_EQ(co_node_poll(d->node, t0 + 100100u), 49900); /* the next deadline: t0 + 100 ms */
+    EXPECT(d, 0x710, "7F");
+    CHECK_EQ(co_node_poll(d->node, t0 + 160000u), 40000); /* 10 ms late: still t0 + 200 ms */
+    EXPECT(d, 0x710, "7F");
+    CHECK_EQ(co_node_poll(d->node, t0 + 199999u), 1);
+    EXPECT_NONE(d);
+    /* More than a period late: one heartbeat, the next a period after it
+     * (no burst to catch up). */
+    CHECK_EQ(co_node_poll(d->node, t0 + 260000u), 50000);
+    EXPECT(d, 0x710, "7F");
+    CHECK_EQ(co_node_poll(d->node, t0 + 309999u), 1);
+    EXPECT_NONE(d);
+    d->now = t0 + 309999u;
 }
 
 static unsigned count_id(h_dev_t *x, uint16_t id)
@@ -712,6 +806,158 @@ static void test_emcy_table_and_history(void)
     SDO(d, "23 14 10 00 B0 00 00 00", "80 14 10 00 30 00 09 06"); /* valid: no change */
     CHECK(co_emcy_send(d->node, 0x1234, 0, NULL));
     EXPECT(d, 0xA0, "34 12 00 00 00 00 00 00");
+}
+
+/* The error table cleared out of order, and the history kept within its
+ * CO_EMCY_HIST_MAX entries however many errors come (tools/mutate's
+ * survivors: find() answering index 0, the history's bounds). */
+static void test_emcy_clear_order_and_history_bound(void)
+{
+    boot();
+    h_drain(d);
+    CHECK(co_emcy_error(d->node, 0x4210, CO_ER_TEMPERATURE, true, NULL));
+    CHECK(co_emcy_error(d->node, 0x2310, CO_ER_CURRENT, true, NULL));
+    h_drain(d);
+    CHECK(!co_emcy_error(d->node, 0x2310, CO_ER_CURRENT, true, NULL)); /* active already */
+    CHECK(!co_emcy_error(d->node, 0x6000, 0, false, NULL)); /* never active: nothing to clear */
+    /* The second entry cleared first: the first one's bit stays. */
+    CHECK(co_emcy_error(d->node, 0x2310, 0, false, NULL));
+    CHECK(co_emcy_active(d->node, 0x4210));
+    CHECK(!co_emcy_active(d->node, 0x2310));
+    CHECK_EQ(h_read(d, 0x1001, 0), CO_ER_GENERIC | CO_ER_TEMPERATURE);
+    EXPECT_NONE(d);
+    CHECK(co_emcy_error(d->node, 0x4210, 0, false, NULL));
+    EXPECT(d, 0x90, "00 00 00 00 00 00 00 00");
+
+    /* More errors than the history holds: the newest CO_EMCY_HIST_MAX,
+     * newest first, and nothing written past the history (the guarding
+     * state behind it in the node stays as it was). */
+    SDO(d, "2F 03 10 00 00 00 00 00", "60 03 10 00 00 00 00 00");
+    co_guard_t guard = d->node->guard;
+    unsigned n = CO_EMCY_HIST_MAX + 3u;
+    for (unsigned i = 0; i < n; i++) {
+        CHECK(co_emcy_send(d->node, (uint16_t)(0x1000u + i), 0, NULL));
+    }
+    h_drain(d);
+    CHECK_EQ(d->node->emcy.nhist, CO_EMCY_HIST_MAX);
+    for (unsigned k = 0; k < CO_EMCY_HIST_MAX; k++) {
+        CHECK_EQ(d->node->emcy.hist[k], 0x1000u + n - 1u - k);
+    }
+    CHECK(memcmp(&guard, &d->node->guard, sizeof(guard)) == 0);
+    CHECK_EQ(h_read(d, 0x1003, 0), 2); /* as deep as the dictionary */
+    CHECK_EQ(h_read(d, 0x1003, 2), 0x1000u + n - 2u);
+}
+
+/* The EMCY COB-ID's CAN-ID may not change while valid, odd CAN-IDs too
+ * (only bit 31 says valid). */
+static void test_emcy_cobid_odd_id(void)
+{
+    boot();
+    SDO(d, "23 14 10 00 91 00 00 00", "80 14 10 00 30 00 09 06"); /* valid: no change */
+    SDO(d, "23 14 10 00 91 00 00 80", "60 14 10 00 00 00 00 00");
+    SDO(d, "23 14 10 00 91 00 00 00", "60 14 10 00 00 00 00 00"); /* 0x91, valid */
+    SDO(d, "23 14 10 00 A1 00 00 00", "80 14 10 00 30 00 09 06"); /* odd to odd: refused */
+    SDO(d, "23 14 10 00 A0 00 00 00", "80 14 10 00 30 00 09 06"); /* odd to even: refused */
+    CHECK_EQ(h_read(d, 0x1014, 0), 0x91);
+}
+
+/* The TPDO loops (start, stop, SYNC, RTR, poll) stay within the TPDO
+ * table: the active EMCY errors, kept right behind it in the node, are
+ * intact through every NMT change (tools/mutate's survivors: the loops
+ * running to n <= CO_TPDO_MAX). */
+static void codes_intact(void)
+{
+    CHECK(co_emcy_active(d->node, 0x2222));
+    CHECK(co_emcy_active(d->node, 0x3333));
+    CHECK(co_emcy_active(d->node, 0x5555));
+    CHECK_EQ(d->node->emcy.nactive, 3);
+    CHECK_EQ(co_emcy_register(d->node), CO_ER_GENERIC | CO_ER_CURRENT | CO_ER_TEMPERATURE);
+}
+
+static void test_tpdo_loops_stay_in_the_table(void)
+{
+    boot();
+    CHECK(co_emcy_error(d->node, 0x2222, CO_ER_CURRENT, true, NULL));
+    CHECK(co_emcy_error(d->node, 0x3333, CO_ER_TEMPERATURE, true, NULL));
+    CHECK(co_emcy_error(d->node, 0x5555, 0, true, NULL));
+    h_drain(d);
+    codes_intact();
+    for (unsigned k = 0; k < 2u; k++) {
+        h_rx(d, 0x000, "01 10"); /* start */
+        h_advance(d, 5000);
+        h_rx(d, 0x080, ""); /* SYNC */
+        co_frame_t rtr = {.id = 0x190, .rtr = true, .dlc = 0};
+        h_rx_frame(d, &rtr);
+        h_advance(d, 5000);
+        codes_intact();
+        h_rx(d, 0x000, "02 10"); /* stop */
+        codes_intact();
+        h_rx(d, 0x000, "80 10"); /* pre-operational */
+        h_advance(d, 5000);
+        codes_intact();
+        h_drain(d);
+    }
+}
+
+/* Two event-driven TPDOs: each keeps its own timer through start, stop
+ * and start again (tools/mutate's survivors: a TPDO loop handling the
+ * first TPDO only). */
+static void test_tpdo_two_event_timers(void)
+{
+    boot();
+    SDO(d, "23 01 18 01 90 02 00 80", "60 01 18 01 00 00 00 00"); /* off to remap */
+    SDO(d, "2F 01 1A 00 00 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 1A 01 10 00 01 20", "60 01 1A 01 00 00 00 00"); /* 0x2001, 16 bits */
+    SDO(d, "2F 01 1A 00 01 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 18 01 90 02 00 00", "60 01 18 01 00 00 00 00");
+    SDO(d, "2F 01 18 02 FE 00 00 00", "60 01 18 02 00 00 00 00"); /* event-driven */
+    SDO(d, "2B 01 18 05 1E 00 00 00", "60 01 18 05 00 00 00 00"); /* 30 ms */
+    for (unsigned k = 0; k < 2u; k++) {
+        h_drain(d);
+        h_rx(d, 0x000, "01 10");
+        h_advance(d, 299999);
+        uint32_t n190 = 0, n290 = 0;
+        const co_frame_t *f;
+        while ((f = h_next(d)) != NULL) {
+            n190 += f->id == 0x190;
+            n290 += f->id == 0x290;
+        }
+        CHECK_EQ(n190, 3);  /* at the start, 100 and 200 ms */
+        CHECK_EQ(n290, 10); /* at the start and every 30 ms */
+        co_frame_t rtr = {.id = 0x290, .rtr = true, .dlc = 2};
+        h_rx_frame(d, &rtr); /* the second TPDO answers its RTR */
+        f = h_next(d);
+        CHECK(f != NULL && f->id == 0x290 && !f->rtr && f->dlc == 2);
+        h_rx(d, 0x000, "02 10"); /* stop */
+        h_advance(d, 100000);
+        h_drain(d);
+    }
+}
+
+/* The event timer polled late keeps its cadence: the next send a period
+ * after the last deadline, not after the late poll; more than a period
+ * late, one send and the next a period after it (tools/mutate's
+ * survivors: the deadline from the poll's time). */
+static void test_tpdo_event_timer_cadence(void)
+{
+    boot();
+    h_drain(d);
+    uint32_t t0 = d->now;
+    h_rx(d, 0x000, "01 10"); /* TPDO1: event timer 100 ms, sent at the start */
+    CHECK_EQ(count_id(d, 0x190), 1);
+    co_node_poll(d->node, t0 + 100300u);
+    CHECK_EQ(count_id(d, 0x190), 1);
+    co_node_poll(d->node, t0 + 200100u);
+    CHECK_EQ(count_id(d, 0x190), 1); /* due at t0 + 200 ms, not 200.3 */
+    co_node_poll(d->node, t0 + 299999u);
+    CHECK_EQ(count_id(d, 0x190), 0);
+    co_node_poll(d->node, t0 + 450000u); /* 150 ms late */
+    CHECK_EQ(count_id(d, 0x190), 1);
+    co_node_poll(d->node, t0 + 549999u);
+    CHECK_EQ(count_id(d, 0x190), 0);
+    co_node_poll(d->node, t0 + 550000u);
+    CHECK_EQ(count_id(d, 0x190), 1);
+    d->now = t0 + 550000u;
 }
 
 static void test_tpdo_rtr_and_types(void)
@@ -1082,6 +1328,13 @@ int main(void)
     RUN(test_two_nodes_one_process);
     RUN(test_node_guarding);
     RUN(test_emcy_table_and_history);
+    RUN(test_emcy_clear_order_and_history_bound);
+    RUN(test_emcy_cobid_odd_id);
+    RUN(test_tpdo_loops_stay_in_the_table);
+    RUN(test_heartbeat_late_poll_keeps_cadence);
+    RUN(test_tpdo_two_event_timers);
+    RUN(test_tpdo_event_timer_cadence);
+    RUN(test_sdo_block_download_abort_is_final);
     RUN(test_tpdo_rtr_and_types);
     RUN(test_tpdo_events_and_inhibit);
     RUN(test_tpdo_cobid_and_mapping_rules);

@@ -1,0 +1,143 @@
+"""tools/mutate's own pieces: the tokeniser, which mutants a C text gets,
+and the stability of their ids (python3 -m unittest, no build needed)."""
+
+import importlib.machinery
+import importlib.util
+import os
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+_loader = importlib.machinery.SourceFileLoader("mutate", os.path.join(ROOT, "tools", "mutate"))
+_spec = importlib.util.spec_from_loader("mutate", _loader)
+mutate = importlib.util.module_from_spec(_spec)
+_loader.exec_module(mutate)
+
+SRC = """\
+#include <stdint.h>
+#define LIMIT(a, b) ((a) < (b) ? \\
+                     (a) : (b))
+/* a < b in a comment, 0 and 1 */
+static const char *const name = "x < 1 && y";
+static const uint8_t table[4] = {1, 2, 3, 5};
+
+int f(int *p, int n)
+{
+    int *q = p;   // n + 1 in a comment
+    char c = '<';
+    if (n <= 0 && p != NULL) {
+        return 0;
+    }
+    for (int i = 0; i < n; i++) {
+        q[i] = q[i] + (int)table[i & 3];
+        if (!q[i]) {
+            break;
+        }
+    }
+    g(&q[0], c);
+    return n;
+}
+
+const void *h(void)
+{
+    return NULL;
+}
+"""
+
+
+def mutants_of(src):
+    return mutate.make_mutants("src/x.c", src)
+
+
+class Tokeniser(unittest.TestCase):
+    def test_comments_strings_chars_and_directives_are_not_tokens(self):
+        texts = [t.text for t in mutate.tokenise(SRC)]
+        self.assertNotIn("LIMIT", texts)       # #define with a continuation line
+        self.assertNotIn("include", texts)
+        self.assertNotIn("'<'", texts)
+        self.assertNotIn('"x < 1 && y"', texts)
+        self.assertEqual(texts.count("<"), 1)  # only the for loop's
+        self.assertIn("table", texts)
+
+    def test_positions(self):
+        toks = mutate.tokenise(SRC)
+        le = [t for t in toks if t.text == "<="][0]
+        self.assertEqual((le.line, le.col), (12, 11))
+        self.assertEqual(SRC[le.start:le.end], "<=")
+
+
+class Mutants(unittest.TestCase):
+    def setUp(self):
+        self.ms = mutants_of(SRC)
+        self.by_line = {}
+        for m in self.ms:
+            self.by_line.setdefault(m.line, []).append(m.desc)
+
+    def test_nothing_in_comments_strings_or_directives(self):
+        for line in (1, 2, 3, 4, 5, 11):
+            self.assertNotIn(line, self.by_line, self.by_line.get(line))
+
+    def test_operators(self):
+        self.assertEqual(sorted(self.by_line[12]), sorted([
+            "<= -> <", "<= -> >", "0 -> 1", "&& -> ||", "!= -> =="]))
+        self.assertIn("< -> <=", self.by_line[15])
+        self.assertIn("< -> >=", self.by_line[15])
+        self.assertIn("++ -> --", self.by_line[15])
+        self.assertIn("+ -> -", self.by_line[16])
+        self.assertIn("& -> |", self.by_line[16])   # binary &
+        self.assertIn("! -> (removed)", self.by_line[17])
+
+    def test_unary_and_declarations_are_left_alone(self):
+        # int *q (a declarator) and &q[0] (an address) are not operators
+        self.assertNotIn("* -> /", self.by_line.get(10, []))
+        self.assertNotIn("& -> |", self.by_line.get(21, []))
+        self.assertNotIn(8, self.by_line)           # the parameter list
+
+    def test_constants_in_tables_but_not_array_sizes(self):
+        self.assertEqual(sorted(self.by_line[6]), sorted([
+            "1 -> 0", "2 -> 3", "2 -> 1", "3 -> 4", "3 -> 2", "5 -> 6", "5 -> 4"]))
+
+    def test_statements(self):
+        self.assertIn("return -> (removed)", self.by_line[13])
+        self.assertIn("return -> 1", self.by_line[13])   # return 0 -> return 1
+        self.assertIn("break -> (removed)", self.by_line[18])
+        self.assertIn("stmt -> (removed)", self.by_line[16])
+        self.assertIn("stmt -> (removed)", self.by_line[21])
+        self.assertIn("return -> 0", self.by_line[22])
+        self.assertNotIn("stmt -> (removed)", self.by_line.get(10, []))  # a declaration
+        self.assertEqual(self.by_line[27], ["return -> (removed)"])  # NULL is 0 already
+
+    def test_applying_a_mutant(self):
+        m = [m for m in self.ms if m.line == 15 and m.desc == "< -> >="][0]
+        out = SRC[:m.start] + m.repl + SRC[m.end:]
+        self.assertIn("for (int i = 0; i >= n; i++) {", out)
+        m = [m for m in self.ms if m.line == 21 and m.kind == "statement"][0]
+        out = SRC[:m.start] + m.repl + SRC[m.end:]
+        self.assertIn("\n    ;\n    return n;", out)
+
+    def test_ids_survive_unrelated_edits(self):
+        moved = SRC.replace("int f(int *p, int n)\n{\n",
+                            "int f(int *p, int n)\n{\n    /* new */\n    extra(n);\n")
+        before = {m.id: m.desc for m in self.ms}
+        after = {m.id: m.desc for m in mutants_of(moved)}
+        for i, d in before.items():
+            self.assertEqual(after.get(i), d, i)
+        self.assertEqual(len(set(before)), len(self.ms))
+
+    def test_identical_lines_get_distinct_ids(self):
+        src = "void f(int *a)\n{\n    a[0] = 1;\n    a[0] = 1;\n}\n"
+        ids = [m.id for m in mutants_of(src)]
+        self.assertEqual(len(ids), len(set(ids)))
+        self.assertTrue(any(".1#" in i for i in ids))
+        self.assertTrue(all(i.startswith("f@") for i in ids))
+
+    def test_every_project_file_tokenises(self):
+        files = mutate.source_files()
+        self.assertTrue(any(f.startswith("boards/common/") for f in files))
+        for f in files:
+            with open(os.path.join(ROOT, f)) as fh:
+                ms = mutants_of(fh.read())
+            self.assertEqual(len({m.id for m in ms}), len(ms), f)
+
+
+if __name__ == "__main__":
+    unittest.main()
