@@ -102,16 +102,19 @@ static uint32_t cost(uint32_t mask, bool used)
  * byte (ACR1/ACR3 low nibbles): masked out. */
 static void put_filter(sja1000_t *c, unsigned k, uint16_t code, uint16_t mask)
 {
-    if (k == 0u) {
-        c->acr[0] = (uint8_t)(code >> 3);
-        c->amr[0] = (uint8_t)(mask >> 3);
-        c->acr[1] = (uint8_t)((code & 7u) << 5);
-        c->amr[1] = (uint8_t)(((mask & 7u) << 5) | 0x1Fu);
-    } else {
-        c->acr[2] = (uint8_t)(code >> 3);
-        c->amr[2] = (uint8_t)(mask >> 3);
-        c->acr[3] = (uint8_t)((code & 7u) << 5);
-        c->amr[3] = (uint8_t)(((mask & 7u) << 5) | 0x1Fu);
+    unsigned r = 2u * k; /* filter 1: ACR0/ACR1 (AMR0/AMR1), filter 2: ACR2/ACR3 */
+    c->acr[r] = (uint8_t)(code >> 3);
+    c->amr[r] = (uint8_t)(mask >> 3);
+    c->acr[r + 1u] = (uint8_t)((code & 7u) << 5);
+    c->amr[r + 1u] = (uint8_t)(((mask & 7u) << 5) | 0x1Fu);
+}
+
+/* Every bit "don't care": the filter passes every frame. */
+static void open_filter(sja1000_t *c)
+{
+    for (unsigned i = 0; i < 4u; i++) {
+        c->acr[i] = 0x00u;
+        c->amr[i] = 0xFFu;
     }
 }
 
@@ -227,10 +230,7 @@ bool sja1000_init(sja1000_t *c, const sja1000_io_t *io, void *ctx, uint32_t cloc
         return false;
     }
     wr(c, SJA_OCR, SJA_OCR_NORMAL);
-    for (unsigned i = 0; i < 4u; i++) {
-        c->acr[i] = 0x00u; /* open: every bit "don't care" */
-        c->amr[i] = 0xFFu;
-    }
+    open_filter(c);
     if (!reprogram(c, btr0, btr1)) {
         return false;
     }
@@ -304,10 +304,7 @@ void sja1000_set_filter(sja1000_t *c, const co_rx_id_t *ids, unsigned n)
             c->ids[k] = list[k];
         }
         if (nu == 0u) {
-            for (unsigned i = 0; i < 4u; i++) {
-                c->acr[i] = 0x00u;
-                c->amr[i] = 0xFFu;
-            }
+            open_filter(c);
         } else {
             choose_filters(c, u, nu);
         }
