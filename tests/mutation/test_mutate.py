@@ -3,7 +3,11 @@ and the stability of their ids (python3 -m unittest, no build needed)."""
 
 import importlib.machinery
 import importlib.util
+import json
 import os
+import subprocess
+import sys
+import tempfile
 import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -137,6 +141,57 @@ class Mutants(unittest.TestCase):
             with open(os.path.join(ROOT, f)) as fh:
                 ms = mutants_of(fh.read())
             self.assertEqual(len({m.id for m in ms}), len(ms), f)
+
+
+class Merge(unittest.TestCase):
+    """--merge: a full run's results with a later re-run's on top."""
+    FILE = "src/sync.c"
+
+    def setUp(self):
+        with open(os.path.join(ROOT, self.FILE)) as fh:
+            self.ms = mutants_of(fh.read())
+        for m in self.ms:
+            m.file = self.FILE
+        self.dir = tempfile.TemporaryDirectory()
+
+    def tearDown(self):
+        self.dir.cleanup()
+
+    def write(self, name, statuses):
+        path = os.path.join(self.dir.name, name)
+        with open(path, "w") as fh:
+            json.dump({"seconds": 1.0, "mutants": [dict(m.to_json(), status=s, test=None)
+                                                     for m, s in statuses]}, fh)
+        return path
+
+    def merge(self, *paths, gate="all=50"):
+        return subprocess.run([sys.executable, os.path.join(ROOT, "tools", "mutate"), "--files",
+                               self.FILE, "--gate", gate, "--merge"] + list(paths),
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+
+    def row(self, out):
+        line = [l for l in out.splitlines() if l.startswith(self.FILE + " ")][0]
+        return [int(x) for x in line.split()[1:8]]
+
+    def test_a_later_run_wins(self):
+        n = len(self.ms)
+        first = self.write("full.json", [(m, "survived") for m in self.ms])
+        half = self.ms[: n // 2]
+        rerun = self.write("rerun.json", [(m, "killed") for m in half])
+        r = self.merge(first, rerun)
+        self.assertEqual(r.returncode, 1 if n - n // 2 > n // 2 else 0, r.stdout)
+        made, compiled, killed, _, survived, _, _ = self.row(r.stdout)
+        self.assertEqual((made, compiled, killed, survived), (n, n, n // 2, n - n // 2))
+        r = self.merge(rerun, first)   # the order matters: the last file wins
+        self.assertEqual(self.row(r.stdout)[2], 0)
+        self.assertEqual(r.returncode, 1)
+
+    def test_a_mutant_without_a_result_fails_the_gate(self):
+        part = self.write("part.json", [(m, "killed") for m in self.ms[1:]])
+        r = self.merge(part, gate="all=0")
+        self.assertEqual(r.returncode, 1, r.stdout)
+        self.assertIn("not run", r.stdout)
+        self.assertIn(self.ms[0].id, r.stdout)
 
 
 if __name__ == "__main__":
