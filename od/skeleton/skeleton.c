@@ -23,7 +23,10 @@ static co_res_t skel_read_slope(co_node_t *n, const co_od_entry_t *e, uint32_t *
     return co_incl_read(&dev_of(n)->incl, 0, v);
 }
 
-/* 0x6000: the resolutions CiA 410 lists; the module clears the presets. */
+/* 0x6000: the resolutions CiA 410 lists, taken while scaling is on; the
+ * module clears the presets. The module asks both axes' operating
+ * parameters for the scaling bit (a one-axis product may have 0x6021 too);
+ * this one has no 0x6021: its one axis' bit stands for both. */
 static co_res_t skel_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
     (void)e;
@@ -33,7 +36,9 @@ static co_res_t skel_write_resolution(co_node_t *n, const co_od_entry_t *e, uint
     if (co_od_checking(n)) { /* a restored set is being validated: act on nothing */
         return CO_OK;
     }
-    return co_incl_set_resolution(&dev_of(n)->incl, (uint16_t)v);
+    skel_dev_t *d = dev_of(n);
+    d->para.incl.op[1] = d->para.incl.op[0];
+    return co_incl_set_resolution(&d->incl, (uint16_t)v);
 }
 
 /* 0x6012: the output equals the preset from now on (CiA 410). */

@@ -72,11 +72,93 @@ static void test_store(void)
     CHECK_EQ(h_read(d, 0x1017, 0), 0);
 }
 
+/* The dictionary as its table gives it: every object is where the profile
+ * puts it (CiA 301 communication objects, CiA 410 slope objects) and reads
+ * its default after power-on; sub-indices beyond an object's are absent. */
+static void test_dictionary_defaults(void)
+{
+    static const struct {
+        uint16_t index;
+        uint8_t sub;
+        long long value; /* -1: absent */
+    } objs[] = {
+        {0x1000, 0, 0x19A},      {0x1001, 0, 0},          {0x1010, 0, 1},  {0x1010, 1, 1},
+        {0x1010, 2, -1},         {0x1011, 0, 1},          {0x1011, 1, 1},  {0x1011, 2, -1},
+        {0x1017, 0, 0},          {0x1018, 0, 4},          {0x1018, 1, 0},  {0x1018, 2, 1},
+        {0x1018, 3, 0x00010000}, {0x1018, 4, 0},          {0x1018, 5, -1}, {0x1800, 0, 5},
+        {0x1800, 1, 0x1A0},      {0x1800, 2, 254},        {0x1800, 3, -1}, {0x1800, 4, -1},
+        {0x1800, 5, 0},          {0x1A00, 0, 1},          {0x1A00, 1, 0x60100010},
+        {0x1A00, 2, -1},         {0x6000, 0, 10},         {0x6010, 0, 0},  {0x6011, 0, 0},
+        {0x6012, 0, 0},          {0x6013, 0, 0},          {0x6014, 0, 0},  {0x6015, 0, -1},
+    };
+    h_boot(d, &skel_incl, false);
+    for (unsigned i = 0; i < sizeof(objs) / sizeof(objs[0]); i++) {
+        long long v = h_read(d, objs[i].index, objs[i].sub);
+        if (v != objs[i].value) {
+            fprintf(stderr, "  %04Xh:%u reads %lld, expected %lld\n", (unsigned)objs[i].index,
+                    (unsigned)objs[i].sub, v, objs[i].value);
+            FAIL("an object differs from the table");
+        }
+    }
+}
+
+/* The slope's operating parameter takes CiA 410's bits 0 (inversion) and
+ * 1 (scaling) only: 0..3, beyond is "value too high". */
+static void test_operating_parameter_range(void)
+{
+    h_boot(d, &skel_incl, false);
+    SDO(d, "2F 11 60 00 04 00 00 00", "80 11 60 00 31 00 09 06");
+    SDO(d, "2F 11 60 00 03 00 00 00", "60 11 60 00 00 00 00 00");
+    SDO(d, "2F 11 60 00 00 00 00 00", "60 11 60 00 00 00 00 00");
+}
+
+/* 0x6000 takes CiA 410's resolutions 0.001, 0.01, 0.1 and 1 deg while
+ * scaling is on (0x6011 bit 1; else "not in the present device state"); a
+ * new one clears the preset's offset, and the slope follows at once and
+ * after a saved set comes back at power-on. */
+static void test_resolution(void)
+{
+    h_boot(d, &skel_incl, false);
+    d->truth[0] = 12345;
+    h_advance(d, 20000);
+    SDO(d, "2B 00 60 00 64 00 00 00", "80 00 60 00 22 00 00 08"); /* scaling off */
+    SDO(d, "2F 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00");
+    SDO(d, "2B 12 60 00 00 00 00 00", "60 12 60 00 00 00 00 00"); /* preset 0 */
+    CHECK_EQ((int16_t)h_read(d, 0x6013, 0), -1235); /* 0 - 12.345 deg in 0.01 */
+    static const char *const refused[] = {"2B 00 60 00 00 00 00 00", "2B 00 60 00 02 00 00 00",
+                                          "2B 00 60 00 09 00 00 00", "2B 00 60 00 0B 00 00 00",
+                                          "2B 00 60 00 65 00 00 00", "2B 00 60 00 E9 03 00 00"};
+    for (unsigned i = 0; i < sizeof(refused) / sizeof(refused[0]); i++) {
+        h_rx(d, 0x620, refused[i]);
+        const co_frame_t *f = h_next(d);
+        CHECK(f != NULL && f->id == 0x5A0 && co_get_u32(&f->data[4]) == 0x06090030u);
+    }
+    SDO(d, "2B 00 60 00 01 00 00 00", "60 00 60 00 00 00 00 00"); /* 0.001 deg */
+    CHECK_EQ(h_read(d, 0x6013, 0), 0);
+    CHECK_EQ(h_read(d, 0x6010, 0), 12345);
+    SDO(d, "2B 00 60 00 E8 03 00 00", "60 00 60 00 00 00 00 00"); /* 1 deg */
+    CHECK_EQ(h_read(d, 0x6010, 0), 12);
+    SDO(d, "2B 00 60 00 0A 00 00 00", "60 00 60 00 00 00 00 00"); /* 0.01 deg */
+    CHECK_EQ(h_read(d, 0x6010, 0), 1235);
+    SDO(d, "2B 00 60 00 64 00 00 00", "60 00 60 00 00 00 00 00"); /* 0.1 deg */
+    CHECK_EQ(h_read(d, 0x6010, 0), 123);
+    SDO(d, "2B 12 60 00 0A 00 00 00", "60 12 60 00 00 00 00 00"); /* preset 1.0 deg */
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_power_cycle(d);
+    h_advance(d, 20000);
+    CHECK_EQ(h_read(d, 0x6000, 0), 100);
+    CHECK_EQ(h_read(d, 0x6010, 0), 10);
+    CHECK_EQ((int16_t)h_read(d, 0x6013, 0), -113);
+}
+
 int main(void)
 {
     RUN(test_boot_and_identity);
     RUN(test_slope_on_tpdo);
     RUN(test_fault_emcy);
     RUN(test_store);
+    RUN(test_dictionary_defaults);
+    RUN(test_operating_parameter_range);
+    RUN(test_resolution);
     return h_finish();
 }
