@@ -21,6 +21,7 @@ typedef struct sim_flash {
     unsigned erases;
     unsigned programs;
     unsigned refused;  /* programs of a non-erased half-word (must stay 0) */
+    unsigned calls;    /* erase and program calls, refused ones included */
 } sim_flash_t;
 
 static sim_flash_t flash;
@@ -39,6 +40,7 @@ static bool power_ok(void)
 static bool sim_erase(void *ctx, uint32_t addr)
 {
     (void)ctx;
+    flash.calls++;
     if (addr % PAGE != 0u || addr >= sizeof(flash.mem)) {
         return false;
     }
@@ -57,6 +59,7 @@ static bool sim_erase(void *ctx, uint32_t addr)
 static bool sim_program16(void *ctx, uint32_t addr, uint16_t v)
 {
     (void)ctx;
+    flash.calls++;
     if ((addr & 1u) != 0u || addr + 2u > sizeof(flash.mem)) {
         return false;
     }
@@ -277,11 +280,64 @@ static void test_flash_of_zeros_takes_a_save(void)
     CHECK_EQ(get(0x1017, 0), 1234);
 }
 
+/* The logical EEPROM is the slots one after the other, each at the start
+ * of its page: a read crossing slots takes the end of one page and the
+ * start of the next; a write stays in one slot, of whole half-words at
+ * even addresses, and one it refuses touches no flash at all. */
+static void test_slots_across_pages(void)
+{
+    memset(flash.mem, 0xFF, sizeof(flash.mem));
+    flash.steps_left = -1;
+    for (uint32_t i = 0; i < 8u; i++) {
+        flash.mem[CO_STORE_SLOT - 4u + i] = (uint8_t)(0x10u + i); /* past slot 0: not EEPROM */
+        flash.mem[PAGE + i] = (uint8_t)(0x20u + i);
+        flash.mem[2u * PAGE + CO_STORE_SLOT - 4u + i] = (uint8_t)(0x30u + i);
+        flash.mem[3u * PAGE + i] = (uint8_t)(0x40u + i);
+    }
+    uint8_t b[8 + CO_STORE_SLOT];
+    CHECK(flash_ee_read(&fe, CO_STORE_SLOT - 4u, b, 8));
+    static const uint8_t want[8] = {0x10, 0x11, 0x12, 0x13, 0x20, 0x21, 0x22, 0x23};
+    CHECK(memcmp(b, want, 8) == 0);
+    /* From slot 1 through all of slot 2 into slot 3. */
+    CHECK(flash_ee_read(&fe, 2u * CO_STORE_SLOT - 4u, b, CO_STORE_SLOT + 8u));
+    CHECK(b[0] == 0xFF && b[4] == 0xFF);
+    CHECK(b[CO_STORE_SLOT] == 0x30 && b[CO_STORE_SLOT + 3u] == 0x33);
+    CHECK(b[CO_STORE_SLOT + 4u] == 0x40 && b[CO_STORE_SLOT + 7u] == 0x43);
+    CHECK(!flash_ee_read(&fe, 4u * CO_STORE_SLOT - 2u, b, 4)); /* past the end */
+    /* The last half-word of a slot, and of the last slot. */
+    uint8_t two[2] = {0x5A, 0xA5};
+    memset(flash.mem, 0xFF, sizeof(flash.mem));
+    flash.calls = 0;
+    CHECK(flash_ee_write(&fe, CO_STORE_SLOT - 2u, two, 2));
+    CHECK(flash.mem[CO_STORE_SLOT - 2u] == 0x5A && flash.mem[CO_STORE_SLOT - 1u] == 0xA5);
+    CHECK(flash_ee_write(&fe, 4u * CO_STORE_SLOT - 2u, two, 2));
+    CHECK(flash.mem[3u * PAGE + CO_STORE_SLOT - 2u] == 0x5A);
+    CHECK_EQ(flash.calls, 2);
+    /* Refused: no erase, no program. */
+    memset(flash.mem, 0xFF, sizeof(flash.mem));
+    flash.calls = 0;
+    CHECK(!flash_ee_write(&fe, 1, two, 2));
+    CHECK(!flash_ee_write(&fe, 0, two, 1));
+    CHECK(!flash_ee_write(&fe, CO_STORE_SLOT + 1u, two, 2));
+    CHECK(!flash_ee_write(&fe, CO_STORE_SLOT, "abc", 3));
+    CHECK(!flash_ee_write(&fe, CO_STORE_SLOT - 2u, "abcd", 4));
+    CHECK(!flash_ee_write(&fe, 2u * CO_STORE_SLOT - 2u, "abcd", 4));
+    CHECK(!flash_ee_write(&fe, 4u * CO_STORE_SLOT, two, 2));
+    CHECK_EQ(flash.calls, 0);
+    for (uint32_t i = 0; i < sizeof(flash.mem); i++) {
+        if (flash.mem[i] != 0xFF) {
+            FAIL("a refused write changed the flash");
+            break;
+        }
+    }
+}
+
 int main(void)
 {
     RUN(test_power_cut_at_every_flash_step);
     RUN(test_pages_and_alignment);
     RUN(test_unusable_geometry);
     RUN(test_flash_of_zeros_takes_a_save);
+    RUN(test_slots_across_pages);
     return h_finish();
 }
