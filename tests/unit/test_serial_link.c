@@ -305,6 +305,144 @@ static void test_sample(void)
     CHECK_EQ(v[2], jd2xxx.inputs[2].initial);
 }
 
+/* Every hex digit, both cases, in the identifier and the data; the highest
+ * standard identifier 0x7FF; a character that is not a hex digit makes an
+ * input line of it (answered), not a frame dropped in silence. */
+static void test_frame_hex_digits_and_limits(void)
+{
+    serial_link_init(&s, &jd2xxx);
+    co_frame_t f;
+    CHECK_EQ(FEED("t7FF80123456789ABCDEF\r", &f), 1);
+    CHECK(f.id == 0x7FF && f.dlc == 8 && !f.rtr);
+    static const uint8_t up[8] = {0x01, 0x23, 0x45, 0x67, 0x89, 0xAB, 0xCD, 0xEF};
+    CHECK(memcmp(f.data, up, 8) == 0);
+    CHECK_EQ(FEED("t0bc8abcdef9876543210\r", &f), 1);
+    static const uint8_t low[8] = {0xAB, 0xCD, 0xEF, 0x98, 0x76, 0x54, 0x32, 0x10};
+    CHECK(f.id == 0x0BC && f.dlc == 8 && memcmp(f.data, low, 8) == 0);
+    CHECK_EQ(FEED("r7FF8\r", &f), 1);
+    CHECK(f.id == 0x7FF && f.rtr && f.dlc == 8);
+    CHECK_EQ(out[0], '\0');
+    /* A DLC above 8, also on a remote frame; one data digit too many on an
+     * 8-byte frame (22 characters). */
+    CHECK_EQ(FEED("r1239\r", &f), 0);
+    CHECK_EQ(FEED("r123F\r", &f), 0);
+    CHECK_EQ(FEED("t12380102030405060708F\r", &f), 0);
+    CHECK_EQ(out[0], '\0');
+    /* The letter O for a zero, a G: not SLCAN, so an unknown command. */
+    CHECK_EQ(FEED("tO120\r", &f), 0);
+    CHECK(same(out, "error: unknown command 'tO120' (set, fault, can, get)\r"));
+    CHECK_EQ(FEED("t1G30\r", &f), 0);
+    CHECK(same(out, "error: unknown command 't1G30' (set, fault, can, get)\r"));
+    CHECK_EQ(FEED("t12g0\r", &f), 0);
+    CHECK(same(out, "error: unknown command 't12g0' (set, fault, can, get)\r"));
+    CHECK_EQ(FEED("t12:0\r", &f), 0);
+    CHECK(same(out, "error: unknown command 't12:0' (set, fault, can, get)\r"));
+}
+
+/* A line of SERIAL_LINE_MAX characters is whole; one more is too long.
+ * Words may be separated by tabs as well as spaces. */
+static void test_line_length_and_separators(void)
+{
+    serial_link_init(&s, &jd2xxx);
+    co_frame_t f;
+    char line[SERIAL_LINE_MAX + 2u];
+    memset(line, ' ', sizeof line);
+    memcpy(line, "set x=7", 7);
+    line[SERIAL_LINE_MAX] = '\r';
+    CHECK_EQ(feed(line, SERIAL_LINE_MAX + 1u, &f), 0);
+    CHECK(same(out, "ok\r"));
+    CHECK_EQ(s.values[0], 7000);
+    memcpy(line, "set x=8", 7);
+    line[SERIAL_LINE_MAX] = ' ';
+    line[SERIAL_LINE_MAX + 1u] = '\r';
+    CHECK_EQ(feed(line, SERIAL_LINE_MAX + 2u, &f), 0);
+    CHECK(same(out, "error: line too long\r"));
+    CHECK_EQ(s.values[0], 7000);
+    CHECK_EQ(FEED("\tset\tx=1\t y=-2\t\r", &f), 0);
+    CHECK(same(out, "ok\r"));
+    CHECK(s.values[0] == 1000 && s.values[1] == -2000);
+    /* The quoted part of an answer keeps every printable character, '~'
+     * (the last) included; DEL is not printable. */
+    CHECK_EQ(FEED("set x=~ \x7f\r", &f), 0);
+    CHECK(same(out, "error: '~': not a number within +-3600 (3 decimals at most)\r"));
+    CHECK_EQ(FEED("~\x7f!\r", &f), 0);
+    CHECK(same(out, "error: unknown command '~?!' (set, fault, can, get)\r"));
+}
+
+/* SLCAN's bit-rate codes (Lawicel): S0 10, S1 20, S2 50, S3 100, S4 125,
+ * S5 250, S6 500, S7 800, S8 1000 kbit/s, no others. At each rate a
+ * bus-off without hold ends after 128 x 11 recessive bit times (ISO
+ * 11898-1), from 250 kbit/s at start. */
+static void test_bitrate_codes_and_recovery(void)
+{
+    static const uint16_t kbps[] = {10, 20, 50, 100, 125, 250, 500, 800, 1000};
+    serial_link_init(&s, &jd2xxx);
+    co_frame_t f;
+    CHECK_EQ(FEED("can bus-off\r", &f), 0);
+    CHECK_EQ(serial_link_can_state(&s, 100u), CO_CAN_BUSOFF);
+    CHECK_EQ(serial_link_can_state(&s, 100u + 5631u), CO_CAN_BUSOFF);
+    CHECK_EQ(serial_link_can_state(&s, 100u + 5632u), CO_CAN_ACTIVE);
+    for (unsigned i = 0; i < sizeof(kbps) / sizeof(kbps[0]); i++) {
+        nout = 0;
+        CHECK(!serial_link_bitrate(&s, (uint16_t)(kbps[i] - 1u), put));
+        CHECK(!serial_link_bitrate(&s, (uint16_t)(kbps[i] + 1u), put));
+        CHECK_EQ(nout, 0);
+        CHECK(serial_link_bitrate(&s, kbps[i], put));
+        CHECK(nout == 3u && out[0] == 'S' && out[1] == (char)('0' + i) && out[2] == '\r');
+        CHECK_EQ(FEED("can bus-off\r", &f), 0);
+        uint32_t t0 = 0xFFFFFF00u + i; /* across the clock's wrap */
+        uint32_t recovery = 1408000u / kbps[i];
+        CHECK_EQ(serial_link_can_state(&s, t0), CO_CAN_BUSOFF);
+        CHECK_EQ(serial_link_can_state(&s, t0 + recovery - 1u), CO_CAN_BUSOFF);
+        CHECK_EQ(serial_link_can_state(&s, t0 + recovery), CO_CAN_ACTIVE);
+    }
+    /* The hold's range, 0 .. 60 s, both ends included. */
+    CHECK_EQ(FEED("can bus-off 0\r", &f), 0);
+    CHECK(same(out, "ok\r"));
+    CHECK_EQ(serial_link_can_state(&s, 0), CO_CAN_BUSOFF);
+    CHECK_EQ(serial_link_can_state(&s, 1407), CO_CAN_BUSOFF);
+    CHECK_EQ(serial_link_can_state(&s, 1408), CO_CAN_ACTIVE);
+    CHECK_EQ(FEED("can bus-off 60\r", &f), 0);
+    CHECK(same(out, "ok\r"));
+    CHECK_EQ(serial_link_can_state(&s, 0), CO_CAN_BUSOFF);
+    CHECK_EQ(serial_link_can_state(&s, 60001407u), CO_CAN_BUSOFF);
+    CHECK_EQ(serial_link_can_state(&s, 60001408u), CO_CAN_ACTIVE);
+    CHECK_EQ(FEED("can bus-off 60.001\r", &f), 0);
+    CHECK(starts(out, "error: usage: can"));
+    CHECK_EQ(FEED("can warning\r", &f), 0);
+    CHECK(same(out, "ok\r"));
+    CHECK_EQ(serial_link_can_state(&s, 0), CO_CAN_WARNING);
+    CHECK_EQ(FEED("can active\r", &f), 0);
+    CHECK_EQ(serial_link_can_state(&s, 0), CO_CAN_ACTIVE);
+}
+
+/* `get` prints zero without a sign and every decimal digit; `fault` needs
+ * its on or off. */
+static void test_get_digits_and_fault_usage(void)
+{
+    serial_link_init(&s, &jd2xxx);
+    co_frame_t f;
+    CHECK_EQ(FEED("set x=0 y=0.999 temp=-0.001\r", &f), 0);
+    CHECK_EQ(FEED("get\r", &f), 0);
+    CHECK(same(out, "ok x=0.000 y=0.999 temp=-0.001\r"));
+    CHECK_EQ(FEED("set x=-0 y=123.456 temp=-199.989\r", &f), 0);
+    CHECK_EQ(FEED("get\r", &f), 0);
+    CHECK(same(out, "ok x=0.000 y=123.456 temp=-199.989\r"));
+    serial_link_init(&s, &gsh_a);
+    CHECK_EQ(FEED("get\r", &f), 0);
+    CHECK(same(out, "ok length=0.000 angle=0.000 field=100.000\r"));
+    CHECK_EQ(FEED("set length=100000 field=-1000\r", &f), 0);
+    CHECK_EQ(FEED("get\r", &f), 0);
+    CHECK(same(out, "ok length=100000.000 angle=0.000 field=-1000.000\r"));
+    CHECK_EQ(FEED("fault tilt-element\r", &f), 0);
+    CHECK(same(out, "error: usage: fault extension-element|tilt-element on|off\r"));
+    CHECK_EQ(FEED("fault\r", &f), 0);
+    CHECK(same(out, "error: usage: fault extension-element|tilt-element on|off\r"));
+    CHECK_EQ(FEED("fault extension-element off\r", &f), 0);
+    CHECK(same(out, "ok\r"));
+    CHECK_EQ(s.faults, 0u);
+}
+
 int main(void)
 {
     RUN(test_sample);
@@ -314,5 +452,9 @@ int main(void)
     RUN(test_fault_and_unknown);
     RUN(test_get_and_commands_not_here);
     RUN(test_can_state_and_bitrate);
+    RUN(test_frame_hex_digits_and_limits);
+    RUN(test_line_length_and_separators);
+    RUN(test_bitrate_codes_and_recovery);
+    RUN(test_get_digits_and_fault_usage);
     return h_finish();
 }
