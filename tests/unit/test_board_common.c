@@ -66,6 +66,8 @@ static void test_libc_min(void)
     CHECK_EQ(lm_memcmp(x, x, 3), 0);
     CHECK_EQ(lm_memcmp(x, y, 1), 0);
     CHECK_EQ(lm_memcmp(x, y, 0), 0);
+    CHECK(lm_memcmp(y + 1, x + 1, 2) < 0); /* the first byte decides */
+    CHECK(lm_memcmp(x + 1, y + 1, 2) > 0);
 }
 
 /* ---- mcu_main.c on a fake board ------------------------------------------- */
@@ -79,9 +81,30 @@ int main(void); /* mcu_main_any: declared, for -Wmissing-prototypes */
 #include "mcu_main.c"
 #undef main
 
+/* Again as the image of a product with two nodes, the redundant GSH-A
+ * (nodes 0x13 and 0x14); its statics renamed, so that both copies link. */
+#undef PRODUCT_SYM
+#undef PRODUCT_HEADER
+#undef PRODUCT_INST_SIZE
+#define main mcu_main_two
+#define leds mcu_main_two_leds
+#define rx_filter mcu_main_two_rx_filter
+#define co_port_can_bitrate mcu_main_two_can_bitrate
+#define PRODUCT_SYM gsh_a_redundant
+#define PRODUCT_HEADER "gsh.h"
+#define PRODUCT_INST_SIZE sizeof(gsh_dev_t)
+int main(void); /* mcu_main_two: declared, for -Wmissing-prototypes */
+bool co_port_can_bitrate(void *port, uint16_t kbps);
+#include "mcu_main.c"
+#undef main
+#undef leds
+#undef rx_filter
+#undef co_port_can_bitrate
+
 int mcu_main_fixed(void); /* mcu_main_fixed.c: the X730 with the X710's fixed config */
 
 #define TX_MAX 1024u
+#define RX_MAX 8u
 
 static struct board {
     jmp_buf out;        /* where the endless loop is left */
@@ -96,15 +119,24 @@ static struct board {
     unsigned samples;
     uint32_t last_sample;
     uint32_t max_gap;   /* longest time between two samples */
-    co_frame_t rx;      /* one frame to receive ... */
-    uint32_t rx_at;     /* ... at this time */
-    bool rx_pending;
+    co_frame_t rx[RX_MAX]; /* frames to receive, in order ... */
+    uint32_t rx_at[RX_MAX]; /* ... each at its time */
+    unsigned nrx;
+    unsigned irx;       /* the next to receive */
+    uint32_t passive_from; /* board_can_state() reports error passive from ... */
+    uint32_t passive_until; /* ... until here (relative to the start; equal: never) */
+    uint32_t start;
+    unsigned state_calls; /* board_can_state() calls */
+    unsigned unfiltered_bootups; /* boot-ups whose SDO request the filter stopped */
+    unsigned nbootup_seen; /* tx[] checked for that up to here */
     co_frame_t tx[TX_MAX];
     uint32_t tx_at[TX_MAX];
     unsigned ntx;
     unsigned leds;      /* board_leds() calls */
     unsigned red_only;  /* of which (green off, red on) */
     bool green_seen[2]; /* green off / on seen */
+    bool red_seen;      /* red on seen ... */
+    uint32_t red_first; /* ... first at this time */
     unsigned red_limit; /* leave after this many red-only calls (0: never) */
     unsigned serial_calls; /* board_serial() calls */
     co_rx_id_t filter[2u * CO_NODE_RX_IDS_MAX]; /* the last board_can_filter() list */
@@ -120,6 +152,21 @@ static void board_reset(bool init_ok, bool bitrate_ok, uint32_t run_us)
     bd.bitrate_ok = bitrate_ok;
     bd.now = 0xFFF00000u; /* 1 s before the 32-bit clock wraps */
     bd.end = bd.now + run_us;
+    bd.start = bd.now;
+}
+
+/* A frame from the bus at time at (frames are queued in time order). */
+static void deliver(co_frame_t f, uint32_t at)
+{
+    if (bd.nrx < RX_MAX) {
+        bd.rx[bd.nrx] = f;
+        bd.rx_at[bd.nrx++] = at;
+    }
+}
+
+static bool rx_pending(void)
+{
+    return bd.irx < bd.nrx;
 }
 
 bool board_init(void)
@@ -142,23 +189,40 @@ uint32_t board_now_us(void)
 
 bool board_can_receive(co_frame_t *f)
 {
-    if (!bd.rx_pending || co_time_before(bd.now, bd.rx_at)) {
+    if (!rx_pending() || co_time_before(bd.now, bd.rx_at[bd.irx])) {
         return false;
     }
-    bd.rx_pending = false;
-    *f = bd.rx;
+    *f = bd.rx[bd.irx++];
     return true;
 }
 
+static bool in_filter(uint16_t id, bool rtr);
+
+/* Where a board with a transmit queue (rv32-virt's SJA1000) sends what
+ * the node queued: every boot-up sent since the last call must find its
+ * node's SDO request in the receive filter by now. */
 uint8_t board_can_state(void)
 {
-    return CO_CAN_ACTIVE;
+    bd.state_calls++;
+    for (; bd.nbootup_seen < bd.ntx; bd.nbootup_seen++) {
+        const co_frame_t *t = &bd.tx[bd.nbootup_seen];
+        if (t->id > 0x700u && t->id <= 0x77Fu && t->dlc == 1u && t->data[0] == 0x00u &&
+            !in_filter((uint16_t)(t->id - 0x100u), false)) {
+            bd.unfiltered_bootups++;
+        }
+    }
+    uint32_t t = bd.now - bd.start;
+    return t >= bd.passive_from && t < bd.passive_until ? CO_CAN_PASSIVE : CO_CAN_ACTIVE;
 }
 
 void board_leds(bool green, bool red)
 {
     bd.leds++;
     bd.green_seen[green ? 1 : 0] = true;
+    if (red && !bd.red_seen) {
+        bd.red_seen = true;
+        bd.red_first = bd.now;
+    }
     if (!green && red) {
         bd.red_only++;
         if (bd.red_limit != 0u && bd.red_only >= bd.red_limit) {
@@ -192,8 +256,9 @@ void board_sleep(uint32_t us)
     bd.sleeps++;
     bd.max_sleep = us > bd.max_sleep ? us : bd.max_sleep;
     uint32_t wake = bd.now + us;
-    if (bd.rx_pending && co_time_before(bd.rx_at, wake)) {
-        wake = co_time_before(bd.now, bd.rx_at) ? bd.rx_at : bd.now; /* the receive interrupt */
+    if (rx_pending() && co_time_before(bd.rx_at[bd.irx], wake)) {
+        /* the receive interrupt */
+        wake = co_time_before(bd.now, bd.rx_at[bd.irx]) ? bd.rx_at[bd.irx] : bd.now;
     }
     bd.now = wake;
     if (!co_time_before(bd.now, bd.end) || bd.sleeps > 100000u) {
@@ -268,9 +333,7 @@ static void test_main_loop_runs_the_product(void)
     board_reset(true, true, 1000000u);
     memset(nvm, 0xFF, sizeof(nvm));
     uint32_t start = bd.now;
-    bd.rx = (co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}};
-    bd.rx_at = start + 500000u;
-    bd.rx_pending = true;
+    deliver((co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}}, start + 500000u);
     if (setjmp(bd.out) == 0) {
         (void)mcu_main_any();
     }
@@ -323,9 +386,7 @@ static void test_main_loop_serial_from_board(void)
     board_reset(true, true, 200000u);
     memset(nvm, 0xFF, sizeof(nvm));
     uint32_t start = bd.now;
-    bd.rx = (co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x40, 0x18, 0x10, 0x04}};
-    bd.rx_at = start + 100000u;
-    bd.rx_pending = true;
+    deliver((co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x40, 0x18, 0x10, 0x04}}, start + 100000u);
     if (setjmp(bd.out) == 0) {
         (void)mcu_main_any();
     }
@@ -365,9 +426,7 @@ static void test_main_loop_nmt_start(void)
     board_reset(true, true, 1000000u);
     memset(nvm, 0xFF, sizeof(nvm));
     uint32_t start = bd.now;
-    bd.rx = (co_frame_t){.id = 0x000, .dlc = 2, .data = {0x01, 0x7F}};
-    bd.rx_at = start + 100000u;
-    bd.rx_pending = true;
+    deliver((co_frame_t){.id = 0x000, .dlc = 2, .data = {0x01, 0x7F}}, start + 100000u);
     if (setjmp(bd.out) == 0) {
         (void)mcu_main_any();
     }
@@ -432,6 +491,99 @@ static void test_main_loop_refuses_to_run(void)
     CHECK_EQ(bd.nkbps, 0);
 }
 
+/* The first frame on id sent at or after time t (relative to the start),
+ * its index in bd.tx; bd.ntx when there is none. */
+static unsigned first_on(uint16_t id, uint32_t t, uint32_t start)
+{
+    unsigned i = 0;
+    while (i < bd.ntx && (bd.tx[i].id != id || bd.tx_at[i] - start < t)) {
+        i++;
+    }
+    return i;
+}
+
+/* Frames received together are served one by one, each to its end: a
+ * reset node (NMT) is done before the next frame is served, so that an SDO
+ * request to the new node-ID right behind it is answered (DST manual: the
+ * node-ID setting is active after the next reset). The boot-up under the
+ * new node-ID leaves with the filter passing its SDO requests (boards
+ * whose controller sends from board_can_state, as rv32-virt's SJA1000). */
+static void test_main_loop_frames_of_one_pass(void)
+{
+    board_reset(true, true, 400000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    uint32_t start = bd.now;
+    deliver((co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x2F, 0xF0, 0x20, 0x00, 0x06}},
+            start + 100000u);
+    deliver((co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x2F, 0xF1, 0x20, 0x00, 0x06}},
+            start + 100000u);
+    deliver((co_frame_t){.id = 0x000, .dlc = 2, .data = {0x81, 0x7F}}, start + 200000u);
+    deliver((co_frame_t){.id = 0x606, .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}},
+            start + 200000u);
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_any();
+    }
+    unsigned boot = first_on(0x706, 0, start);
+    unsigned answer = first_on(0x586, 0, start);
+    CHECK(boot < answer && answer < bd.ntx);
+    if (boot < answer && answer < bd.ntx) {
+        CHECK_EQ(bd.tx_at[boot] - start, 200000);
+        CHECK_EQ(bd.tx_at[answer] - start, 200000);
+        CHECK(bd.tx[answer].data[0] == 0x43 && bd.tx[answer].data[1] == 0x00 &&
+              bd.tx[answer].data[2] == 0x10);
+    }
+    CHECK(bd.state_calls > 0u);
+    CHECK_EQ(bd.unfiltered_bootups, 0);
+    CHECK(in_filter(0x606, false) && !in_filter(0x67F, false));
+}
+
+/* The controller's error state reaches the node in the loop: from 0.1 s
+ * on error passive, and the red LED shows it (CiA 303-3: off while the
+ * controller is error active). */
+static void test_main_loop_can_state(void)
+{
+    board_reset(true, true, 300000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    bd.passive_from = 100000u;
+    bd.passive_until = 300000u;
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_any();
+    }
+    CHECK(bd.red_seen);
+    CHECK(bd.red_first - bd.start >= 100000u && bd.red_first - bd.start < 110000u);
+}
+
+/* A product with two nodes (the redundant GSH-A, nodes 0x13 and 0x14):
+ * each boots, has its own serial number from the board (node 0 and 1),
+ * gets the frames, is polled (TPDOs after NMT start) and is in the
+ * receive list; the sleep waits for the earlier of their deadlines. */
+static void test_main_loop_two_nodes(void)
+{
+    board_reset(true, true, 1000000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    uint32_t start = bd.now;
+    deliver((co_frame_t){.id = 0x613, .dlc = 8, .data = {0x40, 0x18, 0x10, 0x04}}, start + 100000u);
+    deliver((co_frame_t){.id = 0x614, .dlc = 8, .data = {0x40, 0x18, 0x10, 0x04}}, start + 100000u);
+    deliver((co_frame_t){.id = 0x000, .dlc = 2, .data = {0x01, 0x00}}, start + 200000u);
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_two();
+    }
+    CHECK_EQ(bd.serial_calls, 2);
+    CHECK(bd.ntx >= 2u && bd.tx[0].id == 0x713 && bd.tx[1].id == 0x714);
+    CHECK(bd.tx_at[0] == start && bd.tx_at[1] == start);
+    for (unsigned k = 0; k < 2u; k++) {
+        unsigned i = first_on((uint16_t)(0x593u + k), 0, start);
+        CHECK(i < bd.ntx);
+        if (i < bd.ntx) {
+            CHECK_EQ(bd.tx_at[i] - start, 100000);
+            CHECK_EQ(co_get_u32(&bd.tx[i].data[4]), board_serial(k));
+        }
+        CHECK(in_filter((uint16_t)(0x613u + k), false));
+        CHECK(sent_on((uint16_t)(0x193u + k), 200000u, start) >= 5u);
+    }
+    CHECK(bd.max_sleep <= CO_FILTER_PERIOD_US);
+}
+
 int main(void)
 {
     RUN(test_libc_min);
@@ -443,5 +595,8 @@ int main(void)
     RUN(test_main_loop_bitrate_refused);
     RUN(test_port_bitrate_default);
     RUN(test_main_loop_refuses_to_run);
+    RUN(test_main_loop_frames_of_one_pass);
+    RUN(test_main_loop_can_state);
+    RUN(test_main_loop_two_nodes);
     return h_finish();
 }
