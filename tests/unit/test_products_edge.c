@@ -67,6 +67,9 @@ static void test_dst_values(void)
     SDO(d, "2B 17 10 00 14 00 00 00", "60 17 10 00 00 00 00 00"); /* 20 ms */
     SDO(d, "2B 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00"); /* 0: off */
     SDO(d, "2B 17 10 00 13 00 00 00", "80 17 10 00 30 00 09 06"); /* 1-19 refused */
+    SDO(d, "2B 17 10 00 01 00 00 00", "80 17 10 00 30 00 09 06"); /* from 1 on (object 1017h) */
+    /* Event timer: 0 off, 4..65535 ms; 1..3 refused from 1 on (C-17). */
+    SDO(d, "2B 00 18 05 01 00 00 00", "80 00 18 05 30 00 09 06");
     /* C-18: 1..240 and 254 only. */
     SDO(d, "2F 00 18 02 FF 00 00 00", "80 00 18 02 30 00 09 06");
     SDO(d, "2F 00 18 02 FC 00 00 00", "80 00 18 02 30 00 09 06");
@@ -100,6 +103,22 @@ static void test_dst_node_id_pair_unchanged(void)
     CHECK(d->port.nvm_writes > w);
     h_power_cycle(d);
     EXPECT(d, 0x720, "00");
+}
+
+/* Each copy of the pair reads what was written to it (B-43): one copy
+ * alone commits nothing, and the other keeps the active value (B-46). */
+static void test_dst_pair_copies_are_their_own(void)
+{
+    boot_dst();
+    SDO(d, "2F F0 20 00 20 00 00 00", "60 F0 20 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x20F0, 0), 0x20);
+    CHECK_EQ(h_read(d, 0x20F1, 0), 0x7F);
+    SDO(d, "2F F3 20 00 05 00 00 00", "60 F3 20 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x20F2, 0), 3);
+    CHECK_EQ(h_read(d, 0x20F3, 0), 5);
+    h_power_cycle(d);
+    EXPECT(d, 0x77F, "00");
+    CHECK_EQ(d->port.kbps, 250);
 }
 
 /* 0x5001 = 0 (big endian), saved: the PDOs after the next power-on too. */
@@ -335,11 +354,81 @@ static void test_written_mapping_sets_the_dlc(void)
     CHECK(writable >= 2u); /* JD1, JD2, INX, INY */
 }
 
+/* ---- every product: its nodes' ports and EEPROM areas ------------------ */
+
+/* product.h: node i talks through ports[i]. Each port gets its node's
+ * boot-up, and only that (a device's nodes on their own buses). */
+static void test_each_node_talks_through_its_port(void)
+{
+    static fake_port_t ports[PRODUCT_MAX_NODES];
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        const product_t *p = product_list[i];
+        void *pp[PRODUCT_MAX_NODES];
+        for (unsigned k = 0; k < PRODUCT_MAX_NODES; k++) {
+            fake_port_init(&ports[k]);
+            pp[k] = &ports[k];
+        }
+        memset(d, 0, sizeof(*d));
+        p->create(p, d->mem, pp, d->nodes);
+        int32_t in[PRODUCT_MAX_INPUTS];
+        for (unsigned k = 0; k < PRODUCT_MAX_INPUTS; k++) {
+            in[k] = p->inputs[k].initial;
+        }
+        p->sample(d->mem, in, 0);
+        for (unsigned k = 0; k < p->nodes; k++) {
+            co_node_start(d->nodes[k], 1000000u);
+        }
+        for (unsigned k = 0; k < PRODUCT_MAX_NODES; k++) {
+            bool own = k < p->nodes;
+            CHECK_EQ(ports[k].ntx, own ? 1u : 0u);
+            if (own && ports[k].ntx == 1u) {
+                CHECK_EQ(ports[k].tx[0].id, 0x700u + co_node_id(d->nodes[k]));
+            }
+        }
+    }
+}
+
+/* The store record ("CoPS") at an EEPROM address. */
+static bool record_at(uint32_t addr)
+{
+    static const uint8_t magic[4] = {0x43, 0x6F, 0x50, 0x53};
+    return memcmp(&d->port.nvm[addr], magic, sizeof(magic)) == 0;
+}
+
+/* co_node_init: node i of a device stores its sets in its own
+ * CO_STORE_NVM_SIZE bytes from i x CO_STORE_NVM_SIZE, so that the nodes of
+ * one EEPROM never overwrite each other: a "save" (0x1010:1) on node i puts
+ * its parameter record at the start of its area. */
+static void test_each_node_stores_in_its_area(void)
+{
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        h_boot(d, product_list[i], false);
+        for (unsigned k = 0; k < d->nnodes; k++) {
+            co_node_t *node = d->nodes[k];
+            uint8_t id = co_node_id(node);
+            h_drain(d);
+            h_rx(d, (uint16_t)(0x600u + id), "23 10 10 01 73 61 76 65");
+            const co_frame_t *f = h_next(d);
+            while (f != NULL && f->id != 0x580u + id) {
+                f = h_next(d); /* a PDO of a product that starts by itself */
+            }
+            CHECK(f != NULL && f->data[0] == 0x60u);
+            uint32_t base = k * CO_STORE_NVM_SIZE;
+            if (!record_at(base) && !record_at(base + CO_STORE_SLOT)) {
+                fprintf(stderr, "  %s node %u: no record at %u\n", product_list[i]->id, k,
+                        (unsigned)base);
+                FAIL("a node's parameter record is not in its area");
+            }
+        }
+    }
+}
+
 int main(void)
 {
     RUN(test_registry);
     RUN(test_dst_values);
     RUN(test_dst_node_id_pair_unchanged);
+    RUN(test_dst_pair_copies_are_their_own);
     RUN(test_dst_big_endian_after_reset);
     RUN(test_dst_error_while_stopped);
     RUN(test_dst_eeprom_unreadable);
@@ -348,5 +437,7 @@ int main(void)
     RUN(test_pf_stored_set_unusable);
     RUN(test_mapped_length_is_the_dlc);
     RUN(test_written_mapping_sets_the_dlc);
+    RUN(test_each_node_talks_through_its_port);
+    RUN(test_each_node_stores_in_its_area);
     return h_finish();
 }
