@@ -53,8 +53,8 @@ typedef struct co_tpdo {
     uint8_t type;        /* transmission type */
     uint8_t nmap;
     uint8_t sync_count;  /* SYNCs since the last synchronous send */
-    bool timer_armed;    /* event timer running (operational, type 254/255) */
-    bool pending;        /* an application event waits for the inhibit time */
+    bool timer_armed;    /* event timer running (type 254/255; read only while operational) */
+    bool pending;        /* an application event waits for the inhibit time (operational) */
     bool have_last;      /* last[] holds the last data sent (type 0) or sampled (252) */
     uint16_t cob_id;
     uint16_t event_ms;
@@ -94,11 +94,11 @@ void co_tpdo_reconfig(co_node_t *node, unsigned n);
 void co_tpdo_set_msb_first(co_node_t *node, unsigned n, bool msb_first);
 
 /* Entering operational: every TPDO starts afresh (SYNC count 0, no data
- * sent yet, the event timer's first send at the next poll). */
+ * sent yet, no event pending, the event timer's first send at the next
+ * poll). Outside operational nothing is sent and no event is taken (the
+ * poll, SYNC, RTR and event functions check the state), so leaving it
+ * needs no call: what the timers held is set afresh here. */
 void co_tpdo_start(co_node_t *node);
-/* Leaving operational or resetting: event timers and pending events of
- * every TPDO stop; nothing is sent until co_tpdo_start(). */
-void co_tpdo_stop(co_node_t *node);
 
 /* One SYNC received in operational. */
 void co_tpdo_sync(co_node_t *node);

@@ -22,8 +22,6 @@ void co_nmt_enter(co_node_t *node, co_nmt_state_t state)
     node->nmt.state = (uint8_t)state;
     if (state == CO_NMT_OPERATIONAL) {
         co_tpdo_start(node);
-    } else if (old == CO_NMT_OPERATIONAL) {
-        co_tpdo_stop(node);
     }
     if (co_cfg(node)->ops != NULL && co_cfg(node)->ops->state != NULL) {
         co_cfg(node)->ops->state(node, (co_nmt_state_t)old);

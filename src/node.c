@@ -99,7 +99,6 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
 {
     co_node_wake(node);
     /* Silent while re-initialising: no state hook for INIT. */
-    co_tpdo_stop(node);
     node->nmt.state = CO_NMT_INIT;
     if (kind == CO_RESET_NODE) {
         co_od_defaults(node, CO_CLS_VOL, 0x0000, 0xFFFF);

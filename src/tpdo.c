@@ -215,14 +215,6 @@ void co_tpdo_start(co_node_t *node)
     }
 }
 
-void co_tpdo_stop(co_node_t *node)
-{
-    for (unsigned n = 0; n < CO_TPDO_MAX; n++) {
-        node->tpdo[n].timer_armed = false;
-        node->tpdo[n].pending = false;
-    }
-}
-
 /* v's four bytes in reverse order (big-endian PDO values). */
 static uint32_t reverse_bytes(uint32_t v)
 {

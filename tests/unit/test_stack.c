@@ -861,7 +861,7 @@ static void test_emcy_cobid_odd_id(void)
     CHECK_EQ(h_read(d, 0x1014, 0), 0x91);
 }
 
-/* The TPDO loops (start, stop, SYNC, RTR, poll) stay within the TPDO
+/* The TPDO loops (start, SYNC, RTR, poll) stay within the TPDO
  * table: the active EMCY errors, kept right behind it in the node, are
  * intact through every NMT change (tools/mutate's survivors: the loops
  * running to n <= CO_TPDO_MAX). */
