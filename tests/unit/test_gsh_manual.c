@@ -256,6 +256,8 @@ static void test_derived_aborts_d30_to_d39(void)
     SDO(d, "2F 01 30 00 80 00 00 00", "80 01 30 00 31 00 09 06"); /* D-36 (spec: 30) */
     SDO(d, "2F 00 30 00 08 00 00 00", "80 00 30 00 31 00 09 06"); /* D-37 (spec: 30) */
     SDO(d, "2B 00 18 05 03 00 00 00", "80 00 18 05 32 00 09 06"); /* D-38 */
+    SDO(d, "2B 00 18 05 01 00 00 00", "80 00 18 05 32 00 09 06"); /* 1..3 (L404) */
+    SDO(d, "2B 00 18 05 04 00 00 00", "60 00 18 05 00 00 00 00"); /* 4 ms is the least */
     SDO(d, "23 00 18 01 93 02 00 00", "80 00 18 01 02 00 01 06"); /* D-39 */
     SDO(d, "40 11 10 01 00 00 00 00", "80 11 10 01 00 00 02 06"); /* no 0x1011 (C-09) */
     SDO(d, "40 14 10 00 00 00 00 00", "80 14 10 00 00 00 02 06"); /* no EMCY */
@@ -273,6 +275,8 @@ static void test_alarms_counter_checksum(void)
         uint16_t alarms;
     } v[] = {
         {100, 100, 0, 0},
+        {0, 50, 0, 0},      /* the ends of the stroke and of the field's range: no alarm */
+        {GSH_STROKE_MM, 150, 0, 0},
         {-5, 100, 0, GSH_ALARM_UNDER_EXTENSION},
         {9000, 100, 0, GSH_ALARM_OVER_EXTENSION},
         {100, 40, 0, GSH_ALARM_FIELD_LOW},
@@ -308,6 +312,8 @@ static void test_alarms_counter_checksum(void)
             CHECK_EQ(co_get_u16(last->data), GSH_STROKE_MM);
         } else if (v[i].len_mm < 0) {
             CHECK_EQ(co_get_u16(last->data), 0);
+        } else {
+            CHECK_EQ(co_get_u16(last->data), v[i].len_mm);
         }
         /* Bytes 5-8 as the mapped objects read them: the alarm word now,
          * the counter and checksum of the last PDO sent. */

@@ -121,6 +121,45 @@ static void test_dst_pair_copies_are_their_own(void)
     CHECK_EQ(d->port.kbps, 250);
 }
 
+/* The bit-rate codes are 0..7 (object 20F2h): the last, 7 (20 kbit/s), is
+ * a good stored code; a stored 8 (written by no SDO: 0x20F2 takes 0..7)
+ * is not: the default 250 kbit/s, and the set reported corrupt (0x4001
+ * bit 6). */
+static void test_dst_stored_bitrate_codes(void)
+{
+    boot_dst();
+    SDO(d, "2F F2 20 00 07 00 00 00", "60 F2 20 00 00 00 00 00");
+    SDO(d, "2F F3 20 00 07 00 00 00", "60 F3 20 00 00 00 00 00");
+    h_power_cycle(d);
+    EXPECT(d, 0x77F, "00");
+    CHECK_EQ(d->port.kbps, 20);
+    h_advance(d, 1000);
+    CHECK_EQ(h_read(d, 0x4001, 0), 0);
+    dst_dev_t *x = h_inst(d);
+    x->lss.bitrate = 8;
+    CHECK_EQ(co_store_save(d->node, CO_CLS_LSS), CO_OK);
+    h_power_cycle(d);
+    EXPECT(d, 0x77F, "00");
+    CHECK_EQ(d->port.kbps, 250);
+    h_advance(d, 1000);
+    CHECK_EQ(h_read(d, 0x4001, 0), DST_ERR_CHECKSUM);
+}
+
+/* A saved resolution comes back at power-on also when scaling was turned
+ * off after it was set (scaling is asked of a new resolution only). */
+static void test_dst_resolution_kept_without_scaling(void)
+{
+    boot_dst();
+    SDO(d, "2B 00 60 00 0A 00 00 00", "60 00 60 00 00 00 00 00"); /* 0.01 deg */
+    SDO(d, "2F 11 60 00 00 00 00 00", "60 11 60 00 00 00 00 00"); /* scaling off */
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_power_cycle(d);
+    EXPECT(d, 0x77F, "00");
+    CHECK_EQ(h_read(d, 0x6000, 0), 10);
+    CHECK_EQ(h_read(d, 0x6011, 0), 0);
+    SDO(d, "2B 00 60 00 32 00 00 00", "80 00 60 00 22 00 00 08"); /* a new one needs it */
+}
+
 /* 0x5001 = 0 (big endian), saved: the PDOs after the next power-on too. */
 static void test_dst_big_endian_after_reset(void)
 {
@@ -429,6 +468,8 @@ int main(void)
     RUN(test_dst_values);
     RUN(test_dst_node_id_pair_unchanged);
     RUN(test_dst_pair_copies_are_their_own);
+    RUN(test_dst_stored_bitrate_codes);
+    RUN(test_dst_resolution_kept_without_scaling);
     RUN(test_dst_big_endian_after_reset);
     RUN(test_dst_error_while_stopped);
     RUN(test_dst_eeprom_unreadable);
