@@ -394,8 +394,60 @@ static void test_read_fault_in_save_all(void)
     CHECK(refused >= 10);
 }
 
+/* The slot at NVM offset at holds exactly these bytes (hex). */
+static void expect_slot(unsigned at, const char *hex, int line)
+{
+    uint8_t want[CO_STORE_SLOT];
+    unsigned n = h_hex(hex, want, sizeof(want));
+    for (unsigned i = 0; i < n; i++) {
+        h_checks++;
+        if (d->port.nvm[at + i] != want[i]) {
+            h_failures++;
+            fprintf(stderr, "%s:%d: NVM byte %u is %02X, expected %02X\n", __FILE__, line, at + i,
+                    d->port.nvm[at + i], want[i]);
+        }
+    }
+}
+#define EXPECT_SLOT(k, hex) expect_slot((k) * CO_STORE_SLOT, (hex), __LINE__)
+
+/*
+ * The record format (co_store.h) is what a device in the field holds: a
+ * later firmware with the same dictionary layout must read it, so the
+ * bytes are fixed. Little-endian header: magic "CoPS", the layout hash
+ * (FNV-1a over index, sub-index, size and offset of each entry of the
+ * class, then XOR the class's size), sequence, write count, data length,
+ * flags (1: "load" asked for defaults), class (2 parameters, 3 node-ID
+ * set), four zero bytes; the data; CRC-32 (IEEE 802.3) over both. The
+ * expected hashes and CRCs were computed apart from the firmware.
+ */
+static void test_record_bytes(void)
+{
+    static const char s[] = "123456789";
+    CHECK_EQ(co_crc32(0, s, 9), 0xCBF43926u); /* the CRC-32 check value */
+    CHECK_EQ(co_crc32(co_crc32(0, s, 4), s + 4, 5), 0xCBF43926u); /* chained */
+    CHECK_EQ(co_crc32(0x12345678u, s, 0), 0x12345678u);
+    boot();
+    set_all(100, 200, 0x11223344u, 300);
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    /* The parameters: slot 0, sequence 1, the first write. */
+    EXPECT_SLOT(0, "43 6F 50 53 51 64 8F DE 01 00 00 00 01 00 00 00 20 00 00 02 00 00 00 00 "
+                   "64 00 00 00 C8 00 00 00 00 00 00 00 00 00 00 00 00 00 00 00 00 00 44 33 "
+                   "22 11 00 00 2C 01 00 00 37 14 31 17");
+    /* The node-ID set (0x30, bit-rate code 3): slot 2, the second write. */
+    EXPECT_SLOT(2, "43 6F 50 53 C7 9D 1C 81 01 00 00 00 02 00 00 00 02 00 00 03 00 00 00 00 "
+                   "30 03 2D E1 42 69");
+    /* "load": records of no data with the defaults flag, in the other slots. */
+    SDO(d, "23 11 10 01 6C 6F 61 64", "60 11 10 01 00 00 00 00");
+    EXPECT_SLOT(1, "43 6F 50 53 51 64 8F DE 02 00 00 00 03 00 00 00 00 00 01 02 00 00 00 00 "
+                   "06 BE 3A 91");
+    EXPECT_SLOT(3, "43 6F 50 53 C7 9D 1C 81 02 00 00 00 04 00 00 00 00 00 01 03 00 00 00 00 "
+                   "F9 44 91 0D");
+    EXPECT_SLOT(0, "43 6F 50 53 51 64 8F DE 01 00 00 00 01 00 00 00 20 00 00 02"); /* kept */
+}
+
 int main(void)
 {
+    RUN(test_record_bytes);
     RUN(test_group_save);
     RUN(test_group_load);
     RUN(test_group_save_after_load);
