@@ -1306,6 +1306,103 @@ static void test_emcy_cobid_restricted_and_as_written(void)
     SDO(d, "40 01 18 01 00 00 00 00", "43 01 18 01 80 02 00 00");
 }
 
+/*
+ * A node with only what CiA 301 requires and node guarding instead of a
+ * heartbeat: no 0x1005 (SYNC on its default CAN-ID 0x080), no 0x1017 (no
+ * heartbeat: guard requests are answered), TPDO1 with its COB-ID only
+ * (transmission type 254, no inhibit time, no event timer: sent on each
+ * application event), TPDO2 with a transmission type of 1.
+ */
+typedef struct b_vol {
+    uint32_t counter;
+} b_vol_t;
+
+typedef struct b_dev {
+    co_node_t node;
+    b_vol_t vol;
+} b_dev_t;
+
+static const co_od_entry_t b_entries[] = {
+    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_read_register)},
+    {.index = 0x100C, .sub = 0, CO_TYPE_U16, .attr = CO_A_R | CO_A_CONST, .def = 0},
+    {.index = 0x100D, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 0},
+    {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 1},
+    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = CO_A_R | CO_A_NODEID, .def = 0x180},
+    {.index = 0x1801, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 2},
+    {.index = 0x1801, .sub = 1, CO_TYPE_U32, .attr = CO_A_R | CO_A_NODEID, .def = 0x280},
+    {.index = 0x1801, .sub = 2, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
+    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21000020u},
+    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
+    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21000020u},
+    {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, counter)},
+};
+
+static const co_od_t b_od = {.entries = b_entries, .count = sizeof(b_entries) / sizeof(b_entries[0])};
+
+static const co_service_t *const b_services[] = {&co_guard_service, NULL};
+
+static const co_node_cfg_t b_cfg = {
+    .od = &b_od,
+    .services = b_services,
+    .ram_size = {0, sizeof(b_vol_t), 0, 0},
+    .default_node_id = 0x20,
+};
+
+static void b_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
+{
+    (void)p;
+    b_dev_t *b = mem;
+    memset(b, 0, sizeof(*b));
+    void *const ram[CO_CLS_COUNT] = {NULL, &b->vol, NULL, NULL};
+    co_node_init(&b->node, &b_cfg, ports[0], b, ram, 0);
+    nodes[0] = &b->node;
+}
+
+static void b_sample(void *mem, const int32_t v[], uint32_t fault)
+{
+    (void)v;
+    (void)fault;
+    ((b_dev_t *)mem)->vol.counter++;
+}
+
+static const product_t b_prod = {.id = "bare", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
+                                 .inst_size = sizeof(b_dev_t), .create = b_create,
+                                 .sample = b_sample};
+
+static void test_bare_node_defaults(void)
+{
+    h_boot(d, &b_prod, false);
+    EXPECT(d, 0x720, "00");
+    h_advance(d, 2000000);
+    EXPECT_NONE(d); /* no heartbeat */
+    co_frame_t rtr = {.id = 0x720, .rtr = true, .dlc = 1};
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x720, "7F"); /* guarding answered: no heartbeat runs */
+    h_rx(d, 0x000, "01 20");
+    h_advance(d, 1000000);
+    EXPECT_NONE(d); /* TPDO1: no event timer; TPDO2: no SYNC */
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 1);
+    NEXT_IS(0x1A0);
+    co_tpdo_event(d->node, 0); /* no inhibit time: at once again */
+    h_advance(d, 1);
+    NEXT_IS(0x1A0);
+    EXPECT_NONE(d);
+    h_rx(d, 0x081, "");
+    EXPECT_NONE(d);
+    h_rx(d, 0x080, "");
+    NEXT_IS(0x2A0); /* SYNC on 0x080 */
+    EXPECT_NONE(d);
+    h_rx(d, 0x07F, "");
+    EXPECT_NONE(d);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x720, "85");
+    h_advance(d, 1000000);
+    EXPECT_NONE(d);
+}
+
 int main(void)
 {
     RUN(test_od_find);
@@ -1344,5 +1441,6 @@ int main(void)
     RUN(test_largest_periods);
     RUN(test_sync_cobid_bits);
     RUN(test_emcy_cobid_restricted_and_as_written);
+    RUN(test_bare_node_defaults);
     return h_finish();
 }
