@@ -303,6 +303,14 @@ static void test_e10_filter_after_save(void)
     SAVE(); /* E10.3/E10.4 */
     CHECK_EQ(x->filter_active, 0);
     SDO(d, "2F 01 20 00 03 00 00 00", "80 01 20 00 31 00 09 06"); /* > 2 */
+    /* A saved setting is the active one from the next power-on. */
+    SDO(d, "2F 01 20 00 01 00 00 00", "60 01 20 00 00 00 00 00");
+    SAVE();
+    h_power_cycle(d);
+    EXPECT(d, 0x77F, "00");
+    x = (dst_dev_t *)h_inst(d);
+    CHECK_EQ(x->filter_active, 1);
+    CHECK_EQ(x->incl.shift, co_filter_shift(1));
 }
 
 static void test_e11_restore_defaults(void)
@@ -730,6 +738,61 @@ static void test_error_behaviour(void)
     EXPECT(d, 0xFF, "00 10 00 00 01 00 00 00");
 }
 
+/* C-42: 0x4000 acts on a transition of 0x4001 from 0 to an error; an
+ * error added to one already reported is reported (EMCY with the new
+ * 0x4001) without a second state change. */
+static void test_error_behaviour_on_the_first_error_only(void)
+{
+    boot(M->xy10);
+    d->port.nvm_read_fails = true; /* the checksum error from power-on */
+    h_power_cycle(d);
+    EXPECT(d, 0x77F, "00");
+    h_advance(d, 1000);
+    EXPECT(d, 0xFF, "00 10 00 00 40 00 00 00");
+    d->port.nvm_read_fails = false;
+    SDO(d, "2F 00 40 00 02 00 00 00", "60 00 40 00 00 00 00 00"); /* stopped */
+    h_rx(d, 0x000, "01 7F");
+    d->fault = 1u; /* "sensor" */
+    h_advance(d, 10000);
+    EXPECT_ID(d, 0xFF, "00 10 00 00 41 00 00 00");
+    CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
+}
+
+/* Errors are evaluated afresh after every boot-up: one still present
+ * after a reset node is reported again. */
+static void test_error_reported_again_after_reset(void)
+{
+    boot(M->xy10);
+    d->fault = 1u;
+    h_advance(d, 10000);
+    EXPECT(d, 0xFF, "00 10 00 00 01 00 00 00");
+    h_rx(d, 0x000, "81 7F");
+    EXPECT(d, 0x77F, "00");
+    h_advance(d, 10000);
+    EXPECT(d, 0xFF, "00 10 00 00 01 00 00 00");
+    EXPECT_NONE(d);
+}
+
+/* The error check asks to be polled again only when something is due: an
+ * error waiting in stopped for EMCY to be allowed again waits for the NMT
+ * command, and the poll that sends an EMCY leaves nothing behind (no
+ * heartbeat, no timer here: CO_NEVER). */
+static void test_error_poll_leaves_nothing_due(void)
+{
+    boot(M->xy10);
+    h_rx(d, 0x000, "02 7F");
+    d->fault = 1u;
+    h_advance(d, 10000);
+    EXPECT_NONE(d);
+    CHECK_EQ(co_node_poll(d->node, d->now), CO_NEVER);
+    h_rx(d, 0x000, "80 7F");
+    EXPECT(d, 0xFF, "00 10 00 00 01 00 00 00");
+    d->fault = 0u;
+    d->prod->sample(h_inst(d), d->truth, d->fault);
+    CHECK_EQ(co_node_poll(d->node, d->now), CO_NEVER);
+    EXPECT(d, 0xFF, "00 00 00 00 00 00 00 00");
+}
+
 static void test_emcy_cobid(void)
 {
     boot(M->xy10);
@@ -753,6 +816,45 @@ static void test_x730_own_vectors(void)
     SDO(d, "2F 01 50 00 02 00 00 00", "80 01 50 00 31 00 09 06");
     SDO(d, "40 00 18 03 00 00 00 00", "4B 00 18 03 00 00 00 00"); /* inhibit ro 0 */
     SDO(d, "2B 00 18 03 04 00 00 00", "80 00 18 03 02 00 01 06");
+}
+
+/* 0x5001 = 0 not saved: a reset node brings the default 1 back, and the
+ * PDOs are little-endian again. */
+static void test_pdo_coding_default_after_reset(void)
+{
+    boot(&dst_x730_xy30);
+    d->truth[0] = 12500;
+    d->truth[1] = -3000;
+    SDO(d, "2F 01 50 00 00 00 00 00", "60 01 50 00 00 00 00 00");
+    h_rx(d, 0x000, "81 7F");
+    EXPECT(d, 0x77F, "00");
+    CHECK_EQ(h_read(d, 0x5001, 0), 1);
+    operational_settled();
+    EXPECT_TPDO("FA 00 C4 FF 00 00 00 00"); /* 250, -60 in 0.05 deg */
+}
+
+/* Status LED (operating guide section 13): green blinking is 200 ms on,
+ * 200 ms off (pre-operational), the single flash 500 ms on, 500 ms off
+ * (stopped, C-38). */
+static void test_x730_led_timing(void)
+{
+    boot(&dst_x730_xy30);
+    bool g;
+    bool r;
+    uint32_t nx;
+    co_node_leds(d->node, 4000000u, &g, &r, &nx);
+    CHECK(g && !r);
+    CHECK_EQ(nx, 200000);
+    co_node_leds(d->node, 4200000u, &g, &r, &nx);
+    CHECK(!g && !r);
+    CHECK_EQ(nx, 200000);
+    h_rx(d, 0x000, "02 7F");
+    co_node_leds(d->node, 4000000u, &g, &r, &nx);
+    CHECK(g && !r);
+    CHECK_EQ(nx, 500000);
+    co_node_leds(d->node, 4500000u, &g, &r, &nx);
+    CHECK(!g && !r);
+    CHECK_EQ(nx, 500000);
 }
 
 /* ---- DST X710 only ----------------------------------------------------- */
@@ -819,6 +921,9 @@ int main(void)
         RUN(test_derived_preset_and_diff);
         RUN(test_derived_limits_and_emcy);
         RUN(test_error_behaviour);
+        RUN(test_error_behaviour_on_the_first_error_only);
+        RUN(test_error_reported_again_after_reset);
+        RUN(test_error_poll_leaves_nothing_due);
         RUN(test_emcy_cobid);
         RUN(test_segmented_as_expedited);
         RUN(test_segmented_download);
@@ -827,6 +932,8 @@ int main(void)
     RUN(test_derived_pdo_coding); /* D19: X730 only */
     RUN(test_pdo_coding_is_tpdo1s);
     RUN(test_x730_own_vectors);
+    RUN(test_pdo_coding_default_after_reset);
+    RUN(test_x730_led_timing);
     M = &x710;
     RUN(test_x710_own_vectors);
     RUN(test_x710_inhibit_time);
