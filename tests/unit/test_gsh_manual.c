@@ -170,6 +170,28 @@ static void test_e3_autostart_off(void)
     CHECK(f != NULL && f->id == 0x193);
 }
 
+/* 4.6: the PDO counter starts from 0 at every boot-up, also after a
+ * reset; until the first PDO after it, 0x2111 and 0x2112 (the last PDO's
+ * counter and checksum) read 0. Auto-start off (0x5000, C-22), so that the
+ * node waits in pre-operational after the reset communication. */
+static void test_counter_from_zero_after_reset(void)
+{
+    boot(&gsh_a);
+    h_advance(d, 250000); /* PDOs 0, 1, 2 */
+    CHECK(h_read(d, 0x2111, 0) >= 2);
+    SDO(d, "2F 00 50 00 00 00 00 00", "60 00 50 00 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x000, "82 13");
+    EXPECT(d, 0x713, "00");
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
+    CHECK_EQ(h_read(d, 0x2111, 0), 0);
+    CHECK_EQ(h_read(d, 0x2112, 0), 0);
+    h_rx(d, 0x000, "01 13");
+    h_advance(d, 1);
+    const co_frame_t *f = h_next(d);
+    CHECK(f != NULL && f->id == 0x193 && f->data[6] == 0u);
+}
+
 static void test_nmt_and_stopped(void)
 {
     boot(&gsh_a_redundant);
@@ -421,6 +443,7 @@ int main(void)
     RUN(test_e1_node_id);
     RUN(test_e2_event_timer);
     RUN(test_e3_autostart_off);
+    RUN(test_counter_from_zero_after_reset);
     RUN(test_nmt_and_stopped);
     RUN(test_derived_reads_d1_to_d29);
     RUN(test_derived_aborts_d30_to_d39);

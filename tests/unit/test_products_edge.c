@@ -14,6 +14,7 @@
  * length against the mapping, EMCY 8220h).
  */
 #include "dst.h"
+#include "gsh.h"
 #include "harness.h"
 #include "pf.h"
 
@@ -54,6 +55,10 @@ static void test_registry(void)
     product_t none = {.id = "no-table"};
     CHECK_EQ(product_kbps(&none, 3), 0);
 }
+
+#define ANSWERS_MAX 128u
+static uint8_t answers[2][2][ANSWERS_MAX][8];
+static unsigned power_on_answers(const product_t *p, uint8_t fill, uint8_t out[2][ANSWERS_MAX][8]);
 
 static void boot_dst(void)
 {
@@ -119,6 +124,34 @@ static void test_dst_pair_copies_are_their_own(void)
     h_power_cycle(d);
     EXPECT(d, 0x77F, "00");
     CHECK_EQ(d->port.kbps, 250);
+}
+
+/* 0x4001 bit 0 "sensor error" (self-test failure, MEMS IC communication
+ * error): no valid reading, so the slope holds its last value until the
+ * sensor works again; and with no error, 0x4001 reads 0 from the first
+ * request after power-on, before the node has looked for errors. */
+static void test_dst_sensor_error_holds_the_slope(void)
+{
+    (void)power_on_answers(&dst_x730_xy30, 0xA5, answers[0]);
+    const co_od_t *od = co_cfg(d->node)->od;
+    for (unsigned k = 0; k < od->count && k < ANSWERS_MAX; k++) {
+        if (od->entries[k].index == 0x4001u) {
+            CHECK_EQ(answers[0][0][k][0], 0x4F);
+            CHECK_EQ(answers[0][0][k][4], 0);
+        }
+    }
+    boot_dst();
+    d->truth[0] = 10000;
+    h_advance(d, 3000000);
+    CHECK_EQ(h_read(d, 0x6010, 0), 200); /* 10 deg in 0.05 deg */
+    d->fault = 1u;
+    d->truth[0] = 20000;
+    h_advance(d, 3000000);
+    CHECK_EQ(h_read(d, 0x4001, 0), DST_ERR_SENSOR);
+    CHECK_EQ(h_read(d, 0x6010, 0), 200);
+    d->fault = 0u;
+    h_advance(d, 3000000);
+    CHECK_EQ(h_read(d, 0x6010, 0), 400);
 }
 
 /* The bit-rate codes are 0..7 (object 20F2h): the last, 7 (20 kbit/s), is
@@ -427,6 +460,90 @@ static void test_each_node_talks_through_its_port(void)
     }
 }
 
+/* Node 0's answers to an upload of each of its first objects, right after
+ * power-on (one sensor sample, no poll yet) and again after 100 ms, the
+ * instance built in memory that held fill before. */
+static unsigned power_on_answers(const product_t *p, uint8_t fill, uint8_t out[2][ANSWERS_MAX][8])
+{
+    void *ports[PRODUCT_MAX_NODES] = {&d->port, &d->port};
+    memset(d, 0, sizeof(*d));
+    fake_port_init(&d->port);
+    memset(d->mem, fill, sizeof(d->mem));
+    d->prod = p;
+    p->create(p, d->mem, ports, d->nodes);
+    d->nnodes = p->nodes;
+    d->node = d->nodes[0];
+    d->now = 1000000u;
+    for (unsigned k = 0; k < PRODUCT_MAX_INPUTS; k++) {
+        d->truth[k] = p->inputs[k].initial;
+    }
+    p->sample(d->mem, d->truth, 0);
+    for (unsigned k = 0; k < d->nnodes; k++) {
+        co_node_start(d->nodes[k], d->now);
+    }
+    d->next_sample = d->now + CO_FILTER_PERIOD_US;
+    const co_od_t *od = co_cfg(d->node)->od;
+    unsigned n = od->count < ANSWERS_MAX ? od->count : ANSWERS_MAX;
+    for (unsigned pass = 0; pass < 2u; pass++) {
+        for (unsigned i = 0; i < n; i++) {
+            co_frame_t f = {.id = (uint16_t)(0x600u + d->node->node_id), .dlc = 8, .data = {0x40}};
+            co_put_u16(&f.data[1], od->entries[i].index);
+            f.data[3] = od->entries[i].sub;
+            h_drain(d);
+            co_node_receive(d->node, &f, d->now);
+            const co_frame_t *r = h_next(d);
+            memset(out[pass][i], 0, 8);
+            if (r != NULL) {
+                memcpy(out[pass][i], r->data, 8);
+            }
+        }
+        h_advance(d, 100000);
+    }
+    return n;
+}
+
+/* product.h: create() builds the instance in the memory it is given,
+ * whatever that held before (a board's buffer is not known to be zero):
+ * every object answers the same right after power-on and 100 ms later
+ * whether the memory was zero or full of other bytes. */
+static void test_create_on_used_memory(void)
+{
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        unsigned n = power_on_answers(product_list[i], 0x00, answers[0]);
+        (void)power_on_answers(product_list[i], 0xA5, answers[1]);
+        const co_od_t *od = co_cfg(d->node)->od;
+        for (unsigned pass = 0; pass < 2u; pass++) {
+            for (unsigned k = 0; k < n; k++) {
+                if (memcmp(answers[0][pass][k], answers[1][pass][k], 8) != 0) {
+                    fprintf(stderr, "  %s %04Xh:%u (pass %u) differs on used memory\n",
+                            product_list[i]->id, (unsigned)od->entries[k].index,
+                            (unsigned)od->entries[k].sub, pass);
+                    FAIL("an object depends on what the memory held before create()");
+                }
+            }
+        }
+    }
+}
+
+/* The GSH-A has two channels at most (the redundant version): a product
+ * row asking for more nodes is a programming error, reported (CO_CHECK),
+ * and two channels are built, no more. */
+static void test_gsh_at_most_two_channels(void)
+{
+    product_t row = gsh_a_redundant;
+    row.nodes = 3;
+    void *ports[3] = {&d->port, &d->port, &d->port};
+    co_node_t *nodes[3] = {NULL, NULL, NULL};
+    memset(d, 0, sizeof(*d));
+    fake_port_init(&d->port);
+    unsigned before = h_asserts;
+    h_expect_assert(1);
+    row.create(&row, d->mem, ports, nodes);
+    CHECK_EQ(h_asserts, before + 1u);
+    CHECK(nodes[0] != NULL && nodes[1] != NULL && nodes[2] == NULL);
+    CHECK_EQ(((gsh_dev_t *)h_inst(d))->nchan, 2);
+}
+
 /* The store record ("CoPS") at an EEPROM address. */
 static bool record_at(uint32_t addr)
 {
@@ -468,6 +585,7 @@ int main(void)
     RUN(test_dst_values);
     RUN(test_dst_node_id_pair_unchanged);
     RUN(test_dst_pair_copies_are_their_own);
+    RUN(test_dst_sensor_error_holds_the_slope);
     RUN(test_dst_stored_bitrate_codes);
     RUN(test_dst_resolution_kept_without_scaling);
     RUN(test_dst_big_endian_after_reset);
@@ -480,5 +598,7 @@ int main(void)
     RUN(test_written_mapping_sets_the_dlc);
     RUN(test_each_node_talks_through_its_port);
     RUN(test_each_node_stores_in_its_area);
+    RUN(test_create_on_used_memory);
+    RUN(test_gsh_at_most_two_channels);
     return h_finish();
 }
