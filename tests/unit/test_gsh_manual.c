@@ -348,6 +348,23 @@ static void test_alarms_counter_checksum(void)
     CHECK_EQ(h_read(d, 0x1001, 0), 0); /* always 0 */
 }
 
+/* The magnet field is judged in whole percent, rounded: 150.499 % and
+ * 49.5 % are within 50..150 %, 150.5 % is "too high", 49.499 % "too low"
+ * (the alarm word, 0x2110). */
+static void test_field_alarm_in_whole_percent(void)
+{
+    boot(&gsh_a);
+    static const struct {
+        int32_t field;
+        uint16_t alarms;
+    } v[] = {{150499, 0}, {150500, GSH_ALARM_FIELD_HIGH}, {49500, 0}, {49499, GSH_ALARM_FIELD_LOW}};
+    for (unsigned i = 0; i < sizeof(v) / sizeof(v[0]); i++) {
+        d->truth[GSH_IN_FIELD] = v[i].field;
+        h_advance(d, 10000);
+        CHECK_EQ(h_read(d, 0x2110, 0), v[i].alarms);
+    }
+}
+
 /* 0x1800 sub 1 has bit 30 clear (RTR allowed, CiA 301): a remote request
  * on 0x193 is answered at once, in the fixed layout with the next
  * counter; none outside operational. */
@@ -444,6 +461,7 @@ int main(void)
     RUN(test_e2_event_timer);
     RUN(test_e3_autostart_off);
     RUN(test_counter_from_zero_after_reset);
+    RUN(test_field_alarm_in_whole_percent);
     RUN(test_nmt_and_stopped);
     RUN(test_derived_reads_d1_to_d29);
     RUN(test_derived_aborts_d30_to_d39);
