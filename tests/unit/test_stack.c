@@ -1403,6 +1403,84 @@ static void test_bare_node_defaults(void)
     EXPECT_NONE(d);
 }
 
+/*
+ * Communication parameters kept in no RAM (constants) yet given their
+ * write hooks, as a product that fixes them might leave them: a write is
+ * refused as to a read-only object (0x06010002), never confirmed, and the
+ * node goes on with the constant. Its inhibit time unit is given as 5 ms:
+ * more than the 1 ms co_node_cfg_t allows, so it counts as 1 ms.
+ */
+static const co_od_entry_t c_entries[] = {
+    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
+    {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, .def = 0x80, CO_EXT(.write = co_sync_write_cobid)},
+    {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, .def = 0, CO_EXT(.write = co_hb_write_time)},
+    {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 2},
+    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, .def = 0x80000180u, CO_EXT(.write = co_tpdo_write_cobid)},
+    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = CO_A_RW, .def = 1, CO_EXT(.write = co_tpdo_write_comm)},
+    {.index = 0x1801, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 3},
+    {.index = 0x1801, .sub = 1, CO_TYPE_U32, .attr = CO_A_R | CO_A_NODEID, .def = 0x280},
+    {.index = 0x1801, .sub = 2, CO_TYPE_U8, .attr = CO_A_R, .def = 254},
+    {.index = 0x1801, .sub = 3, CO_TYPE_U16, .attr = CO_A_R, .def = 10},
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, .def = 1, CO_EXT(.write = co_tpdo_write_map)},
+    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, .def = 0x21000020u, CO_EXT(.write = co_tpdo_write_map)},
+    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
+    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21000020u},
+    {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, counter)},
+};
+
+static const co_od_t c_od = {.entries = c_entries, .count = sizeof(c_entries) / sizeof(c_entries[0])};
+
+static const co_node_cfg_t c_cfg = {
+    .od = &c_od,
+    .ram_size = {0, sizeof(b_vol_t), 0, 0},
+    .default_node_id = 0x20,
+    .inhibit_unit_us = 5000, /* counts as 1000 (co_node_cfg_t) */
+};
+
+static void c_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
+{
+    (void)p;
+    b_dev_t *b = mem;
+    memset(b, 0, sizeof(*b));
+    void *const ram[CO_CLS_COUNT] = {NULL, &b->vol, NULL, NULL};
+    co_node_init(&b->node, &c_cfg, ports[0], b, ram, 0);
+    nodes[0] = &b->node;
+}
+
+static const product_t c_prod = {.id = "constants", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
+                                 .inst_size = sizeof(b_dev_t), .create = c_create,
+                                 .sample = b_sample};
+
+static void test_constant_parameters_refuse_writes(void)
+{
+    h_boot(d, &c_prod, false);
+    EXPECT(d, 0x720, "00");
+    SDO(d, "2B 17 10 00 64 00 00 00", "80 17 10 00 02 00 01 06");
+    SDO(d, "23 05 10 00 81 00 00 00", "80 05 10 00 02 00 01 06");
+    SDO(d, "23 00 18 01 A0 01 00 00", "80 00 18 01 02 00 01 06");
+    SDO(d, "2F 00 18 02 02 00 00 00", "80 00 18 02 02 00 01 06");
+    SDO(d, "2F 00 1A 00 00 00 00 00", "80 00 1A 00 02 00 01 06");
+    CHECK_EQ(h_read(d, 0x1017, 0), 0);
+    CHECK_EQ(h_read(d, 0x1005, 0), 0x80);
+    CHECK_EQ(h_read(d, 0x1800, 1), 0x800001A0u);
+    CHECK_EQ(h_read(d, 0x1800, 2), 1);
+    CHECK_EQ(h_read(d, 0x1A00, 0), 1);
+    h_rx(d, 0x000, "01 20");
+    h_advance(d, 1000000);
+    h_rx(d, 0x080, "");
+    EXPECT_NONE(d); /* no heartbeat; TPDO1 stays invalid */
+    co_tpdo_event(d->node, 1);
+    h_advance(d, 0);
+    NEXT_IS(0x2A0);
+    uint32_t t0 = d->now;
+    co_tpdo_event(d->node, 1); /* inhibit time 10 x 1 ms */
+    h_advance(d, 9999);
+    EXPECT_NONE(d);
+    h_advance(d, 1);
+    NEXT_IS(0x2A0);
+    CHECK_EQ(d->now - t0, 10000);
+}
+
 int main(void)
 {
     RUN(test_od_find);
@@ -1442,5 +1520,6 @@ int main(void)
     RUN(test_sync_cobid_bits);
     RUN(test_emcy_cobid_restricted_and_as_written);
     RUN(test_bare_node_defaults);
+    RUN(test_constant_parameters_refuse_writes);
     return h_finish();
 }
