@@ -1481,6 +1481,93 @@ static void test_constant_parameters_refuse_writes(void)
     CHECK_EQ(d->now - t0, 10000);
 }
 
+static void nmt_restart(void)
+{
+    h_rx(d, 0x000, "80 10");
+    h_rx(d, 0x000, "01 10");
+}
+
+/* Entering operational again, every TPDO starts afresh (co_tpdo.h): the
+ * SYNC count from zero, the first change-driven (type 0) PDO sent whatever
+ * was sent before, nothing sampled for type 252, no event kept from
+ * before, no inhibit time running, the event timer's first send at once. */
+static void test_tpdo_restart_is_afresh(void)
+{
+    boot();
+    SDO(d, "2F 00 18 02 03 00 00 00", "60 00 18 02 00 00 00 00"); /* every 3rd SYNC */
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    h_rx(d, 0x080, "");
+    h_rx(d, 0x080, "");
+    EXPECT_NONE(d);
+    nmt_restart();
+    h_rx(d, 0x080, "");
+    h_rx(d, 0x080, "");
+    EXPECT_NONE(d); /* two SYNCs since the start, not four */
+    h_rx(d, 0x080, "");
+    NEXT_IS(0x190);
+    EXPECT_NONE(d);
+
+    boot();
+    SDO(d, "2F 00 18 02 00 00 00 00", "60 00 18 02 00 00 00 00"); /* on change */
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    h_rx(d, 0x080, "");
+    NEXT_IS(0x190);
+    h_rx(d, 0x080, "");
+    EXPECT_NONE(d); /* the same data */
+    nmt_restart();
+    h_rx(d, 0x080, "");
+    NEXT_IS(0x190); /* the first since the start */
+    EXPECT_NONE(d);
+
+    boot();
+    SDO(d, "2F 00 18 02 FC 00 00 00", "60 00 18 02 00 00 00 00"); /* sampled at SYNC */
+    h_rx(d, 0x000, "01 10");
+    h_rx(d, 0x080, "");
+    h_drain(d);
+    co_frame_t rtr = {.id = 0x190, .rtr = true, .dlc = 6};
+    h_rx_frame(d, &rtr);
+    NEXT_IS(0x190);
+    nmt_restart();
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT_NONE(d); /* no SYNC since the start: nothing sampled */
+
+    boot();
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* no timer */
+    SDO(d, "2B 00 18 03 E8 03 00 00", "60 00 18 03 00 00 00 00"); /* inhibit 100 ms */
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 0);
+    NEXT_IS(0x190);
+    co_tpdo_event(d->node, 0); /* waits for the inhibit time */
+    h_advance(d, 10000);
+    h_rx(d, 0x000, "80 10");
+    h_advance(d, 40000);
+    h_rx(d, 0x000, "01 10");
+    h_advance(d, 0);
+    EXPECT_NONE(d); /* the event from before is gone */
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 0);
+    NEXT_IS(0x190); /* at once: no inhibit time from before */
+    EXPECT_NONE(d);
+
+    boot();
+    h_rx(d, 0x000, "01 10"); /* event timer 100 ms: the first at once */
+    NEXT_IS(0x190);
+    h_advance(d, 30000);
+    EXPECT_NONE(d);
+    nmt_restart();
+    h_advance(d, 0);
+    NEXT_IS(0x190); /* at once again, not at the old deadline */
+    h_advance(d, 99999);
+    EXPECT_NONE(d);
+    h_advance(d, 1);
+    NEXT_IS(0x190);
+}
+
 int main(void)
 {
     RUN(test_od_find);
@@ -1521,5 +1608,6 @@ int main(void)
     RUN(test_emcy_cobid_restricted_and_as_written);
     RUN(test_bare_node_defaults);
     RUN(test_constant_parameters_refuse_writes);
+    RUN(test_tpdo_restart_is_afresh);
     return h_finish();
 }
