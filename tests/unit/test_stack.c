@@ -1311,7 +1311,8 @@ static void test_emcy_cobid_restricted_and_as_written(void)
  * heartbeat: no 0x1005 (SYNC on its default CAN-ID 0x080), no 0x1017 (no
  * heartbeat: guard requests are answered), TPDO1 with its COB-ID only
  * (transmission type 254, no inhibit time, no event timer: sent on each
- * application event), TPDO2 with a transmission type of 1.
+ * application event), TPDO2 with a transmission type of 1 mapping two
+ * sub-indices of a record.
  */
 typedef struct b_vol {
     uint32_t counter;
@@ -1334,9 +1335,13 @@ static const co_od_entry_t b_entries[] = {
     {.index = 0x1801, .sub = 2, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21000020u},
-    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
-    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21000020u},
+    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 2},
+    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x22000108u},
+    {.index = 0x1A01, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, .def = 0x22000210u},
     {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, counter)},
+    {.index = 0x2200, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 2},
+    {.index = 0x2200, .sub = 1, CO_TYPE_U8, .attr = CO_A_R | CO_A_PDO, .def = 0x11},
+    {.index = 0x2200, .sub = 2, CO_TYPE_U16, .attr = CO_A_R | CO_A_PDO, .def = 0x2233},
 };
 
 static const co_od_t b_od = {.entries = b_entries, .count = sizeof(b_entries) / sizeof(b_entries[0])};
@@ -1393,7 +1398,7 @@ static void test_bare_node_defaults(void)
     h_rx(d, 0x081, "");
     EXPECT_NONE(d);
     h_rx(d, 0x080, "");
-    NEXT_IS(0x2A0); /* SYNC on 0x080 */
+    EXPECT(d, 0x2A0, "11 33 22"); /* SYNC on 0x080; 0x2200 sub 1 and 2 mapped */
     EXPECT_NONE(d);
     h_rx(d, 0x07F, "");
     EXPECT_NONE(d);
@@ -1423,9 +1428,13 @@ static const co_od_entry_t c_entries[] = {
     {.index = 0x1801, .sub = 3, CO_TYPE_U16, .attr = CO_A_R, .def = 10},
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, .def = 1, CO_EXT(.write = co_tpdo_write_map)},
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, .def = 0x21000020u, CO_EXT(.write = co_tpdo_write_map)},
-    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
-    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21000020u},
+    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 2},
+    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x22000108u},
+    {.index = 0x1A01, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, .def = 0x22000210u},
     {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, counter)},
+    {.index = 0x2200, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 2},
+    {.index = 0x2200, .sub = 1, CO_TYPE_U8, .attr = CO_A_R | CO_A_PDO, .def = 0x11},
+    {.index = 0x2200, .sub = 2, CO_TYPE_U16, .attr = CO_A_R | CO_A_PDO, .def = 0x2233},
 };
 
 static const co_od_t c_od = {.entries = c_entries, .count = sizeof(c_entries) / sizeof(c_entries[0])};
