@@ -993,7 +993,10 @@ static void test_tpdo_rtr_and_types(void)
     CHECK(f != NULL && co_get_u32(f->data) == sampled);
     /* 0: at a SYNC, only if the data changed. */
     SDO(d, "2F 00 18 02 00 00 00 00", "60 00 18 02 00 00 00 00");
-    SDO(d, "2F 00 18 02 F1 00 00 00", "80 00 18 02 30 00 09 06"); /* reserved */
+    SDO(d, "2F 00 18 02 F1 00 00 00", "80 00 18 02 30 00 09 06"); /* reserved: 241..251 */
+    SDO(d, "2F 00 18 02 FB 00 00 00", "80 00 18 02 30 00 09 06");
+    SDO(d, "2F 00 18 02 F0 00 00 00", "60 00 18 02 00 00 00 00"); /* every 240th SYNC */
+    SDO(d, "2F 00 18 02 00 00 00 00", "60 00 18 02 00 00 00 00");
     h_drain(d);
     h_rx(d, 0x080, "");
     CHECK(h_next(d) != NULL);
@@ -1093,6 +1096,9 @@ static void test_tpdo_cobid_and_mapping_rules(void)
     SDO(d, "23 01 1A 01 20 00 00 20", "80 01 1A 01 41 00 04 06"); /* 0x2000 not mappable */
     SDO(d, "23 01 1A 01 20 00 05 21", "80 01 1A 01 00 00 02 06"); /* no 0x2105 */
     SDO(d, "23 01 1A 01 28 00 00 21", "80 01 1A 01 41 00 04 06"); /* 40 bits of a U32 */
+    SDO(d, "23 01 1A 01 21 00 00 21", "80 01 1A 01 41 00 04 06"); /* 33 bits: no whole bytes */
+    SDO(d, "23 01 1A 01 00 00 00 21", "80 01 1A 01 41 00 04 06"); /* 0 bits */
+    SDO(d, "23 01 1A 01 11 00 01 20", "80 01 1A 01 41 00 04 06"); /* 17 bits of an I16 */
     SDO(d, "23 01 1A 01 20 00 00 21", "60 01 1A 01 00 00 00 00");
     SDO(d, "23 01 1A 02 20 00 00 21", "60 01 1A 02 00 00 00 00");
     SDO(d, "2F 01 1A 00 02 00 00 00", "60 01 1A 00 00 00 00 00"); /* 64 bits: ok */
