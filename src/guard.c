@@ -20,8 +20,7 @@ void co_guard_reset(co_node_t *node)
     co_guard_t *g = &node->guard;
     g->enabled = co_node_entry(node, 0x100C, 0) != NULL;
     g->toggle = 0;
-    g->seen = false;
-    g->kick = false;
+    g->seen = false; /* kick counts only once a request is seen (receive sets both) */
     if (g->lost) {
         g->lost = false;
         (void)co_emcy_error(node, CO_EMCY_LIFE_GUARD, CO_ER_COMM, false, NULL);
@@ -74,13 +73,13 @@ uint32_t co_guard_poll(co_node_t *node, uint32_t now)
          * more than 2^31 us old, it reads as ahead, and the event came up to
          * 36 min late (found by tests/fuzz/fuzz_node.c). */
         g->seen = false;
-        g->kick = false;
         return CO_NEVER;
     }
     if (g->kick) {
+        /* The first lap starts at the request's time (receive set the
+         * deadline to it, never ahead of now): the loop below starts it. */
         g->kick = false;
         g->left_ms = life_ms;
-        next_lap(g, g->deadline); /* from the request's time (receive) */
     }
     while (!co_time_before(now, g->deadline)) {
         if (g->left_ms == 0u) {

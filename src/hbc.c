@@ -18,8 +18,7 @@ void co_hbc_reset(co_node_t *node)
     }
     c->node_id = (uint8_t)(v >> 16);
     c->time_ms = (uint16_t)v;
-    c->started = false;
-    c->kick = false;
+    c->started = false; /* kick counts only once started (receive sets both) */
     c->lost = false;
 }
 
@@ -55,7 +54,7 @@ bool co_hbc_receive(co_node_t *node, const co_frame_t *f)
 uint32_t co_hbc_poll(co_node_t *node, uint32_t now)
 {
     co_hbc_t *c = &node->hbc;
-    if (!c->started || c->lost || c->time_ms == 0u) {
+    if (!c->started || c->lost) { /* started: with a time (receive, reset) */
         return CO_NEVER;
     }
     if (c->kick) {

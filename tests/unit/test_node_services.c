@@ -260,6 +260,81 @@ static void test_life_guard_event_cleared_by_reset_communication(void)
     EXPECT(d, 0x740, "7F");
 }
 
+/* Life guarding (CiA 301) runs from the last guard request answered: a
+ * reset communication forgets the requests before it, and the life time
+ * starts again with the first one after. A life time factor of 0 is node
+ * guarding without life guarding: answered, never an event, no timer. */
+static void test_life_guard_starts_with_a_request(void)
+{
+    boot();
+    SDO(d, "2B 0C 10 00 64 00 00 00", "60 0C 10 00 00 00 00 00"); /* 100 ms */
+    co_frame_t rtr = {.id = 0x740, .rtr = true, .dlc = 1};
+    h_drain(d);
+    co_node_receive(d->node, &rtr, d->now);
+    EXPECT(d, 0x740, "7F");
+    CHECK_EQ(co_node_poll(d->node, d->now), CO_NEVER); /* nothing to time */
+    h_advance(d, 1000000);
+    EXPECT_NONE(d);
+    SDO(d, "2F 0D 10 00 02 00 00 00", "60 0D 10 00 00 00 00 00"); /* x 2 */
+    CHECK(co_store_save(d->node, CO_CLS_PARA) == CO_OK); /* kept over the reset */
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x740, "FF");
+    h_advance(d, 100000);
+    h_rx(d, 0x000, "82 40");
+    EXPECT(d, 0x740, "00");
+    h_advance(d, 1000000);
+    EXPECT_NONE(d); /* no request since the reset: not guarded yet */
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x740, "7F"); /* the toggle bit starts at 0 again */
+    h_advance(d, 199999);
+    EXPECT_NONE(d);
+    d->now++;
+    CHECK_EQ(co_node_poll(d->node, d->now), CO_NEVER); /* lost: no timer after */
+    EXPECT(d, 0xC0, "30 81 11 00 00 00 00 00");
+}
+
+/* Life guarding and the heartbeat consumer report one EMCY code (8130h);
+ * each one's event ends by its own protocol only: a guard request after a
+ * reset does not end the consumer's event, nor a heartbeat after a new
+ * 0x1016 value the life guarding's. */
+static void test_guard_and_consumer_events_apart(void)
+{
+    boot();
+    SDO(d, "2B 0C 10 00 64 00 00 00", "60 0C 10 00 00 00 00 00"); /* 100 ms */
+    SDO(d, "2F 0D 10 00 02 00 00 00", "60 0D 10 00 00 00 00 00"); /* x 2 */
+    co_frame_t rtr = {.id = 0x740, .rtr = true, .dlc = 1};
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x740, "7F");
+    h_advance(d, 200000);
+    EXPECT(d, 0xC0, "30 81 11 00 00 00 00 00"); /* life guarding's event */
+    h_rx(d, 0x000, "82 40");
+    EXPECT(d, 0x740, "00");
+    CHECK_EQ(h_read(d, 0x1001, 0), 0);
+    SDO(d, "23 16 10 01 64 00 05 00", "60 16 10 01 00 00 00 00"); /* node 5, 100 ms */
+    h_rx(d, 0x705, "05");
+    h_advance(d, 100000);
+    EXPECT(d, 0xC0, "30 81 11 00 00 00 00 00"); /* the consumer's event */
+    SDO(d, "2B 0C 10 00 64 00 00 00", "60 0C 10 00 00 00 00 00");
+    SDO(d, "2F 0D 10 00 02 00 00 00", "60 0D 10 00 00 00 00 00");
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x740, "7F");
+    EXPECT_NONE(d); /* a guard request: the consumer's event stays */
+    CHECK_EQ(h_read(d, 0x1001, 0), 0x11);
+    /* A new consumer time ends its event; then life guarding's comes. */
+    h_drain(d);
+    h_rx(d, 0x640, "23 16 10 01 C8 00 05 00");
+    EXPECT(d, 0xC0, "00 00 00 00 00 00 00 00");
+    EXPECT(d, 0x5C0, "60 16 10 01 00 00 00 00");
+    h_advance(d, 200000);
+    EXPECT(d, 0xC0, "30 81 11 00 00 00 00 00");
+    h_rx(d, 0x705, "05");
+    EXPECT_NONE(d); /* a heartbeat: life guarding's event stays */
+    CHECK_EQ(h_read(d, 0x1001, 0), 0x11);
+}
+
 /* Heartbeat consumer (0x1016): only a 1-byte heartbeat of the node it
  * watches counts; the event (8130h) ends with the next heartbeat or a new
  * 0x1016 value. */
@@ -268,6 +343,7 @@ static void test_heartbeat_consumer(void)
     boot();
     SDO(d, "23 16 10 01 64 00 05 01", "80 16 10 01 30 00 09 06"); /* bits 24-31 */
     SDO(d, "23 16 10 01 64 00 80 00", "80 16 10 01 30 00 09 06"); /* node 128 */
+    SDO(d, "23 16 10 01 65 00 7F 00", "60 16 10 01 00 00 00 00"); /* node 127, 101 ms */
     SDO(d, "23 16 10 01 64 00 05 00", "60 16 10 01 00 00 00 00"); /* node 5, 100 ms */
     h_rx(d, 0x000, "01 40");
     h_drain(d);
@@ -293,6 +369,30 @@ static void test_heartbeat_consumer(void)
     h_drain(d);
     h_advance(d, 1000000);
     EXPECT_NONE(d); /* waits for the first heartbeat again */
+}
+
+/* The consumer's timer as a board sees it: the poll asks to be called
+ * when the consumer time runs out, and for nothing after the event; 1 ms
+ * is a time too. The consumer takes only heartbeats: a TPDO still answers
+ * its remote request. */
+static void test_heartbeat_consumer_timer(void)
+{
+    boot();
+    SDO(d, "23 16 10 01 01 00 05 00", "60 16 10 01 00 00 00 00"); /* node 5, 1 ms */
+    h_drain(d);
+    h_rx(d, 0x705, "05");
+    CHECK_EQ(co_node_poll(d->node, d->now), 1000);
+    CHECK_EQ(co_node_poll(d->node, d->now + 999u), 1);
+    EXPECT_NONE(d);
+    d->now += 1000u;
+    CHECK_EQ(co_node_poll(d->node, d->now), CO_NEVER);
+    EXPECT(d, 0xC0, "30 81 11 00 00 00 00 00");
+    h_rx(d, 0x000, "01 40");
+    h_drain(d);
+    co_frame_t rtr = {.id = 0x1C0, .rtr = true, .dlc = 0};
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x1C0, "44 33 22 11 66 55");
+    EXPECT_NONE(d);
 }
 
 /* A poll late by more than a period sends one heartbeat, not a burst. */
@@ -462,7 +562,10 @@ int main(void)
     RUN(test_lss_store_in_lss_set);
     RUN(test_lss_fastscan_ignored_requests);
     RUN(test_life_guard_event_cleared_by_reset_communication);
+    RUN(test_life_guard_starts_with_a_request);
+    RUN(test_guard_and_consumer_events_apart);
     RUN(test_heartbeat_consumer);
+    RUN(test_heartbeat_consumer_timer);
     RUN(test_heartbeat_late_poll);
     RUN(test_nmt_state_hook);
     RUN(test_cia303_led_mapping);
