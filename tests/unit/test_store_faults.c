@@ -38,9 +38,13 @@ static const co_od_entry_t s_entries[] = {
     LOAD(3, co_store_write_group_load),
     LOAD(4, co_store_write_group_load),
     {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, PARA(0), .def = 0, CO_EXT(.write = co_hb_write_time)},
+    {.index = 0x1FFF, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, PARA(2), .def = 0},
     {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, PARA(4), .def = 100},
     {.index = 0x2001, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, PARA(22), .def = 0xA5A5A5A5u},
+    {.index = 0x5FFF, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, PARA(3), .def = 0},
     {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, PARA(28), .def = 7},
+    {.index = 0x9FFF, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, PARA(30), .def = 0},
+    {.index = 0xA000, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, PARA(31), .def = 0}, /* in no group */
 };
 
 static const co_od_t s_od = {.entries = s_entries, .count = sizeof(s_entries) / sizeof(s_entries[0])};
@@ -394,6 +398,40 @@ static void test_read_fault_in_save_all(void)
     CHECK(refused >= 10);
 }
 
+/* The edges of the groups (0x1FFF, 0x2000, 0x5FFF, 0x6000, 0x9FFF) belong
+ * to their group alone, and 0xA000 to none: a group save stores what is in
+ * its range and keeps the stored (here: default) value of the rest. */
+static void test_group_edges(void)
+{
+    static const uint16_t edge[4] = {0x1FFF, 0x5FFF, 0x9FFF, 0xA000};
+    static const char *const save[3] = {"23 10 10 02 73 61 76 65", "23 10 10 04 73 61 76 65",
+                                        "23 10 10 03 73 61 76 65"};
+    for (unsigned g = 0; g < 3u; g++) {
+        boot();
+        set_all(100, 200, 0x11223344u, 300);
+        for (unsigned i = 0; i < 4u; i++) {
+            char req[64];
+            char resp[64];
+            snprintf(req, sizeof(req), "2F %02X %02X 00 %02X 00 00 00", edge[i] & 0xFFu,
+                     edge[i] >> 8, i + 1u);
+            snprintf(resp, sizeof(resp), "60 %02X %02X 00 00 00 00 00", edge[i] & 0xFFu,
+                     edge[i] >> 8);
+            SDO(d, req, resp);
+        }
+        h_drain(d);
+        h_rx(d, 0x630, save[g]);
+        const co_frame_t *f = h_next(d);
+        CHECK(f != NULL && f->data[0] == 0x60);
+        h_power_cycle(d);
+        /* Group g holds edge g only (comm: 0x1FFF, manufacturer: 0x5FFF, application: 0x9FFF). */
+        for (unsigned i = 0; i < 4u; i++) {
+            CHECK_EQ(h_read(d, edge[i], 0), i == g ? (long long)(i + 1u) : 0);
+        }
+        EXPECT_ALL(g == 0u ? 100 : 0, g == 1u ? 200 : 100, g == 1u ? 0x11223344u : 0xA5A5A5A5u,
+                   g == 2u ? 300 : 7);
+    }
+}
+
 /* The slot at NVM offset at holds exactly these bytes (hex). */
 static void expect_slot(unsigned at, const char *hex, int line)
 {
@@ -430,24 +468,25 @@ static void test_record_bytes(void)
     set_all(100, 200, 0x11223344u, 300);
     SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
     /* The parameters: slot 0, sequence 1, the first write. */
-    EXPECT_SLOT(0, "43 6F 50 53 51 64 8F DE 01 00 00 00 01 00 00 00 20 00 00 02 00 00 00 00 "
+    EXPECT_SLOT(0, "43 6F 50 53 D7 1A 7F DA 01 00 00 00 01 00 00 00 20 00 00 02 00 00 00 00 "
                    "64 00 00 00 C8 00 00 00 00 00 00 00 00 00 00 00 00 00 00 00 00 00 44 33 "
-                   "22 11 00 00 2C 01 00 00 37 14 31 17");
+                   "22 11 00 00 2C 01 00 00 91 78 F6 5F");
     /* The node-ID set (0x30, bit-rate code 3): slot 2, the second write. */
     EXPECT_SLOT(2, "43 6F 50 53 C7 9D 1C 81 01 00 00 00 02 00 00 00 02 00 00 03 00 00 00 00 "
                    "30 03 2D E1 42 69");
     /* "load": records of no data with the defaults flag, in the other slots. */
     SDO(d, "23 11 10 01 6C 6F 61 64", "60 11 10 01 00 00 00 00");
-    EXPECT_SLOT(1, "43 6F 50 53 51 64 8F DE 02 00 00 00 03 00 00 00 00 00 01 02 00 00 00 00 "
-                   "06 BE 3A 91");
+    EXPECT_SLOT(1, "43 6F 50 53 D7 1A 7F DA 02 00 00 00 03 00 00 00 00 00 01 02 00 00 00 00 "
+                   "59 81 50 86");
     EXPECT_SLOT(3, "43 6F 50 53 C7 9D 1C 81 02 00 00 00 04 00 00 00 00 00 01 03 00 00 00 00 "
                    "F9 44 91 0D");
-    EXPECT_SLOT(0, "43 6F 50 53 51 64 8F DE 01 00 00 00 01 00 00 00 20 00 00 02"); /* kept */
+    EXPECT_SLOT(0, "43 6F 50 53 D7 1A 7F DA 01 00 00 00 01 00 00 00 20 00 00 02"); /* kept */
 }
 
 int main(void)
 {
     RUN(test_record_bytes);
+    RUN(test_group_edges);
     RUN(test_group_save);
     RUN(test_group_load);
     RUN(test_group_save_after_load);
