@@ -53,6 +53,43 @@ static void test_filter_settling(void)
     CHECK_EQ(co_filter_step(&f, -12345, 5), -12345);
 }
 
+/* The filter sample by sample: three cascaded stages y += (x - y) >> k in
+ * Q8 millidegrees, the output rounded to the nearest millidegree (a half
+ * up). A step from 0 to 6.401 deg, medium speed (k = 3): the first output
+ * is 12.5 mdeg (rounded up to 13), the fourth 186.496 (down to 186). */
+static void test_filter_exact_response(void)
+{
+    CHECK_EQ(co_filter_shift(0), 5);
+    CHECK_EQ(co_filter_shift(1), 3);
+    CHECK_EQ(co_filter_shift(2), 2);
+    /* A speed the header does not name (a corrupt setting): slow. */
+    CHECK_EQ(co_filter_shift(3), 5);
+    CHECK_EQ(co_filter_shift(255), 5);
+    co_filter_t f;
+    co_filter_reset(&f);
+    CHECK_EQ(co_filter_step(&f, 0, co_filter_shift(1)), 0);
+    static const int32_t out[] = {13, 45, 103, 186};
+    for (unsigned i = 0; i < 4u; i++) {
+        CHECK_EQ(co_filter_step(&f, 6401, co_filter_shift(1)), out[i]);
+    }
+    /* The input range: +-CO_FILTER_IN_MAX (about 4194 deg) passes as it is,
+     * beyond it saturates (the first sample passes straight through). */
+    static const struct {
+        int32_t in, out;
+    } bound[] = {{3000000, 3000000},
+                 {-3000000, -3000000},
+                 {CO_FILTER_IN_MAX, CO_FILTER_IN_MAX},
+                 {-CO_FILTER_IN_MAX - 1, -CO_FILTER_IN_MAX - 1},
+                 {CO_FILTER_IN_MAX + 1, CO_FILTER_IN_MAX},
+                 {-CO_FILTER_IN_MAX - 2, -CO_FILTER_IN_MAX - 1},
+                 {INT32_MAX, CO_FILTER_IN_MAX},
+                 {INT32_MIN, -CO_FILTER_IN_MAX - 1}};
+    for (unsigned i = 0; i < sizeof(bound) / sizeof(bound[0]); i++) {
+        co_filter_reset(&f);
+        CHECK_EQ(co_filter_step(&f, bound[i].in, 5), bound[i].out);
+    }
+}
+
 static void test_filter_through_the_device(void)
 {
     static h_dev_t dv;
@@ -396,6 +433,7 @@ static void test_led_patterns(void)
 int main(void)
 {
     RUN(test_filter_settling);
+    RUN(test_filter_exact_response);
     RUN(test_filter_through_the_device);
     RUN(test_incl_arithmetic);
     RUN(test_incl_wrap);
