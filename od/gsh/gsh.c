@@ -151,6 +151,5 @@ void gsh_sample(void *mem, const int32_t values[], uint32_t faults)
         c->position_mm = (uint16_t)(i == 0u ? len_mm : GSH_STROKE_MM - len_mm);
         c->alarms = alarms;
         co_incl_sample(&c->incl, angle);
-        co_node_wake(&c->node);
     }
 }

@@ -402,6 +402,11 @@ static void test_redundant_channels_are_independent(void)
     h_drain(d);
     h_rx(d, 0x614, "40 00 18 05 00 00 00 00");
     EXPECT_ID(d, 0x594, "4B 00 18 05 64 00 00 00"); /* ch 2 still 100 ms */
+    /* Each channel's 0x3001 reads its own node-ID, 0x13 and 0x14. */
+    h_rx(d, 0x613, "40 01 30 00 00 00 00 00");
+    EXPECT_ID(d, 0x593, "4F 01 30 00 13 00 00 00");
+    h_rx(d, 0x614, "40 01 30 00 00 00 00 00");
+    EXPECT_ID(d, 0x594, "4F 01 30 00 14 00 00 00");
     h_power_cycle(d);
     h_drain(d);
     h_advance(d, 1000000 - 1);
@@ -414,6 +419,27 @@ static void test_redundant_channels_are_independent(void)
     }
     CHECK_EQ(n1, 5);
     CHECK_EQ(n2, 10);
+}
+
+/* A node-ID set that fails its check at power-on (node-ID 0) gives the
+ * channel its own default back: 0x14 on channel 2 (0x3001, R-27). Only
+ * where the fake EEPROM holds the second node's area (not the qemu build's
+ * 1 KB). */
+static void test_channel2_node_id_default_after_a_bad_set(void)
+{
+    boot(&gsh_a_redundant);
+    if (d->nodes[1]->nvm_base + CO_STORE_NVM_SIZE > sizeof(d->port.nvm)) {
+        return;
+    }
+    gsh_dev_t *g = h_inst(d);
+    g->ch[1].lss.node_id = 0;
+    CHECK_EQ(co_store_save(d->nodes[1], CO_CLS_LSS), CO_OK);
+    h_power_cycle(d);
+    EXPECT_ID(d, 0x714, "00");
+    CHECK_EQ(d->nodes[1]->store.status[CO_CLS_LSS], CO_STORE_CORRUPT);
+    h_drain(d);
+    h_rx(d, 0x614, "40 01 30 00 00 00 00 00");
+    EXPECT_ID(d, 0x594, "4F 01 30 00 14 00 00 00");
 }
 
 static void test_group_save(void)
@@ -468,6 +494,7 @@ int main(void)
     RUN(test_alarms_counter_checksum);
     RUN(test_rtr_answered);
     RUN(test_redundant_channels_are_independent);
+    RUN(test_channel2_node_id_default_after_a_bad_set);
     RUN(test_group_save);
     RUN(test_write_count_across_restart);
     return h_finish();
