@@ -1118,6 +1118,11 @@ static void test_tpdo_cobid_and_mapping_rules(void)
     if (f != NULL) {
         CHECK_EQ(f->data[4], 0xFB); /* 0x2001 = -5 after the counter */
     }
+    /* 241..251 are reserved values of the transmission type only. */
+    SDO(d, "2B 00 18 03 F5 00 00 00", "60 00 18 03 00 00 00 00"); /* inhibit 245 x 100 us */
+    SDO(d, "23 00 18 01 F5 00 00 00", "60 00 18 01 00 00 00 00"); /* CAN-ID 0x0F5 */
+    SDO(d, "40 00 18 01 00 00 00 00", "43 00 18 01 F5 00 00 00");
+    SDO(d, "40 00 18 03 00 00 00 00", "4B 00 18 03 F5 00 00 00");
 }
 
 /* The next sent frame has this CAN-ID (its data vary with the clock). */
@@ -1583,6 +1588,32 @@ static void test_tpdo_restart_is_afresh(void)
     NEXT_IS(0x190);
 }
 
+/* Reset communication brings TPDO2's default mapping back, which names an
+ * object that cannot be mapped: TPDO2, valid and sending before, is then
+ * silent (co_tpdo.h: an unusable mapping leaves the PDO invalid). */
+static void test_tpdo_unusable_default_mapping_after_reset(void)
+{
+    boot();
+    SDO(d, "23 01 18 01 90 02 00 80", "60 01 18 01 00 00 00 00"); /* off to remap */
+    SDO(d, "2F 01 1A 00 00 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 1A 01 10 00 01 20", "60 01 1A 01 00 00 00 00"); /* 0x2001, 16 bits */
+    SDO(d, "2F 01 1A 00 01 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 18 01 90 02 00 00", "60 01 18 01 00 00 00 00");
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* TPDO1 quiet */
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    h_rx(d, 0x080, "");
+    EXPECT(d, 0x290, "FB FF"); /* type 1: every SYNC */
+    h_rx(d, 0x000, "82 10");
+    EXPECT(d, 0x710, "00");
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    for (unsigned k = 0; k < 3u; k++) {
+        h_rx(d, 0x080, "");
+    }
+    CHECK_EQ(count_id(d, 0x290), 0);
+}
+
 int main(void)
 {
     RUN(test_od_find);
@@ -1624,5 +1655,6 @@ int main(void)
     RUN(test_bare_node_defaults);
     RUN(test_constant_parameters_refuse_writes);
     RUN(test_tpdo_restart_is_afresh);
+    RUN(test_tpdo_unusable_default_mapping_after_reset);
     return h_finish();
 }
