@@ -306,11 +306,12 @@ static bool cmd_can(serial_link_t *s, tokens_t *t, serial_put_fn put)
 /* `get`: "ok NAME=VALUE ..." in the product's input order, thousandths,
  * as the Linux program answers it but without its "nmt=" word: the line
  * sees the inputs, not the node (its NMT state is on the bus, in the
- * heartbeat). Returns false (answered "error") for words after it. */
-static bool cmd_get(const serial_link_t *s, tokens_t *t, serial_put_fn put)
+ * heartbeat). Words after it: answered "error" instead. */
+static void cmd_get(const serial_link_t *s, tokens_t *t, serial_put_fn put)
 {
     if (next_token(t) != NULL) {
-        return fail(put, "get takes nothing after it", "", "");
+        (void)fail(put, "get takes nothing after it", "", "");
+        return;
     }
     put_str(put, "ok");
     for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && s->prod->inputs[i].name != NULL; i++) {
@@ -327,7 +328,6 @@ static bool cmd_get(const serial_link_t *s, tokens_t *t, serial_put_fn put)
         put((char)('0' + m % 10u));
     }
     put('\r');
-    return true;
 }
 
 /* The Linux program's commands this image does not have, each answered
@@ -363,7 +363,7 @@ static void input_line(serial_link_t *s, serial_put_fn put)
     } else if (equal(cmd, "can")) {
         ok = cmd_can(s, &t, put);
     } else if (equal(cmd, "get")) {
-        (void)cmd_get(s, &t, put);
+        cmd_get(s, &t, put);
         return; /* answered: "ok ..." or "error: ..." */
     } else if (not_here(cmd)) {
         ok = fail(put, "'", cmd, "' is not on this target (set, fault, can, get)");

@@ -87,6 +87,8 @@ static void test_frames_in(void)
     CHECK_EQ(FEED("T0000060A200\r", &f), 0);            /* extended frame */
     CHECK_EQ(FEED("t60\r", &f), 0);                     /* cut short */
     CHECK_EQ(FEED("O\rC\rS6\rV\r\r\n", &f), 0);         /* adapter commands, blank lines */
+    /* Acceptance code and mask (M, m) as long as a 2-byte frame line. */
+    CHECK_EQ(FEED("M00020000\rm7FF200FF\r", &f), 0);
     CHECK_EQ(out[0], '\0');
     /* One too long for the line, then a good one: only the good one. */
     CHECK_EQ(FEED("t60A80000000000000000000000000000000000000000000000000000\rt0010\r", &f), 1);
@@ -443,6 +445,48 @@ static void test_get_digits_and_fault_usage(void)
     CHECK_EQ(s.faults, 0u);
 }
 
+/* A product of the test's own with every input and fault place used
+ * (PRODUCT_MAX_INPUTS of each, no NULL to end the lists) and initial
+ * values that are not 0: the link starts from them, and reads, sets, gets
+ * and forces within the lists. */
+static const product_t full = {
+    .id = "test-full",
+    .inputs = {{"a", "u", 1500, 10}, {"b", "u", -2000, 10}, {"c", "u", 3, 10}, {"d", "u", 4000, 10}},
+    .faults = {"f0", "f1", "f2", "f3"},
+    .nodes = 1,
+};
+
+static void test_full_lists(void)
+{
+    serial_link_t t;
+    memset(&t, 0x5A, sizeof t);
+    int32_t v[PRODUCT_MAX_INPUTS] = {7, 7, 7, 7};
+    uint32_t faults = 99;
+    serial_link_sample(&t, &full, v, &faults);
+    CHECK(v[0] == 1500 && v[1] == -2000 && v[2] == 3 && v[3] == 4000);
+    CHECK_EQ(faults, 0);
+    serial_link_init(&s, &full);
+    co_frame_t f;
+    CHECK_EQ(FEED("get\r", &f), 0);
+    CHECK(same(out, "ok a=1.500 b=-2.000 c=0.003 d=4.000\r"));
+    CHECK_EQ(FEED("set d=9.5\r", &f), 0);
+    CHECK(same(out, "ok\r"));
+    CHECK(s.values[0] == 1500 && s.values[1] == -2000 && s.values[2] == 3 && s.values[3] == 9500);
+    CHECK_EQ(FEED("set f0=1\r", &f), 0);
+    CHECK(same(out, "error: 'f0': not an input of this product (NAME=VALUE)\r"));
+    CHECK_EQ(FEED("fault f3 on\r", &f), 0);
+    CHECK(same(out, "ok\r"));
+    CHECK_EQ(s.faults, 8u);
+    CHECK_EQ(FEED("fault a on\r", &f), 0);
+    CHECK(same(out, "error: usage: fault f0|f1|f2|f3 on|off\r"));
+    CHECK_EQ(s.faults, 8u);
+    /* A number of more digits than 32 bits hold is refused, not wrapped:
+     * 4294967297 is 2^32 + 1. */
+    CHECK_EQ(FEED("set a=4294967297\r", &f), 0);
+    CHECK(starts(out, "error: '4294967297': not a number"));
+    CHECK_EQ(s.values[0], 1500);
+}
+
 int main(void)
 {
     RUN(test_sample);
@@ -456,5 +500,6 @@ int main(void)
     RUN(test_line_length_and_separators);
     RUN(test_bitrate_codes_and_recovery);
     RUN(test_get_digits_and_fault_usage);
+    RUN(test_full_lists);
     return h_finish();
 }
