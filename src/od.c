@@ -104,28 +104,23 @@ const co_od_entry_t *co_od_find(const co_od_t *od, uint16_t index, uint8_t sub, 
 /* Load a size-byte little-endian host value, sign-extending INTEGERn. */
 static uint32_t load_value(const co_od_entry_t *e, const uint8_t *p)
 {
-    uint32_t v = 0;
     switch (e->size) {
     case 1: {
         uint8_t x;
         memcpy(&x, p, 1);
-        v = is_signed(e) ? (uint32_t)(int32_t)(int8_t)x : x;
-        break;
+        return is_signed(e) ? (uint32_t)(int32_t)(int8_t)x : x;
     }
     case 2: {
         uint16_t x;
         memcpy(&x, p, 2);
-        v = is_signed(e) ? (uint32_t)(int32_t)(int16_t)x : x;
-        break;
+        return is_signed(e) ? (uint32_t)(int32_t)(int16_t)x : x;
     }
     default: {
         uint32_t x;
         memcpy(&x, p, 4);
-        v = x;
-        break;
+        return x;
     }
     }
-    return v;
 }
 
 static void store_value(const co_od_entry_t *e, uint8_t *p, uint32_t v)
@@ -268,9 +263,7 @@ co_res_t co_od_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf
     if (!is_number(e)) {
         return CO_E_RO; /* no writable strings in any product yet */
     }
-    uint8_t tmp[4] = {0, 0, 0, 0};
-    memcpy(tmp, buf, len);
-    return write_value(node, e, load_value(e, tmp));
+    return write_value(node, e, load_value(e, buf)); /* len is the entry's size */
 }
 
 bool co_od_validate(co_node_t *node, const co_od_entry_t *e)

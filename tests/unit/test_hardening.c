@@ -67,11 +67,40 @@ static void test_emcy_cobid_base_reads_back_as_written(void)
     h_power_cycle(d);
     EXPECT(d, 0x77F, "00");
     SDO(d, "40 14 10 00 00 00 00 00", "43 14 10 00 80 00 00 00");
+    /* A CAN-ID next to the base (0x081), or next to the default 0x0FF, is
+     * a CAN-ID of its own as well: it reads back as written. */
+    SDO(d, "23 14 10 00 81 00 00 00", "60 14 10 00 00 00 00 00");
+    SDO(d, "40 14 10 00 00 00 00 00", "43 14 10 00 81 00 00 00");
+    SDO(d, "23 14 10 00 FE 00 00 00", "60 14 10 00 00 00 00 00");
+    SDO(d, "40 14 10 00 00 00 00 00", "43 14 10 00 FE 00 00 00");
+    SDO(d, "23 14 10 00 80 00 00 00", "60 14 10 00 00 00 00 00");
     /* The JD (node 10) the same way, through CiA 301's invalid-first rule. */
     boot(&jd2xxx);
     SDO(d, "23 14 10 00 8A 00 00 80", "60 14 10 00 00 00 00 00");
     SDO(d, "23 14 10 00 80 00 00 00", "60 14 10 00 00 00 00 00");
     SDO(d, "40 14 10 00 00 00 00 00", "43 14 10 00 80 00 00 00");
+}
+
+/* A COB-ID set to a CAN-ID of its own (EMCY 0x086 on node 5) keeps it
+ * through node-ID changes, also through node 6, whose default EMCY COB-ID
+ * it equals, and a save there: on node 7 it is 0x086 still. */
+static void test_emcy_cobid_own_id_through_node_id_changes(void)
+{
+    const uint8_t ids[PRODUCT_MAX_NODES] = {5};
+    h_boot_ids(d, &pf_iny360d, ids);
+    EXPECT(d, 0x705, "00");
+    SDO(d, "23 14 10 00 86 00 00 80", "60 14 10 00 00 00 00 00");
+    SDO(d, "23 14 10 00 86 00 00 00", "60 14 10 00 00 00 00 00");
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    d->factory_id[0] = 6;
+    h_power_cycle(d);
+    EXPECT(d, 0x706, "00");
+    SDO(d, "40 14 10 00 00 00 00 00", "43 14 10 00 86 00 00 00");
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    d->factory_id[0] = 7;
+    h_power_cycle(d);
+    EXPECT(d, 0x707, "00");
+    SDO(d, "40 14 10 00 00 00 00 00", "43 14 10 00 86 00 00 00");
 }
 
 static void sync_bit30_refused(const product_t *p)
@@ -388,6 +417,7 @@ int main(void)
 {
     RUN(test_emcy_cobid_refuses_restricted_ids);
     RUN(test_emcy_cobid_base_reads_back_as_written);
+    RUN(test_emcy_cobid_own_id_through_node_id_changes);
     RUN(test_sync_cobid_refuses_bit30);
     RUN(test_jd_differential_offset_range);
     RUN(test_jd_slope_saturates_with_any_stored_offset);

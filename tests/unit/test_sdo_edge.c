@@ -8,11 +8,14 @@
 #include "harness.h"
 
 #define LONG_NAME "A device name of seventy bytes, longer than the SDO transfer buffer..."
+#define BUF_NAME "A string of sixty-four bytes: exactly the SDO transfer buffer..."
 
 typedef struct e_para {
     uint32_t u32;
     int8_t i8;
     uint16_t hb;
+    uint16_t ro;
+    uint32_t cob;
 } e_para_t;
 
 typedef struct e_dev {
@@ -33,6 +36,8 @@ static const co_od_entry_t e_entries[] = {
     {.index = 0x1008, .sub = 0, CO_TYPE_STR(LONG_NAME), .attr = CO_A_R | CO_A_CONST},
     {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(hb), .def = 0, CO_EXT(.write = co_hb_write_time)},
     {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(u32), .def = 100, CO_EXT(.min = 10, .max = 1000)},
+    /* Read-only, with a value in RAM (the product sets it). */
+    {.index = 0x2001, .sub = 0, CO_TYPE_U16, .attr = CO_A_R, P(ro), .def = 7},
     {.index = 0x2003, .sub = 0, CO_TYPE_I8, .attr = CO_A_RW, P(i8), .def = (uint32_t)-3, CO_EXT(.min = -10, .max = 10)},
     /* A writable string: the stack stores no strings yet (co_od_write). */
     {.index = 0x2004, .sub = 0, CO_TYPE_STR("12345678"), .attr = CO_A_RW},
@@ -42,6 +47,13 @@ static const co_od_entry_t e_entries[] = {
     {.index = 0x2006, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, .def = 5},
     /* Writable and longer than the transfer buffer. */
     {.index = 0x2007, .sub = 0, CO_TYPE_STR(LONG_NAME), .attr = CO_A_RW},
+    /* In a class this node keeps no RAM for (no LSS record), not at offset 0. */
+    {.index = 0x2008, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, CO_AT(CO_CLS_LSS, co_lss_para_t, bitrate), .def = 3},
+    /* A COB-ID of the manufacturer's that follows the node-ID from an odd base. */
+    {.index = 0x2009, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, P(cob), .def = 0x381},
+    /* Writable strings of exactly the transfer buffer, and of 5 bytes. */
+    {.index = 0x200A, .sub = 0, CO_TYPE_STR(BUF_NAME), .attr = CO_A_RW},
+    {.index = 0x200B, .sub = 0, CO_TYPE_STR("12345"), .attr = CO_A_RW},
 };
 
 static const co_od_t e_od = {.entries = e_entries, .count = sizeof(e_entries) / sizeof(e_entries[0])};
@@ -109,6 +121,21 @@ static void test_segmented_download_refusals(void)
     CHECK_EQ(h_read(d, 0x2000, 0), 100);
 }
 
+/* An object of exactly the transfer buffer's 64 bytes is taken, segmented
+ * and block (only the write refuses a string); an expedited download
+ * without size carries 4 bytes, too few for a 5-byte object. */
+static void test_buffer_sized_object(void)
+{
+    boot();
+    CHECK_EQ(sizeof(BUF_NAME) - 1u, CO_SDO_BUF);
+    SDO(d, "21 0A 20 00 40 00 00 00", "60 0A 20 00 00 00 00 00");
+    SDO(d, "20 0A 20 00 00 00 00 00", "60 0A 20 00 00 00 00 00");
+    SDO(d, "C6 0A 20 00 40 00 00 00", "A4 0A 20 00 0A 00 00 00");
+    h_rx(d, 0x620, "80 0A 20 00 00 00 04 05"); /* the client aborts */
+    EXPECT_NONE(d);
+    SDO(d, "22 0B 20 00 31 32 33 34", "80 0B 20 00 13 00 07 06");
+}
+
 /* Writable strings are refused whole (co_od_write: none is stored yet),
  * after all their segments, with 0x06010002; the object keeps its value. */
 static void test_writable_string_refused(void)
@@ -131,6 +158,9 @@ static void test_write_only_reads(void)
     /* Writable without RAM: 0x06010002, and it still reads its constant. */
     SDO(d, "23 06 20 00 07 00 00 00", "80 06 20 00 02 00 01 06");
     SDO(d, "40 06 20 00 00 00 00 00", "43 06 20 00 05 00 00 00");
+    /* So is an object of a class the node was given no RAM for. */
+    SDO(d, "2F 08 20 00 07 00 00 00", "80 08 20 00 02 00 01 06");
+    SDO(d, "40 08 20 00 00 00 00 00", "4F 08 20 00 03 00 00 00");
     /* An RTR on the SDO CAN-ID is no request: no answer. */
     h_drain(d);
     co_frame_t rtr = {.id = 0x620, .rtr = true, .dlc = 8};
@@ -147,11 +177,34 @@ static void test_integer8_limits(void)
     SDO(d, "2F 03 20 00 0B 00 00 00", "80 03 20 00 31 00 09 06"); /* 11 */
     SDO(d, "2F 03 20 00 80 00 00 00", "80 03 20 00 32 00 09 06"); /* -128 */
     SDO(d, "2F 03 20 00 F6 00 00 00", "60 03 20 00 00 00 00 00"); /* -10 */
+    SDO(d, "2F 03 20 00 0A 00 00 00", "60 03 20 00 00 00 00 00"); /* 10 */
+    SDO(d, "40 03 20 00 00 00 00 00", "4F 03 20 00 0A 00 00 00");
+    SDO(d, "2F 03 20 00 F6 00 00 00", "60 03 20 00 00 00 00 00");
     SDO(d, "2B 03 20 00 F6 00 00 00", "80 03 20 00 12 00 07 06"); /* 2 bytes to 1 */
     SDO(d, "40 03 20 00 00 00 00 00", "4F 03 20 00 F6 00 00 00");
     uint32_t v = 0;
     CHECK(co_od_get(d->node, co_node_entry(d->node, 0x2003, 0), &v) == CO_OK);
     CHECK_EQ((int32_t)v, -10); /* sign-extended to 32 bits for the stack */
+}
+
+/* A COB-ID that follows the node-ID (co_od.h) from any base, here 0x381
+ * on node 0x20: its default reads 0x3A1, and written back it keeps
+ * following; the base itself and the CAN-IDs next to the default are
+ * CAN-IDs of their own and read back as written. */
+static void test_cobid_odd_base(void)
+{
+    boot();
+    SDO(d, "40 09 20 00 00 00 00 00", "43 09 20 00 A1 03 00 00");
+    SDO(d, "23 09 20 00 A1 03 00 00", "60 09 20 00 00 00 00 00");
+    CHECK_EQ(((e_dev_t *)h_inst(d))->para.cob, 0x381);
+    SDO(d, "23 09 20 00 81 03 00 00", "60 09 20 00 00 00 00 00");
+    SDO(d, "40 09 20 00 00 00 00 00", "43 09 20 00 81 03 00 00");
+    SDO(d, "23 09 20 00 A0 03 00 00", "60 09 20 00 00 00 00 00");
+    SDO(d, "40 09 20 00 00 00 00 00", "43 09 20 00 A0 03 00 00");
+    SDO(d, "23 09 20 00 A2 03 00 00", "60 09 20 00 00 00 00 00");
+    SDO(d, "40 09 20 00 00 00 00 00", "43 09 20 00 A2 03 00 00");
+    SDO(d, "23 09 20 00 80 03 00 00", "60 09 20 00 00 00 00 00");
+    SDO(d, "40 09 20 00 00 00 00 00", "43 09 20 00 80 03 00 00");
 }
 
 /* Block download: more segments than the buffer, sizes that disagree,
@@ -257,7 +310,13 @@ static void test_od_api_checks(void)
     CHECK(co_od_read(n, co_node_entry(n, 0x2005, 0), 0, buf, 8, &len) == CO_E_WO);
     CHECK_EQ(len, 0);
     len = 99;
-    CHECK(co_od_read(n, co_node_entry(n, 0x1000, 0), 4, buf, 8, &len) == CO_OK); /* past the end */
+    CHECK(co_od_read(n, co_node_entry(n, 0x1000, 0), 4, buf, 8, &len) == CO_OK); /* at the end */
+    CHECK_EQ(len, 0);
+    len = 99;
+    CHECK(co_od_read(n, co_node_entry(n, 0x1000, 0), 9, buf, 8, &len) == CO_OK); /* past it */
+    CHECK_EQ(len, 0);
+    len = 99;
+    CHECK(co_od_read(n, co_node_entry(n, 0x1008, 0), 71, buf, 8, &len) == CO_OK);
     CHECK_EQ(len, 0);
     CHECK(co_od_read(n, co_node_entry(n, 0x1003, 2), 0, buf, 8, &len) == CO_E_NO_DATA);
     CHECK(co_od_read(n, co_node_entry(n, 0x1008, 0), 66, buf, 8, &len) == CO_OK);
@@ -265,7 +324,18 @@ static void test_od_api_checks(void)
     CHECK(memcmp(buf, "r...", 4) == 0); /* the last 4 of 70 bytes */
     uint8_t four[4] = {1, 0, 0, 0};
     CHECK(co_od_write(n, co_node_entry(n, 0x1000, 0), four, 4) == CO_E_RO);
+    /* Read-only with RAM: refused by the dictionary itself, as by SDO. */
+    CHECK(co_od_write(n, co_node_entry(n, 0x2001, 0), four, 2) == CO_E_RO);
+    SDO(d, "2B 01 20 00 01 00 00 00", "80 01 20 00 02 00 01 06");
+    SDO(d, "40 01 20 00 00 00 00 00", "4B 01 20 00 07 00 00 00");
     CHECK(co_od_store(n, co_node_entry(n, 0x1000, 0), 1) == CO_E_RO);
+    /* Validation (co_od_validate): entries without RAM, strings and
+     * entries of a class the node keeps no RAM for pass as they are. */
+    CHECK(co_od_validate(n, co_node_entry(n, 0x2006, 0)));
+    CHECK(co_od_validate(n, co_node_entry(n, 0x1008, 0)));
+    CHECK(co_od_validate(n, co_node_entry(n, 0x2008, 0)));
+    SDO(d, "40 06 20 00 00 00 00 00", "43 06 20 00 05 00 00 00");
+    SDO(d, "40 08 20 00 00 00 00 00", "4F 08 20 00 03 00 00 00");
     /* Restricted CAN-IDs (CiA 301 7.3.5), at both edges of every range. */
     static const uint16_t restricted[] = {0x000, 0x07F, 0x101, 0x180, 0x581, 0x5FF, 0x601,
                                           0x67F, 0x6E0, 0x6FF, 0x701, 0x77F, 0x780, 0x7FF};
@@ -278,16 +348,128 @@ static void test_od_api_checks(void)
     }
 }
 
+/* A table of every shape the lookup meets: a first object with a hole
+ * after sub 0, a one-entry object followed by one with a hole (its sub 2
+ * sits where the one-entry object's sub 2 would be), an object without
+ * sub 0, and a record with holes at both ends of its sub-indices. */
+#define F(i, s) {.index = (i), .sub = (s), CO_TYPE_U8, .attr = CO_A_R}
+static const co_od_entry_t f_entries[] = {
+    F(0x1000, 0), F(0x1000, 2), F(0x1001, 0), F(0x1002, 0), F(0x1002, 2), F(0x1002, 3),
+    F(0x1004, 1), F(0x1004, 2), F(0x1005, 0), F(0x1006, 0), F(0x1006, 1), F(0x1006, 3),
+    F(0x1006, 5), F(0x1007, 0),
+};
+
+/* co_od_find on every prefix of that table (each a table of its own, so
+ * the search meets every shape at every place) finds exactly the entries
+ * a plain scan finds, and tells a missing object (0x06020000) from a
+ * missing sub-index (0x06090011). */
+static void test_od_find_every_shape(void)
+{
+    const uint16_t n = (uint16_t)(sizeof(f_entries) / sizeof(f_entries[0]));
+    for (uint16_t count = 0; count <= n; count++) {
+        const co_od_t od = {.entries = f_entries, .count = count};
+        for (uint16_t index = 0x0FFF; index <= 0x1008u; index++) {
+            for (uint8_t sub = 0; sub <= 6u; sub++) {
+                const co_od_entry_t *want = NULL;
+                co_res_t want_r = CO_E_NO_OBJ;
+                for (uint16_t k = 0; k < count; k++) {
+                    if (f_entries[k].index == index && f_entries[k].sub == sub) {
+                        want = &f_entries[k];
+                        want_r = CO_OK;
+                    } else if (f_entries[k].index == index && want == NULL) {
+                        want_r = CO_E_NO_SUB;
+                    }
+                }
+                co_res_t r = CO_E_HW;
+                CHECK(co_od_find(&od, index, sub, &r) == want);
+                CHECK(r == want_r);
+                CHECK(co_od_find(&od, index, sub, NULL) == want);
+            }
+        }
+    }
+}
+
+/* co_od_defaults sets every entry of the class whose index lies in
+ * [lo, hi], both ends included, the table's first entry too, and no
+ * other entry. A node of its own on a table of three PARA objects. */
+static const co_od_entry_t g_entries[] = {
+    {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(u32), .def = 100},
+    {.index = 0x2001, .sub = 0, CO_TYPE_U16, .attr = CO_A_R, P(ro), .def = 7},
+    {.index = 0x2003, .sub = 0, CO_TYPE_I8, .attr = CO_A_RW, P(i8), .def = (uint32_t)-3},
+};
+static const co_od_t g_od = {.entries = g_entries, .count = 3};
+static const co_node_cfg_t g_cfg = {.od = &g_od, .ram_size = {0, 0, sizeof(e_para_t), 0},
+                                    .default_node_id = 0x21};
+
+static void test_od_defaults_range(void)
+{
+    static co_node_t node;
+    static e_para_t para;
+    void *const ram[CO_CLS_COUNT] = {NULL, NULL, &para, NULL};
+    co_node_init(&node, &g_cfg, NULL, NULL, ram, 0);
+    para = (e_para_t){.u32 = 500, .i8 = 4, .hb = 9, .ro = 8};
+    co_od_defaults(&node, CO_CLS_VOL, 0x0000, 0xFFFF); /* another class */
+    co_od_defaults(&node, CO_CLS_PARA, 0x2001, 0x2002);
+    CHECK_EQ(para.u32, 500);
+    CHECK_EQ(para.ro, 7);
+    CHECK_EQ(para.i8, 4);
+    para.ro = 8;
+    co_od_defaults(&node, CO_CLS_PARA, 0x2002, 0x2003);
+    CHECK_EQ(para.ro, 8);
+    CHECK_EQ(para.i8, -3);
+    co_od_defaults(&node, CO_CLS_PARA, 0x1000, 0x2000);
+    CHECK_EQ(para.u32, 100);
+    CHECK_EQ(para.ro, 8);
+    CHECK_EQ(para.hb, 9); /* no entry holds it */
+}
+
+/* Paint the stack below the caller with ones: a field a frame built on
+ * the stack is sent without would show. */
+static CO_NOINLINE void paint_stack(void)
+{
+    volatile uint8_t junk[1024];
+    for (size_t i = 0; i < sizeof(junk); i++) {
+        junk[i] = 0xFF;
+    }
+}
+
+/* SDO answers are data frames of 8 bytes, never remote frames: expedited,
+ * segmented, block and abort answers alike. */
+static void test_answers_are_data_frames(void)
+{
+    boot();
+    static const char *const req[] = {
+        "40 00 10 00 00 00 00 00", /* expedited upload */
+        "40 08 10 00 00 00 00 00", /* segmented upload initiate */
+        "60 00 00 00 00 00 00 00", /* its first segment */
+        "40 00 30 00 00 00 00 00", /* abort: no object */
+        "A4 00 10 00 04 00 00 00", /* block upload initiate */
+        "A3 00 00 00 00 00 00 00", /* its block */
+    };
+    for (size_t i = 0; i < sizeof(req) / sizeof(req[0]); i++) {
+        h_drain(d);
+        paint_stack();
+        h_rx(d, 0x620, req[i]);
+        const co_frame_t *f = h_next(d);
+        CHECK(f != NULL && f->id == 0x5A0 && f->dlc == 8u && !f->rtr);
+    }
+}
+
 int main(void)
 {
     RUN(test_segmented_download_refusals);
     RUN(test_writable_string_refused);
+    RUN(test_buffer_sized_object);
     RUN(test_write_only_reads);
     RUN(test_integer8_limits);
+    RUN(test_cobid_odd_base);
     RUN(test_block_download_refusals);
     RUN(test_block_upload_refusals);
     RUN(test_block_upload_timeout);
     RUN(test_history_depth);
     RUN(test_od_api_checks);
+    RUN(test_od_find_every_shape);
+    RUN(test_od_defaults_range);
+    RUN(test_answers_are_data_frames);
     return h_finish();
 }
