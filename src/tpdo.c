@@ -78,9 +78,7 @@ void co_tpdo_reconfig(co_node_t *node, unsigned n)
     t->msb_first = msb_first;
     uint16_t comm = (uint16_t)(0x1800u + n);
     uint16_t mapi = (uint16_t)(0x1A00u + n);
-    if (co_node_entry(node, comm, 1) == NULL) {
-        return;
-    }
+    /* No COB-ID (no such TPDO in the dictionary): invalid, sends nothing. */
     uint32_t cob = get_or(node, comm, 1, 0x80000000u);
     t->type = (uint8_t)get_or(node, comm, 2, 254);
     t->inhibit_us = inhibit_us(node, get_or(node, comm, 3, 0));

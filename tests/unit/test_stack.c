@@ -1366,13 +1366,13 @@ static const co_node_cfg_t b_cfg = {
     .default_node_id = 0x20,
 };
 
+/* The small test nodes below: their configuration is the product's. */
 static void b_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
 {
-    (void)p;
     b_dev_t *b = mem;
     memset(b, 0, sizeof(*b));
     void *const ram[CO_CLS_COUNT] = {NULL, &b->vol, NULL, NULL};
-    co_node_init(&b->node, &b_cfg, ports[0], b, ram, 0);
+    co_node_init(&b->node, p->cfg, ports[0], b, ram, 0);
     nodes[0] = &b->node;
 }
 
@@ -1385,7 +1385,7 @@ static void b_sample(void *mem, const int32_t v[], uint32_t fault)
 
 static const product_t b_prod = {.id = "bare", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
                                  .inst_size = sizeof(b_dev_t), .create = b_create,
-                                 .sample = b_sample};
+                                 .sample = b_sample, .cfg = &b_cfg};
 
 static void test_bare_node_defaults(void)
 {
@@ -1457,19 +1457,9 @@ static const co_node_cfg_t c_cfg = {
     .inhibit_unit_us = 5000, /* counts as 1000 (co_node_cfg_t) */
 };
 
-static void c_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
-{
-    (void)p;
-    b_dev_t *b = mem;
-    memset(b, 0, sizeof(*b));
-    void *const ram[CO_CLS_COUNT] = {NULL, &b->vol, NULL, NULL};
-    co_node_init(&b->node, &c_cfg, ports[0], b, ram, 0);
-    nodes[0] = &b->node;
-}
-
 static const product_t c_prod = {.id = "constants", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
-                                 .inst_size = sizeof(b_dev_t), .create = c_create,
-                                 .sample = b_sample};
+                                 .inst_size = sizeof(b_dev_t), .create = b_create,
+                                 .sample = b_sample, .cfg = &c_cfg};
 
 static void test_constant_parameters_refuse_writes(void)
 {
@@ -1614,6 +1604,44 @@ static void test_tpdo_unusable_default_mapping_after_reset(void)
     CHECK_EQ(count_id(d, 0x290), 0);
 }
 
+/* A mapping without its communication parameters (no 0x1800) is no TPDO:
+ * nothing is sent on an event, a SYNC or a remote request. */
+static const co_od_entry_t m_entries[] = {
+    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
+    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21000020u},
+    {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, counter)},
+};
+
+static const co_od_t m_od = {.entries = m_entries, .count = sizeof(m_entries) / sizeof(m_entries[0])};
+
+static const co_service_t *const m_services[] = {&co_rtr_service, NULL};
+
+static const co_node_cfg_t m_cfg = {
+    .od = &m_od,
+    .services = m_services,
+    .ram_size = {0, sizeof(b_vol_t), 0, 0},
+    .default_node_id = 0x20,
+};
+
+static const product_t m_prod = {.id = "mapping only", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
+                                 .inst_size = sizeof(b_dev_t), .create = b_create,
+                                 .sample = b_sample, .cfg = &m_cfg};
+
+static void test_mapping_without_tpdo(void)
+{
+    h_boot(d, &m_prod, false);
+    EXPECT(d, 0x720, "00");
+    h_rx(d, 0x000, "01 20");
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 1000);
+    h_rx(d, 0x080, "");
+    co_frame_t rtr = {.id = 0x7FF, .rtr = true, .dlc = 4};
+    h_rx_frame(d, &rtr);
+    h_advance(d, 1000000);
+    EXPECT_NONE(d);
+}
+
 int main(void)
 {
     RUN(test_od_find);
@@ -1656,5 +1684,6 @@ int main(void)
     RUN(test_constant_parameters_refuse_writes);
     RUN(test_tpdo_restart_is_afresh);
     RUN(test_tpdo_unusable_default_mapping_after_reset);
+    RUN(test_mapping_without_tpdo);
     return h_finish();
 }
