@@ -28,9 +28,7 @@ void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limi
     incl->axes = axes;
     incl->limit_mdeg = limit_mdeg;
     incl->wrap = wrap;
-    incl->shift = co_filter_shift(0);
-    co_filter_reset(&incl->f[0]);
-    co_filter_reset(&incl->f[1]);
+    incl->shift = co_filter_shift(0); /* the filters unprimed: zeroed above */
 }
 
 static void refresh(co_incl_t *incl);

@@ -107,14 +107,45 @@ static const co_node_cfg_t n_cfg = {
     .lss_bitrates = 0x00DF, /* CiA 305 indices 0-4, 6, 7 */
 };
 
-/* variant: true = the board keeps no LSS set (ram NULL): "store" is not supported. */
+/* A dictionary with the fewest objects the services work with: no EMCY
+ * COB-ID (the default 80h + node-ID), an error history with no field,
+ * a guard time without a life time factor, no identity. */
+static const co_od_entry_t n_min_entries[] = {
+    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x0000019Au},
+    {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_read_register)},
+#if CO_EMCY_HIST_MAX > 0
+    {.index = 0x1003, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_read_hist)},
+#endif
+    {.index = 0x100C, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(guard_ms), .def = 0},
+};
+
+static const co_od_t n_min_od = {.entries = n_min_entries,
+                                 .count = sizeof(n_min_entries) / sizeof(n_min_entries[0])};
+
+static const co_node_cfg_t n_min_cfg = {
+    .od = &n_min_od,
+    .services = n_services,
+    .ram_size = {0, 0, sizeof(n_para_t), 0},
+    .default_node_id = 0x40,
+    .default_bitrate = 3,
+};
+
+/* variant: NULL = the test dictionary; otherwise what it points to. */
+typedef struct n_variant {
+    bool no_lss; /* the board keeps no LSS set (ram NULL): "store" is not supported */
+    const co_node_cfg_t *cfg;
+} n_variant_t;
+
 static void n_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
 {
     n_dev_t *t = mem;
     memset(t, 0, sizeof(*t));
-    bool no_lss = p->variant != NULL && *(const bool *)p->variant;
-    void *const ram[CO_CLS_COUNT] = {NULL, &t->vol, &t->para, no_lss ? NULL : &t->lss};
-    co_node_init(&t->node, &n_cfg, ports[0], t, ram, 0);
+    const n_variant_t *v = p->variant;
+    bool no_lss = v != NULL && v->no_lss;
+    const co_node_cfg_t *cfg = v != NULL ? v->cfg : &n_cfg;
+    void *const ram[CO_CLS_COUNT] = {NULL, cfg->ram_size[CO_CLS_VOL] != 0u ? &t->vol : NULL,
+                                     &t->para, no_lss || !cfg->lss ? NULL : &t->lss};
+    co_node_init(&t->node, cfg, ports[0], t, ram, 0);
     nodes[0] = &t->node;
 }
 
@@ -125,7 +156,8 @@ static void n_sample(void *mem, const int32_t v[], uint32_t fault)
     (void)fault;
 }
 
-static const bool n_no_lss = true;
+static const n_variant_t n_no_lss = {.no_lss = true, .cfg = &n_cfg};
+static const n_variant_t n_min = {.no_lss = true, .cfg = &n_min_cfg};
 static const product_t n_prod = {.id = "services", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
                                   .inst_size = sizeof(n_dev_t), .create = n_create,
                                   .sample = n_sample};
@@ -133,6 +165,9 @@ static const product_t n_prod_no_lss = {.id = "services-no-lss", .inputs = {{NUL
                                          .nodes = 1, .inst_size = sizeof(n_dev_t),
                                          .create = n_create, .sample = n_sample,
                                          .variant = &n_no_lss};
+static const product_t n_prod_min = {.id = "services-min", .inputs = {{NULL, NULL, 0, 0}},
+                                      .nodes = 1, .inst_size = sizeof(n_dev_t),
+                                      .create = n_create, .sample = n_sample, .variant = &n_min};
 
 static h_dev_t dev;
 static h_dev_t *const d = &dev;
@@ -557,6 +592,31 @@ static void test_emcy_table_full_and_cobid(void)
     CHECK_EQ(h_read(d, 0x1014, 0), 0xC0);
 }
 
+/* The fewest objects: an EMCY on 80h + node-ID without 0x1014; an error
+ * history the dictionary keeps no field of counts 0 errors; a guard time
+ * without a life time factor (0x100D) is node guarding without life
+ * guarding: answered, never an event. */
+static void test_fewest_objects(void)
+{
+    h_boot(d, &n_prod_min, false);
+    EXPECT(d, 0x740, "00");
+    CHECK(co_emcy_error(d->node, 0xFF00, CO_ER_MANUFACTURER, true, NULL));
+    EXPECT(d, 0xC0, "00 FF 81 00 00 00 00 00");
+#if CO_EMCY_HIST_MAX > 0
+    SDO(d, "40 03 10 00 00 00 00 00", "4F 03 10 00 00 00 00 00");
+#endif
+    SDO(d, "2B 0C 10 00 64 00 00 00", "60 0C 10 00 00 00 00 00"); /* 100 ms */
+    co_frame_t rtr = {.id = 0x740, .rtr = true, .dlc = 1};
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x740, "7F");
+    h_advance(d, 1000000);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x740, "FF");
+    h_advance(d, 1000000);
+    EXPECT_NONE(d);
+}
+
 int main(void)
 {
     RUN(test_lss_store_in_lss_set);
@@ -572,5 +632,6 @@ int main(void)
     RUN(test_tpdo_mapping_longer_than_8_bytes);
     RUN(test_tpdo_mapping_count_beyond_entries);
     RUN(test_emcy_table_full_and_cobid);
+    RUN(test_fewest_objects);
     return h_finish();
 }

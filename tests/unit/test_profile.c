@@ -186,6 +186,26 @@ static void test_incl_arithmetic(void)
     CHECK_EQ(p.resolution, 10);
 }
 
+/* A profile starts with the slow filter, each axis primed by its first
+ * sample: a 20 deg step then moves the output by 1 mdeg, then 2. */
+static void test_incl_starts_slow(void)
+{
+    co_incl_para_t p = {.resolution = 1, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
+    co_incl_t in;
+    memset(&in, 0x55, sizeof(in));
+    co_incl_init(&in, &p, 2, 0, false);
+    int32_t a[2] = {0, -5000};
+    co_incl_sample(&in, a);
+    CHECK_EQ(co_incl_slope(&in, 0), 0);
+    CHECK_EQ(co_incl_slope(&in, 1), -5000);
+    a[0] = 20000;
+    co_incl_sample(&in, a);
+    CHECK_EQ(co_incl_slope(&in, 0), 1);
+    co_incl_sample(&in, a);
+    CHECK_EQ(co_incl_slope(&in, 0), 2);
+    CHECK_EQ(co_incl_slope(&in, 1), -5000);
+}
+
 static void test_incl_wrap(void)
 {
     co_incl_para_t p = {.resolution = 10, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
@@ -240,6 +260,10 @@ static void test_incl_output_fits(void)
     CHECK_EQ(co_incl_output(35000, sc, 2000, -500, c), 500);
     CHECK_EQ(co_incl_output(1000, sc, INT32_MAX, INT32_MAX, c), 24294); /* 1000 + 2 x 11647 */
     CHECK_EQ(co_incl_output(1000, sc, INT32_MIN, 0, c), 25352); /* -2^31 mod 36000 = 24352 */
+    /* Any turn above 0 is circular, the smallest (1) too: everything is 0. */
+    co_incl_fit_t one = {.turn = 1, .wide = false, .centred = false};
+    CHECK_EQ(co_incl_output(1234, sc, 100, 10, one), 0);
+    CHECK_EQ(co_incl_preset_offset(100, 1234, 0, 0, one), 0);
     /* The preset's offset: preset - s*m - diff, fitted the same way. */
     CHECK_EQ(co_incl_preset_offset(100, 1234, 0, 0, i16), -1134);
     CHECK_EQ(co_incl_preset_offset(100, 1234, inv, 0, i16), 1334);
@@ -436,6 +460,7 @@ int main(void)
     RUN(test_filter_exact_response);
     RUN(test_filter_through_the_device);
     RUN(test_incl_arithmetic);
+    RUN(test_incl_starts_slow);
     RUN(test_incl_wrap);
     RUN(test_incl_output_fits);
     RUN(test_incl_meas);
