@@ -311,6 +311,38 @@ static void test_accel_sine_table(void)
     }
 }
 
+/* Between whole degrees the accelerations are linear between the
+ * neighbouring whole degrees' values (truncated to whole mg), both signs,
+ * and symmetric about 90 deg: sin(180 - a) = sin a. */
+static void test_accel_between_degrees(void)
+{
+    boot(&jd2xxx);
+    jd_dev_t *j = h_inst(d);
+    static const int32_t fracs[] = {1, 250, 500, 950, 999};
+    int32_t lo = 0;
+    for (int deg = 0; deg < 90; deg++) {
+        int32_t v[3] = {(deg + 1) * 1000, 0, 25000};
+        d->prod->sample(j, v, 0);
+        int32_t hi = j->accel[0];
+        for (unsigned k = 0; k < sizeof(fracs) / sizeof(fracs[0]); k++) {
+            int32_t a = deg * 1000 + fracs[k];
+            int32_t want = lo + (hi - lo) * fracs[k] / 1000;
+            int32_t in[4][3] = {{a, 0, 25000}, {-a, 0, 25000}, {180000 - a, 0, 25000},
+                                {a - 180000, 0, 25000}};
+            int32_t sign[4] = {1, -1, 1, -1};
+            for (unsigned m = 0; m < 4u; m++) {
+                d->prod->sample(j, in[m], 0);
+                if (j->accel[0] != sign[m] * want) {
+                    fprintf(stderr, "  x = %ld mdeg: %d mg, expected %ld\n", (long)in[m][0],
+                            j->accel[0], (long)(sign[m] * want));
+                    FAIL("acceleration not linear between whole degrees");
+                }
+            }
+        }
+        lo = hi;
+    }
+}
+
 int main(void)
 {
     RUN(test_lss_activate_bit_timing);
@@ -322,6 +354,7 @@ int main(void)
     RUN(test_jd1_moving_average_across_zero);
     RUN(test_leds);
     RUN(test_accel_sine_table);
+    RUN(test_accel_between_degrees);
     RUN(test_lss_stores_across_power_cycles);
     RUN(test_lss_store_edges);
     return h_finish();
