@@ -111,8 +111,7 @@ void co_incl_sample(co_incl_t *incl, const int32_t mdeg[2])
                 }
                 *u += d;
             }
-            incl->angle[a] = w;
-            incl->beyond[a] = false;
+            incl->angle[a] = w; /* never beyond: no limit (beyond[] stays 0 from init) */
             continue;
         }
         int32_t y = co_filter_step(&incl->f[a], x, incl->shift);

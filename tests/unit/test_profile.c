@@ -206,6 +206,38 @@ static void test_incl_starts_slow(void)
     CHECK_EQ(co_incl_slope(&in, 1), -5000);
 }
 
+/* A shaft turning on and on (a circular device, 20 turns one way in 10 deg
+ * steps) reads the angle it stops at: the filter keeps its state within
+ * the [-180, 180) window, however far it turned. While the sensor is at
+ * fault, a sample is ignored and the outputs hold. */
+static void test_incl_many_turns(void)
+{
+    co_incl_para_t p = {.resolution = 10, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
+    co_incl_t in;
+    co_incl_init(&in, &p, 1, 0, true);
+    in.shift = co_filter_shift(2);
+    int32_t a[2] = {0, 0};
+    for (int i = 0; i < 20 * 36; i++) {
+        a[0] = co_incl_wrap180(a[0] + 10000);
+        co_incl_sample(&in, a);
+    }
+    a[0] = 45000;
+    for (int i = 0; i < 200; i++) {
+        co_incl_sample(&in, a);
+    }
+    CHECK_EQ(co_incl_slope(&in, 0), 4500);
+    CHECK(!co_incl_beyond(&in));
+    in.fault = true;
+    a[0] = -90000;
+    co_incl_sample(&in, a);
+    CHECK_EQ(co_incl_slope(&in, 0), 4500);
+    in.fault = false;
+    for (int i = 0; i < 200; i++) {
+        co_incl_sample(&in, a);
+    }
+    CHECK_EQ(co_incl_slope(&in, 0), -9000);
+}
+
 static void test_incl_wrap(void)
 {
     co_incl_para_t p = {.resolution = 10, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
@@ -271,6 +303,7 @@ static void test_incl_output_fits(void)
     CHECK_EQ(co_incl_preset_offset(-32000, 2000, 0, 0, i16), -32768);
     CHECK_EQ(co_incl_preset_offset(-32000, 2000, 0, 0, i32), -34000);
     CHECK_EQ(co_incl_preset_offset(INT32_MIN, 1, 0, 0, i32), INT32_MIN);
+    CHECK_EQ(co_incl_preset_offset(100, 1234, 0, 50, i32), -1184);
     CHECK_EQ(co_incl_preset_offset(100, 1000, 0, 0, c), 35100); /* [0, turn) */
     co_incl_fit_t cc = {.turn = 36000, .wide = false, .centred = true};
     CHECK_EQ(co_incl_preset_offset(100, 1000, 0, 0, cc), -900); /* (-turn/2, turn/2] */
@@ -321,6 +354,7 @@ static void test_incl_meas(void)
     CHECK_EQ(co_incl_meas_at(&c, raw, 1000)->m[0], 100);
     CHECK_EQ(c.turn, 360);
     co_incl_remeasure(&c, raw, 0);
+    CHECK_EQ(c.turn, 0);
     CHECK_EQ(c.m[0], 0);
     CHECK_EQ(c.m[1], 0);
     CHECK_EQ(c.res, 0);
@@ -462,6 +496,7 @@ int main(void)
     RUN(test_incl_arithmetic);
     RUN(test_incl_starts_slow);
     RUN(test_incl_wrap);
+    RUN(test_incl_many_turns);
     RUN(test_incl_output_fits);
     RUN(test_incl_meas);
     RUN(test_incl_limit_edges);
