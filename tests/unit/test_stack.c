@@ -1424,7 +1424,8 @@ static void test_bare_node_defaults(void)
  * write hooks, as a product that fixes them might leave them: a write is
  * refused as to a read-only object (0x06010002), never confirmed, and the
  * node goes on with the constant. Its inhibit time unit is given as 5 ms:
- * more than the 1 ms co_node_cfg_t allows, so it counts as 1 ms.
+ * more than the 1 ms co_node_cfg_t allows, so it counts as 1 ms. TPDO2
+ * maps eight objects, the most a PDO holds.
  */
 static const co_od_entry_t c_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
@@ -1439,13 +1440,17 @@ static const co_od_entry_t c_entries[] = {
     {.index = 0x1801, .sub = 3, CO_TYPE_U16, .attr = CO_A_R, .def = 10},
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, .def = 1, CO_EXT(.write = co_tpdo_write_map)},
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, .def = 0x21000020u, CO_EXT(.write = co_tpdo_write_map)},
-    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 2},
-    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x22000108u},
-    {.index = 0x1A01, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, .def = 0x22000210u},
+    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 8}, /* the most: 8 objects */
+    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
+    {.index = 0x1A01, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
+    {.index = 0x1A01, .sub = 3, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
+    {.index = 0x1A01, .sub = 4, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
+    {.index = 0x1A01, .sub = 5, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
+    {.index = 0x1A01, .sub = 6, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
+    {.index = 0x1A01, .sub = 7, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
+    {.index = 0x1A01, .sub = 8, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
     {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, counter)},
-    {.index = 0x2200, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 2},
-    {.index = 0x2200, .sub = 1, CO_TYPE_U8, .attr = CO_A_R | CO_A_PDO, .def = 0x11},
-    {.index = 0x2200, .sub = 2, CO_TYPE_U16, .attr = CO_A_R | CO_A_PDO, .def = 0x2233},
+    {.index = 0x2101, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_PDO, .def = 0x5A},
 };
 
 static const co_od_t c_od = {.entries = c_entries, .count = sizeof(c_entries) / sizeof(c_entries[0])};
@@ -1481,7 +1486,7 @@ static void test_constant_parameters_refuse_writes(void)
     EXPECT_NONE(d); /* no heartbeat; TPDO1 stays invalid */
     co_tpdo_event(d->node, 1);
     h_advance(d, 0);
-    NEXT_IS(0x2A0);
+    EXPECT(d, 0x2A0, "5A 5A 5A 5A 5A 5A 5A 5A");
     uint32_t t0 = d->now;
     co_tpdo_event(d->node, 1); /* inhibit time 10 x 1 ms */
     h_advance(d, 9999);
@@ -1604,13 +1609,22 @@ static void test_tpdo_unusable_default_mapping_after_reset(void)
     CHECK_EQ(count_id(d, 0x290), 0);
 }
 
-/* A mapping without its communication parameters (no 0x1800) is no TPDO:
+/* A mapping without its communication parameters (no 0x1800) is no TPDO,
+ * nor is one whose default mapping holds more than 8 bytes (TPDO2: 9):
  * nothing is sent on an event, a SYNC or a remote request. */
 static const co_od_entry_t m_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
+    {.index = 0x1801, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 2},
+    {.index = 0x1801, .sub = 1, CO_TYPE_U32, .attr = CO_A_R | CO_A_NODEID, .def = 0x280},
+    {.index = 0x1801, .sub = 2, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21000020u},
+    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 3},
+    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21000020u},
+    {.index = 0x1A01, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21000020u},
+    {.index = 0x1A01, .sub = 3, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
     {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, counter)},
+    {.index = 0x2101, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_PDO, .def = 0x5A},
 };
 
 static const co_od_t m_od = {.entries = m_entries, .count = sizeof(m_entries) / sizeof(m_entries[0])};
@@ -1634,11 +1648,33 @@ static void test_mapping_without_tpdo(void)
     EXPECT(d, 0x720, "00");
     h_rx(d, 0x000, "01 20");
     co_tpdo_event(d->node, 0);
+    co_tpdo_event(d->node, 1);
     h_advance(d, 1000);
     h_rx(d, 0x080, "");
     co_frame_t rtr = {.id = 0x7FF, .rtr = true, .dlc = 4};
     h_rx_frame(d, &rtr);
+    rtr.id = 0x2A0;
+    h_rx_frame(d, &rtr);
     h_advance(d, 1000000);
+    EXPECT_NONE(d);
+}
+
+/* A TPDO whose mapping holds no object (sub 0 = 0) sends nothing, valid
+ * COB-ID or not: at a SYNC, on a remote request. */
+static void test_tpdo_without_mapped_objects(void)
+{
+    boot();
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* TPDO1 quiet */
+    SDO(d, "23 01 18 01 90 02 00 80", "60 01 18 01 00 00 00 00");
+    SDO(d, "2F 01 1A 00 00 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 18 01 90 02 00 00", "60 01 18 01 00 00 00 00"); /* valid, type 1 */
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    h_rx(d, 0x080, "");
+    co_frame_t rtr = {.id = 0x290, .rtr = true, .dlc = 0};
+    h_rx_frame(d, &rtr);
+    h_advance(d, 100000);
+    h_rx(d, 0x080, "");
     EXPECT_NONE(d);
 }
 
@@ -1685,5 +1721,6 @@ int main(void)
     RUN(test_tpdo_restart_is_afresh);
     RUN(test_tpdo_unusable_default_mapping_after_reset);
     RUN(test_mapping_without_tpdo);
+    RUN(test_tpdo_without_mapped_objects);
     return h_finish();
 }
