@@ -1327,6 +1327,8 @@ static void test_emcy_cobid_restricted_and_as_written(void)
  */
 typedef struct b_vol {
     uint32_t counter;
+    uint8_t type3;  /* 0x1802 sub 2 */
+    uint8_t count3; /* 0x1A02 sub 0 */
 } b_vol_t;
 
 typedef struct b_dev {
@@ -1437,7 +1439,9 @@ static const co_od_entry_t c_entries[] = {
     {.index = 0x1801, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 3},
     {.index = 0x1801, .sub = 1, CO_TYPE_U32, .attr = CO_A_R | CO_A_NODEID, .def = 0x280},
     {.index = 0x1801, .sub = 2, CO_TYPE_U8, .attr = CO_A_R, .def = 254},
-    {.index = 0x1801, .sub = 3, CO_TYPE_U16, .attr = CO_A_R, .def = 10},
+    {.index = 0x1801, .sub = 3, CO_TYPE_U16, .attr = CO_A_RW, .def = 10, CO_EXT(.write = co_tpdo_write_comm)},
+    {.index = 0x1802, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 2},
+    {.index = 0x1802, .sub = 2, CO_TYPE_U8, .attr = CO_A_RW, CO_AT(CO_CLS_VOL, b_vol_t, type3), .def = 254, CO_EXT(.write = co_tpdo_write_comm)},
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, .def = 1, CO_EXT(.write = co_tpdo_write_map)},
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, .def = 0x21000020u, CO_EXT(.write = co_tpdo_write_map)},
     {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 8}, /* the most: 8 objects */
@@ -1449,6 +1453,7 @@ static const co_od_entry_t c_entries[] = {
     {.index = 0x1A01, .sub = 6, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
     {.index = 0x1A01, .sub = 7, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
     {.index = 0x1A01, .sub = 8, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
+    {.index = 0x1A02, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, CO_AT(CO_CLS_VOL, b_vol_t, count3), .def = 0, CO_EXT(.write = co_tpdo_write_map)},
     {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, counter)},
     {.index = 0x2101, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_PDO, .def = 0x5A},
 };
@@ -1489,11 +1494,21 @@ static void test_constant_parameters_refuse_writes(void)
     EXPECT(d, 0x2A0, "5A 5A 5A 5A 5A 5A 5A 5A");
     uint32_t t0 = d->now;
     co_tpdo_event(d->node, 1); /* inhibit time 10 x 1 ms */
-    h_advance(d, 9999);
+    h_advance(d, 5000);
+    /* A refused write changes nothing: the event still waits for the end. */
+    SDO(d, "2B 01 18 03 14 00 00 00", "80 01 18 03 02 00 01 06");
+    h_advance(d, 4999);
     EXPECT_NONE(d);
     h_advance(d, 1);
     NEXT_IS(0x2A0);
     CHECK_EQ(d->now - t0, 10000);
+    /* The parameters of a third TPDO, which this build has no room for
+     * (CO_TPDO_MAX 2), are kept as any value: no TPDO, no contract broken. */
+    SDO(d, "2F 02 18 02 01 00 00 00", "60 02 18 02 00 00 00 00");
+    SDO(d, "2F 02 1A 00 00 00 00 00", "60 02 1A 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x1802, 2), 1);
+    h_rx(d, 0x080, "");
+    EXPECT_NONE(d);
 }
 
 static void nmt_restart(void)
