@@ -67,6 +67,11 @@ static void test_jd2_lateral_preset_inverted(void)
     SDO(d, "40 01 26 00 00 00 00 00", "4B 01 26 00 E8 03 00 00");
     SDO(d, "2B 01 26 00 29 23 00 00", "80 01 26 00 30 00 09 06"); /* 90.01 deg */
     SDO(d, "40 12 60 00 00 00 00 00", "4B 12 60 00 00 00 00 00"); /* X untouched */
+    /* 6022h is the lateral preset too. */
+    SDO(d, "2B 22 60 00 2C 01 00 00", "60 22 60 00 00 00 00 00"); /* 3.00 deg */
+    SDO(d, "40 01 26 00 00 00 00 00", "4B 01 26 00 2C 01 00 00");
+    SDO(d, "40 12 61 00 00 00 00 00", "43 12 61 00 00 00 00 00"); /* X untouched */
+    SDO(d, "40 22 61 00 00 00 00 00", "43 22 61 00 2C 01 00 00");
 }
 
 /* R53: the 16-bit slope is clamped to INTEGER16 only; R56: the 32-bit one
