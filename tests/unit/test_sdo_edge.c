@@ -5,6 +5,7 @@
  * out-of-turn block frames, signed 8-bit limits, the 0x1003 history past its
  * depth. Every answer is the CiA 301 abort code (7.2.4.3.17), frame by frame.
  */
+#include "dst.h"
 #include "harness.h"
 
 #define LONG_NAME "A device name of seventy bytes, longer than the SDO transfer buffer..."
@@ -119,6 +120,14 @@ static void test_segmented_download_refusals(void)
     CHECK(f != NULL && f->id == 0x5A0 && f->data[0] == 0x80u &&
           co_get_u32(&f->data[4]) == CO_E_CMD);
     CHECK_EQ(h_read(d, 0x2000, 0), 100);
+    /* An expedited upload request replaces an unfinished download: its
+     * segment is then out of turn, and no timeout follows. */
+    SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00");
+    SDO(d, "40 00 10 00 00 00 00 00", "43 00 10 00 91 01 00 00");
+    SDO(d, "0B E8 03 00 00 00 00 00", "80 E8 03 00 01 00 04 05");
+    h_advance(d, 2u * CO_SDO_TIMEOUT_US);
+    EXPECT_NONE(d);
+    CHECK_EQ(h_read(d, 0x2000, 0), 100);
 }
 
 /* An object of exactly the transfer buffer's 64 bytes is taken, segmented
@@ -134,6 +143,37 @@ static void test_buffer_sized_object(void)
     h_rx(d, 0x620, "80 0A 20 00 00 00 04 05"); /* the client aborts */
     EXPECT_NONE(d);
     SDO(d, "22 0B 20 00 31 32 33 34", "80 0B 20 00 13 00 07 06");
+    /* An upload of those 5 bytes is segmented (size indicated). */
+    SDO(d, "40 0B 20 00 00 00 00 00", "41 0B 20 00 05 00 00 00");
+    SDO(d, "60 00 00 00 00 00 00 00", "05 31 32 33 34 35 00 00");
+}
+
+/* A segmented download where the product links no segmented protocol
+ * (the DST X730 takes at most 4 bytes so): the toggle bit alternates
+ * through every segment, segments without data included (CiA 301). */
+static void test_short_segmented_download_toggles(void)
+{
+    h_boot(d, &dst_x730_xy30, false);
+    EXPECT(d, 0x77F, "00");
+    SDO(d, "20 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "0E 00 00 00 00 00 00 00", "20 00 00 00 00 00 00 00"); /* no data */
+    SDO(d, "1C F4 00 00 00 00 00 00", "30 00 00 00 00 00 00 00");
+    SDO(d, "0E 00 00 00 00 00 00 00", "20 00 00 00 00 00 00 00");
+    SDO(d, "1D 01 00 00 00 00 00 00", "30 00 00 00 00 00 00 00"); /* last */
+    SDO(d, "40 17 10 00 00 00 00 00", "4B 17 10 00 F4 01 00 00");
+    /* The transfer is over: a segment more is out of turn, and no timeout
+     * follows. */
+    SDO(d, "0E 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05");
+    SDO(d, "20 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "0B 00 00 00 00 00 00 00", "20 00 00 00 00 00 00 00"); /* heartbeat off */
+    h_advance(d, 2u * CO_SDO_TIMEOUT_US);
+    for (const co_frame_t *f = h_next(d); f != NULL; f = h_next(d)) {
+        CHECK_EQ(f->id, 0x77F);
+    }
+    /* 5 bytes in a segment that is not the last: 06070012h at once. */
+    SDO(d, "20 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "04 01 02 03 04 05 00 00", "80 17 10 00 12 00 07 06");
+    SDO(d, "40 17 10 00 00 00 00 00", "4B 17 10 00 00 00 00 00");
 }
 
 /* Writable strings are refused whole (co_od_write: none is stored yet),
@@ -286,6 +326,9 @@ static void test_block_upload_timeout(void)
 static void test_history_depth(void)
 {
     boot();
+    /* Empty: a read of an entry is aborted with 08000024h, and that alone. */
+    SDO(d, "40 03 10 01 00 00 00 00", "80 03 10 01 24 00 00 08");
+    EXPECT_NONE(d);
     for (uint16_t i = 1; i <= CO_EMCY_HIST_MAX + 2u; i++) {
         uint8_t info[5] = {(uint8_t)i, 0, 0, 0, 0};
         CHECK(co_emcy_error(d->node, (uint16_t)(0xFF00u + i), CO_ER_MANUFACTURER, true, info));
@@ -460,6 +503,7 @@ int main(void)
     RUN(test_segmented_download_refusals);
     RUN(test_writable_string_refused);
     RUN(test_buffer_sized_object);
+    RUN(test_short_segmented_download_toggles);
     RUN(test_write_only_reads);
     RUN(test_integer8_limits);
     RUN(test_cobid_odd_base);
