@@ -1104,6 +1104,7 @@ static void test_tpdo_cobid_and_mapping_rules(void)
     SDO(d, "2F 01 1A 00 02 00 00 00", "60 01 1A 00 00 00 00 00"); /* 64 bits: ok */
     SDO(d, "2F 01 1A 00 03 00 00 00", "80 01 1A 00 00 00 02 06"); /* no sub 3: no object */
     SDO(d, "2F 01 1A 00 41 00 00 00", "80 01 1A 00 31 00 09 06"); /* beyond 64 */
+    SDO(d, "2F 01 1A 00 40 00 00 00", "80 01 1A 00 00 00 02 06"); /* 64: no sub 3 */
     SDO(d, "2F 01 1A 00 00 00 00 00", "60 01 1A 00 00 00 00 00");
     SDO(d, "23 01 1A 02 10 00 01 20", "60 01 1A 02 00 00 00 00"); /* 0x2001, 16 bits */
     SDO(d, "2F 01 1A 00 02 00 00 00", "60 01 1A 00 00 00 00 00");
@@ -1329,6 +1330,7 @@ typedef struct b_vol {
     uint32_t counter;
     uint8_t type3;  /* 0x1802 sub 2 */
     uint8_t count3; /* 0x1A02 sub 0 */
+    uint32_t map3[3]; /* 0x1A02 sub 1..3 */
 } b_vol_t;
 
 typedef struct b_dev {
@@ -1454,6 +1456,9 @@ static const co_od_entry_t c_entries[] = {
     {.index = 0x1A01, .sub = 7, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
     {.index = 0x1A01, .sub = 8, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
     {.index = 0x1A02, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, CO_AT(CO_CLS_VOL, b_vol_t, count3), .def = 0, CO_EXT(.write = co_tpdo_write_map)},
+    {.index = 0x1A02, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, CO_AT(CO_CLS_VOL, b_vol_t, map3[0]), .def = 0, CO_EXT(.write = co_tpdo_write_map)},
+    {.index = 0x1A02, .sub = 2, CO_TYPE_U32, .attr = CO_A_RW, CO_AT(CO_CLS_VOL, b_vol_t, map3[1]), .def = 0, CO_EXT(.write = co_tpdo_write_map)},
+    {.index = 0x1A02, .sub = 3, CO_TYPE_U32, .attr = CO_A_RW, CO_AT(CO_CLS_VOL, b_vol_t, map3[2]), .def = 0, CO_EXT(.write = co_tpdo_write_map)},
     {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, counter)},
     {.index = 0x2101, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_PDO, .def = 0x5A},
 };
@@ -1507,6 +1512,12 @@ static void test_constant_parameters_refuse_writes(void)
     SDO(d, "2F 02 18 02 01 00 00 00", "60 02 18 02 00 00 00 00");
     SDO(d, "2F 02 1A 00 00 00 00 00", "60 02 1A 00 00 00 00 00");
     CHECK_EQ(h_read(d, 0x1802, 2), 1);
+    /* Its mapping's rules hold all the same: 4 + 4 + 1 bytes are too many. */
+    SDO(d, "23 02 1A 01 20 00 00 21", "60 02 1A 01 00 00 00 00");
+    SDO(d, "23 02 1A 02 20 00 00 21", "60 02 1A 02 00 00 00 00");
+    SDO(d, "23 02 1A 03 08 00 01 21", "60 02 1A 03 00 00 00 00");
+    SDO(d, "2F 02 1A 00 03 00 00 00", "80 02 1A 00 42 00 04 06");
+    SDO(d, "2F 02 1A 00 02 00 00 00", "60 02 1A 00 00 00 00 00");
     h_rx(d, 0x080, "");
     EXPECT_NONE(d);
 }
