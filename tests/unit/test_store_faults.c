@@ -432,6 +432,25 @@ static void test_group_edges(void)
     }
 }
 
+/* Reset communication restores the stored communication objects, up to
+ * the area's last index 0x1FFF, and leaves the others' running values. */
+static void test_reset_communication_restores_its_area(void)
+{
+    boot();
+    set_all(100, 200, 0x11223344u, 300);
+    SDO(d, "2F FF 1F 00 09 00 00 00", "60 FF 1F 00 00 00 00 00");
+    SDO(d, "2F FF 5F 00 09 00 00 00", "60 FF 5F 00 00 00 00 00");
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    set_all(101, 201, 0x55667788u, 301);
+    SDO(d, "2F FF 1F 00 01 00 00 00", "60 FF 1F 00 00 00 00 00");
+    SDO(d, "2F FF 5F 00 01 00 00 00", "60 FF 5F 00 00 00 00 00");
+    h_rx(d, 0x000, "82 30");
+    EXPECT(d, 0x730, "00");
+    EXPECT_ALL(100, 201, 0x55667788u, 301);
+    CHECK_EQ(h_read(d, 0x1FFF, 0), 9);
+    CHECK_EQ(h_read(d, 0x5FFF, 0), 1);
+}
+
 /* The slot at NVM offset at holds exactly these bytes (hex). */
 static void expect_slot(unsigned at, const char *hex, int line)
 {
@@ -487,6 +506,7 @@ int main(void)
 {
     RUN(test_record_bytes);
     RUN(test_group_edges);
+    RUN(test_reset_communication_restores_its_area);
     RUN(test_group_save);
     RUN(test_group_load);
     RUN(test_group_save_after_load);
