@@ -238,6 +238,33 @@ static void test_incl_many_turns(void)
     CHECK_EQ(co_incl_slope(&in, 0), -9000);
 }
 
+/* A circular output rounds the angle taken within one turn: -0.005 deg is
+ * 359.995, 360.00 at 0.01 deg, so 0; -0.015 deg is 359.985, so 359.99;
+ * -179.995 is 180.005, so 180.01. A linear one's preset makes the output
+ * read the preset plus the differential offset. */
+static void test_incl_rounding_and_preset(void)
+{
+    co_incl_para_t p = {.resolution = 10, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
+    co_incl_t in;
+    static const struct {
+        int32_t in, out;
+    } cases[] = {{-5, 0}, {-15, 35999}, {5, 1}, {-179995, 18001}};
+    for (unsigned i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+        co_incl_init(&in, &p, 1, 0, true);
+        in.circular = true;
+        int32_t a[2] = {cases[i].in, 0};
+        co_incl_sample(&in, a);
+        CHECK_EQ((uint16_t)co_incl_slope(&in, 0), cases[i].out);
+    }
+    co_incl_init(&in, &p, 1, 0, false);
+    int32_t a[2] = {12340, 0};
+    co_incl_sample(&in, a);
+    p.diff[0] = 7;
+    co_incl_set_preset(&in, 0, 100);
+    CHECK_EQ(p.offset[0], 100 - 1234);
+    CHECK_EQ(co_incl_slope(&in, 0), 107);
+}
+
 static void test_incl_wrap(void)
 {
     co_incl_para_t p = {.resolution = 10, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
@@ -497,6 +524,7 @@ int main(void)
     RUN(test_incl_starts_slow);
     RUN(test_incl_wrap);
     RUN(test_incl_many_turns);
+    RUN(test_incl_rounding_and_preset);
     RUN(test_incl_output_fits);
     RUN(test_incl_meas);
     RUN(test_incl_limit_edges);
