@@ -124,7 +124,7 @@ co_res_t jd_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
     jd_dev_t *d = dev_of(n);
     unsigned axis = (e->index == 0x2601u || e->index == 0x6022u || e->index == 0x6122u) ? 1u : 0u;
-    int32_t p = e->size == 2u ? (int32_t)(int16_t)v : (int32_t)v;
+    int32_t p = (int32_t)v; /* INTEGER16 comes sign-extended, as co_od_get gives it */
     int32_t lim = 90000 / (int32_t)d->para.resolution;
     if (d->axes == 1u) {
         if (e->size == 2u) {
@@ -151,7 +151,7 @@ co_res_t jd_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 
 co_res_t jd_write_diff(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
-    int32_t x = e->size == 2u ? (int32_t)(int16_t)v : (int32_t)v;
+    int32_t x = (int32_t)v; /* INTEGER16 comes sign-extended, as co_od_get gives it */
     if (!diff_ok(dev_of(n), x)) {
         return CO_E_VAL;
     }
