@@ -515,6 +515,46 @@ static void test_led_patterns(void)
     CHECK(strcmp(co_led_pattern_name(CO_LED_FLASH1), "single flash") == 0);
 }
 
+/* Each CiA 303-3 pattern repeats with its period (flicker 50 + 50 ms,
+ * blinking 200 + 200 ms, single flash 200 + 1000 ms, double flash
+ * 200 + 200 + 200 + 1000 ms): level and time to the next edge in later
+ * cycles, at phase edges and just before them. */
+static void test_led_cycles(void)
+{
+    static const struct {
+        co_led_pattern_t p;
+        uint32_t now;
+        bool on;
+        uint32_t next;
+    } cases[] = {
+        {CO_LED_FLASH2, 1600000, true, 200000},
+        {CO_LED_FLICKER, 50000, false, 50000},
+        {CO_LED_FLICKER, 100000, true, 50000},
+        {CO_LED_FLASH2, 1800000, false, 200000},
+        {CO_LED_FLICKER, 149999, true, 1},
+        {CO_LED_FLICKER, 150000, false, 50000},
+        {CO_LED_FLASH2, 2000000, true, 200000},
+        {CO_LED_BLINK, 400000, true, 200000},
+        {CO_LED_BLINK, 600000, false, 200000},
+        {CO_LED_FLASH2, 2200000, false, 1000000},
+        {CO_LED_BLINK, 4399999, false, 1},
+        {CO_LED_FLASH2, 161599999, false, 1},
+        {CO_LED_FLASH1, 1200000, true, 200000},
+        {CO_LED_FLASH1, 1400000, false, 1000000},
+        {CO_LED_FLASH2, 1000000, false, 600000},
+        {CO_LED_FLASH1, 15799999, true, 1},
+    };
+    for (unsigned i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+        uint32_t next = 0;
+        bool on = co_led_level(cases[i].p, &co_led_cia303, cases[i].now, &next);
+        if (on != cases[i].on || next != cases[i].next) {
+            fprintf(stderr, "  pattern %d at %u us: %d, next %u\n", (int)cases[i].p,
+                    (unsigned)cases[i].now, (int)on, (unsigned)next);
+            FAIL("LED level or next edge");
+        }
+    }
+}
+
 int main(void)
 {
     RUN(test_filter_settling);
@@ -531,5 +571,6 @@ int main(void)
     RUN(test_incl_axis_bounds);
     RUN(test_incl_two_axes_circular);
     RUN(test_led_patterns);
+    RUN(test_led_cycles);
     return h_finish();
 }
