@@ -100,6 +100,11 @@ static void test_dictionary_defaults(void)
             FAIL("an object differs from the table");
         }
     }
+    /* The simulated input starts level: 0 also at the finest resolution. */
+    SDO(d, "2F 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00");
+    SDO(d, "2B 00 60 00 01 00 00 00", "60 00 60 00 00 00 00 00");
+    h_advance(d, 20000);
+    CHECK_EQ(h_read(d, 0x6010, 0), 0);
 }
 
 /* The slope's operating parameter takes CiA 410's bits 0 (inversion) and
@@ -149,6 +154,38 @@ static void test_resolution(void)
     CHECK_EQ(h_read(d, 0x6000, 0), 100);
     CHECK_EQ(h_read(d, 0x6010, 0), 10);
     CHECK_EQ((int16_t)h_read(d, 0x6013, 0), -113);
+    /* Scaling is asked of a new resolution only: saved with scaling off,
+     * the resolution comes back all the same. */
+    SDO(d, "2F 11 60 00 00 00 00 00", "60 11 60 00 00 00 00 00");
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_power_cycle(d);
+    h_advance(d, 20000);
+    CHECK_EQ(h_read(d, 0x6000, 0), 100);
+    CHECK_EQ(h_read(d, 0x6010, 0), 123);
+}
+
+/* A stored set that fails its check at power-on: the table's defaults,
+ * and CiA 301's EMCY 6300h "data set" with the generic error bit, until a
+ * good save. */
+static void test_corrupt_store_emcy(void)
+{
+    h_boot(d, &skel_incl, false);
+    SDO(d, "2B 17 10 00 F4 01 00 00", "60 17 10 00 00 00 00 00");
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    for (unsigned i = 0; i < 2u * CO_STORE_SLOT; i++) {
+        if (d->port.nvm[i] != 0xFFu) {
+            d->port.nvm[i + CO_STORE_HDR] ^= 0x01u; /* a data byte of the record */
+            break;
+        }
+    }
+    h_power_cycle(d);
+    EXPECT(d, 0x720, "00");
+    h_advance(d, 1000);
+    EXPECT(d, 0xA0, "00 63 01 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x1017, 0), 0);
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_advance(d, 1000);
+    EXPECT_ID(d, 0xA0, "00 00 00 00 00 00 00 00");
 }
 
 int main(void)
@@ -160,5 +197,6 @@ int main(void)
     RUN(test_dictionary_defaults);
     RUN(test_operating_parameter_range);
     RUN(test_resolution);
+    RUN(test_corrupt_store_emcy);
     return h_finish();
 }
