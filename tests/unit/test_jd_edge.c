@@ -78,6 +78,26 @@ static void test_jd2_lateral_preset_inverted(void)
     SDO(d, "40 22 61 00 00 00 00 00", "43 22 61 00 2C 01 00 00");
 }
 
+/* R52: a preset sets the offset once, at the angle of that moment; a
+ * saved offset comes back at power-on as it was, whatever the angle is
+ * then (the preset is not taken again). */
+static void test_jd2_preset_offset_survives_power_cycle(void)
+{
+    boot(&jd2xxx);
+    tilt(10000, 0);
+    SDO(d, "22 11 61 00 02 00 00 00", "60 11 61 00 00 00 00 00"); /* scaling on */
+    SDO(d, "22 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00");
+    SDO(d, "23 12 61 00 00 00 00 00", "60 12 61 00 00 00 00 00"); /* zero here */
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    d->truth[0] = 20000;
+    h_power_cycle(d);
+    EXPECT(d, 0x70A, "00");
+    h_advance(d, 20000);
+    SDO(d, "40 10 61 00 00 00 00 00", "43 10 61 00 E8 03 00 00"); /* 10.00 deg past it */
+    SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 E8 03 00 00");
+    SDO(d, "40 13 61 00 00 00 00 00", "43 13 61 00 18 FC FF FF"); /* -1000 */
+}
+
 /* R53: the 16-bit slope is clamped to INTEGER16 only; R56: the 32-bit one
  * carries the same sum unclamped. A differential offset beyond +-90 deg is
  * refused (spec 6014h/6114h, 0x06090030), so only a stored offset reaches
@@ -357,6 +377,7 @@ int main(void)
     RUN(test_lss_activate_bit_timing);
     RUN(test_jd1_preset_and_wrap);
     RUN(test_jd2_lateral_preset_inverted);
+    RUN(test_jd2_preset_offset_survives_power_cycle);
     RUN(test_jd2_slope_limits);
     RUN(test_jd2_negative_fold);
     RUN(test_temperature);
