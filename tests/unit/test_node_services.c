@@ -104,12 +104,13 @@ static const co_node_cfg_t n_cfg = {
     .default_node_id = 0x40,
     .default_bitrate = 3,
     .lss = true,
-    .lss_bitrates = 0x00DF, /* CiA 305 indices 0-4, 6, 7 */
+    .lss_bitrates = 0x01DF, /* CiA 305 indices 0-4, 6-8 */
 };
 
 /* A dictionary with the fewest objects the services work with: no EMCY
  * COB-ID (the default 80h + node-ID), an error history with no field,
- * a guard time without a life time factor, no identity. */
+ * a guard time without a life time factor, a consumer time kept nowhere,
+ * no identity. */
 static const co_od_entry_t n_min_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x0000019Au},
     {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_read_register)},
@@ -117,6 +118,8 @@ static const co_od_entry_t n_min_entries[] = {
     {.index = 0x1003, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_read_hist)},
 #endif
     {.index = 0x100C, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(guard_ms), .def = 0},
+    /* A consumer time kept nowhere (no RAM): fixed at its default. */
+    {.index = 0x1016, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, .def = 0, CO_EXT(.write = co_hbc_write_time)},
 };
 
 static const co_od_t n_min_od = {.entries = n_min_entries,
@@ -236,6 +239,70 @@ static void test_lss_store_in_lss_set(void)
     LSS("17 00 00 00 00 00 00 00", "17 01 00 00 00 00 00 00");
 }
 
+/* LSS "activate bit timing" (CiA 305): each index of the bit timing table
+ * reaches the board as its rate once the switch delay is over; the
+ * reserved index 5 and automatic detection (9) are refused. */
+static void test_lss_bit_timing_table(void)
+{
+    boot();
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    static const struct {
+        uint8_t index;
+        uint16_t kbps;
+    } rates[] = {{0, 1000}, {1, 800}, {2, 500}, {3, 250}, {4, 125}, {6, 50}, {7, 20}, {8, 10}};
+    uint16_t was = d->port.kbps;
+    for (unsigned i = 0; i < sizeof(rates) / sizeof(rates[0]); i++) {
+        co_frame_t f = {.id = 0x7E5, .dlc = 8, .data = {0x13, 0x00, rates[i].index}};
+        h_drain(d);
+        h_rx_frame(d, &f);
+        EXPECT(d, 0x7E4, "13 00 00 00 00 00 00 00");
+        LSS("15 0A 00 00 00 00 00 00", NULL); /* after 10 ms */
+        h_advance(d, 9999);
+        CHECK_EQ(d->port.kbps, was);
+        h_advance(d, 1);
+        CHECK_EQ(d->port.kbps, rates[i].kbps);
+        was = rates[i].kbps;
+    }
+    LSS("13 00 05 00 00 00 00 00", "13 01 00 00 00 00 00 00");
+    LSS("13 00 09 00 00 00 00 00", "13 01 00 00 00 00 00 00");
+}
+
+/* LSS identify remote slave (CiA 305): the revision and serial ranges
+ * include both their bounds; a bound one past the node's value leaves it
+ * out. Inquire identity: each part of 0x1018. Configure node-ID: 1..127
+ * and FFh (none) taken, 0, 80h and FEh refused. */
+static void test_lss_identity_bounds(void)
+{
+    boot();
+    /* vendor, product, revision low, high, serial low, high */
+    static const char *const seq[6] = {"46 78 56 34 12 00 00 00", "47 CD AB 00 00 00 00 00",
+                                       "48 02 00 01 00 00 00 00", "49 02 00 01 00 00 00 00",
+                                       "4A 42 00 00 00 00 00 00", "4B 42 00 00 00 00 00 00"};
+    for (unsigned k = 0; k < 6u; k++) {
+        LSS(seq[k], k == 5u ? "4F 00 00 00 00 00 00 00" : NULL);
+    }
+    /* Each bound one past the node's value: no answer. */
+    static const char *const off[4] = {"48 03 00 01 00 00 00 00", "49 01 00 01 00 00 00 00",
+                                       "4A 43 00 00 00 00 00 00", "4B 41 00 00 00 00 00 00"};
+    for (unsigned j = 0; j < 4u; j++) {
+        for (unsigned k = 0; k < 6u; k++) {
+            LSS(k == j + 2u ? off[j] : seq[k], NULL);
+        }
+    }
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("5A 00 00 00 00 00 00 00", "5A 78 56 34 12 00 00 00");
+    LSS("5B 00 00 00 00 00 00 00", "5B CD AB 00 00 00 00 00");
+    LSS("5C 00 00 00 00 00 00 00", "5C 02 00 01 00 00 00 00");
+    LSS("5D 00 00 00 00 00 00 00", "5D 42 00 00 00 00 00 00");
+    LSS("11 01 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
+    LSS("11 7F 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
+    LSS("11 80 00 00 00 00 00 00", "11 01 00 00 00 00 00 00");
+    LSS("11 FE 00 00 00 00 00 00", "11 01 00 00 00 00 00 00");
+    LSS("04 00 00 00 00 00 00 00", NULL);
+    h_rx(d, 0x000, "82 40");
+    EXPECT(d, 0x77F, "00"); /* the last one taken: 127 */
+}
+
 /* Fastscan: only a node without node-ID in waiting state takes part, and
  * only in the sequence a master runs (restart first, bit 31..0, sub 0..3). */
 static void test_lss_fastscan_ignored_requests(void)
@@ -268,6 +335,21 @@ static void test_lss_fastscan_ignored_requests(void)
     LSS("11 FF 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
     LSS("04 00 00 00 00 00 00 00", NULL);
     LSS("4C 00 00 00 00 00 00 00", "50 00 00 00 00 00 00 00");
+}
+
+/* Fastscan knows LSS address parts 0..3 only: after a master named a
+ * part 4 to go on with, no request for it is answered. */
+static void test_lss_fastscan_no_part_4(void)
+{
+    boot();
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("11 FF 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
+    LSS("04 00 00 00 00 00 00 00", NULL);
+    h_rx(d, 0x000, "82 40");
+    LSS("51 00 00 00 00 80 00 00", "4F 00 00 00 00 00 00 00");
+    LSS("51 78 56 34 12 00 00 04", "4F 00 00 00 00 00 00 00"); /* vendor; next: 4 */
+    LSS("51 00 00 00 00 1F 04 00", NULL);
+    LSS("51 00 00 00 00 00 04 00", NULL);
 }
 
 /* A life-guarding event is cleared by reset communication: error register 0. */
@@ -428,6 +510,13 @@ static void test_heartbeat_consumer_timer(void)
     h_rx_frame(d, &rtr);
     EXPECT(d, 0x1C0, "44 33 22 11 66 55");
     EXPECT_NONE(d);
+    /* Node 1 is a node to watch too. */
+    SDO(d, "23 16 10 01 0A 00 01 00", "60 16 10 01 00 00 00 00"); /* node 1, 10 ms */
+    h_rx(d, 0x701, "05");
+    h_advance(d, 9999);
+    EXPECT_NONE(d);
+    h_advance(d, 1);
+    EXPECT(d, 0xC0, "30 81 11 00 00 00 00 00");
 }
 
 /* A poll late by more than a period sends one heartbeat, not a burst. */
@@ -615,12 +704,17 @@ static void test_fewest_objects(void)
     EXPECT(d, 0x740, "FF");
     h_advance(d, 1000000);
     EXPECT_NONE(d);
+    /* A consumer time without RAM cannot be written (read only). */
+    SDO(d, "23 16 10 01 64 00 05 00", "80 16 10 01 02 00 01 06");
 }
 
 int main(void)
 {
     RUN(test_lss_store_in_lss_set);
     RUN(test_lss_fastscan_ignored_requests);
+    RUN(test_lss_bit_timing_table);
+    RUN(test_lss_identity_bounds);
+    RUN(test_lss_fastscan_no_part_4);
     RUN(test_life_guard_event_cleared_by_reset_communication);
     RUN(test_life_guard_starts_with_a_request);
     RUN(test_guard_and_consumer_events_apart);
