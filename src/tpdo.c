@@ -199,11 +199,9 @@ co_res_t co_tpdo_write_map(co_node_t *node, const co_od_entry_t *e, uint32_t val
     if (checking) {
         return CO_OK;
     }
-    co_res_t r = co_od_store(node, e, value);
-    if (r == CO_OK && n < CO_TPDO_MAX) {
-        co_tpdo_reconfig(node, n);
-    }
-    return r;
+    /* No reconfig: the PDO is invalid while its mapping changes (above),
+     * and the COB-ID's write that makes it valid again reconfigures it. */
+    return co_od_store(node, e, value);
 }
 
 void co_tpdo_start(co_node_t *node)

@@ -1704,6 +1704,38 @@ static void test_tpdo_without_mapped_objects(void)
     EXPECT_NONE(d);
 }
 
+/* A TPDO whose product codes its values big-endian (the DST's "PDO
+ * coding") sends each mapped value most significant byte first: 32, 24
+ * and 16 bits. */
+static void test_tpdo_big_endian_values(void)
+{
+    boot();
+    co_tpdo_set_msb_first(d->node, 0, true);
+    co_tpdo_set_msb_first(d->node, 1, true);
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* TPDO1 quiet */
+    SDO(d, "23 01 18 01 90 02 00 80", "60 01 18 01 00 00 00 00"); /* TPDO2: remap */
+    SDO(d, "2F 01 1A 00 00 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 1A 01 18 00 00 21", "60 01 1A 01 00 00 00 00"); /* 24 bits of 0x2100 */
+    SDO(d, "23 01 1A 02 10 00 01 20", "60 01 1A 02 00 00 00 00"); /* 0x2001 */
+    SDO(d, "2F 01 1A 00 02 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 18 01 90 02 00 00", "60 01 18 01 00 00 00 00");
+    SDO(d, "2F 01 18 02 FD 00 00 00", "60 01 18 02 00 00 00 00"); /* on request only */
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    ((t_dev_t *)h_inst(d))->vol.counter = 0x12345679u;
+    co_frame_t rtr = {.id = 0x190, .rtr = true, .dlc = 6};
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x190, "12 34 56 79 FF FB");
+    rtr.id = 0x290;
+    rtr.dlc = 5;
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x290, "34 56 79 FF FB");
+    co_tpdo_set_msb_first(d->node, 0, false); /* CiA 301's order again */
+    rtr.id = 0x190;
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x190, "79 56 34 12 FB FF");
+}
+
 int main(void)
 {
     RUN(test_od_find);
@@ -1748,5 +1780,6 @@ int main(void)
     RUN(test_tpdo_unusable_default_mapping_after_reset);
     RUN(test_mapping_without_tpdo);
     RUN(test_tpdo_without_mapped_objects);
+    RUN(test_tpdo_big_endian_values);
     return h_finish();
 }
