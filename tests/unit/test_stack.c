@@ -1722,18 +1722,20 @@ static void test_tpdo_big_endian_values(void)
     SDO(d, "2F 01 18 02 FD 00 00 00", "60 01 18 02 00 00 00 00"); /* on request only */
     h_rx(d, 0x000, "01 10");
     h_drain(d);
-    ((t_dev_t *)h_inst(d))->vol.counter = 0x12345679u;
+    /* Odd and even bytes in turn, so that no bit of one lands on another. */
+    ((t_dev_t *)h_inst(d))->vol.counter = 0x12345779u;
     co_frame_t rtr = {.id = 0x190, .rtr = true, .dlc = 6};
     h_rx_frame(d, &rtr);
-    EXPECT(d, 0x190, "12 34 56 79 FF FB");
+    EXPECT(d, 0x190, "12 34 57 79 FF FB");
+    ((t_dev_t *)h_inst(d))->vol.counter = 0x12355779u;
     rtr.id = 0x290;
     rtr.dlc = 5;
     h_rx_frame(d, &rtr);
-    EXPECT(d, 0x290, "34 56 79 FF FB");
+    EXPECT(d, 0x290, "35 57 79 FF FB");
     co_tpdo_set_msb_first(d->node, 0, false); /* CiA 301's order again */
     rtr.id = 0x190;
     h_rx_frame(d, &rtr);
-    EXPECT(d, 0x190, "79 56 34 12 FB FF");
+    EXPECT(d, 0x190, "79 57 35 12 FB FF");
 }
 
 int main(void)
