@@ -98,6 +98,82 @@ static void test_jd2_preset_offset_survives_power_cycle(void)
     SDO(d, "40 13 61 00 00 00 00 00", "43 13 61 00 18 FC FF FF"); /* -1000 */
 }
 
+/* Half away from zero, as the device rounds into a coarser unit. */
+static int32_t div_round(int32_t v, int32_t k)
+{
+    return v >= 0 ? (v + k / 2) / k : -((-v + k / 2) / k);
+}
+
+/* R55: a new resolution carries every preset, offset and differential
+ * offset into the new unit, on both axes, 16- and 32-bit objects: rounded
+ * into a coarser unit, multiplied into a finer one. */
+static void test_jd2_resolution_rescales_everything(void)
+{
+    static const uint16_t objs[] = {0x6012, 0x6013, 0x6014, 0x6022, 0x6023, 0x6024,
+                                    0x6112, 0x6113, 0x6114, 0x6122, 0x6123, 0x6124};
+    enum { N = sizeof(objs) / sizeof(objs[0]) };
+    boot(&jd2xxx);
+    tilt(12345, -5678);
+    SDO(d, "22 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00"); /* scaling on */
+    SDO(d, "22 21 60 00 03 00 00 00", "60 21 60 00 00 00 00 00"); /* and inverted */
+    SDO(d, "22 11 61 00 02 00 00 00", "60 11 61 00 00 00 00 00");
+    SDO(d, "22 21 61 00 02 00 00 00", "60 21 61 00 00 00 00 00");
+    SDO(d, "2B 14 60 00 2D 01 00 00", "60 14 60 00 00 00 00 00"); /* 3.01 deg */
+    SDO(d, "2B 24 60 00 69 FF 00 00", "60 24 60 00 00 00 00 00"); /* -1.51 deg */
+    SDO(d, "23 14 61 00 FB 00 00 00", "60 14 61 00 00 00 00 00"); /* 2.51 deg */
+    SDO(d, "23 24 61 00 CD FF FF FF", "60 24 61 00 00 00 00 00"); /* -0.51 deg */
+    SDO(d, "2B 12 60 00 65 00 00 00", "60 12 60 00 00 00 00 00"); /* X 1.01 deg */
+    SDO(d, "2B 22 60 00 37 FF 00 00", "60 22 60 00 00 00 00 00"); /* Y -2.01 deg */
+    int32_t before[N];
+    for (unsigned i = 0; i < N; i++) {
+        long long v = h_read(d, objs[i], 0);
+        before[i] = objs[i] < 0x6100u ? (int16_t)v : (int32_t)v;
+    }
+    SDO(d, "22 00 60 00 64 00 00 00", "60 00 60 00 00 00 00 00"); /* 0.1 deg */
+    int32_t coarse[N];
+    for (unsigned i = 0; i < N; i++) {
+        long long v = h_read(d, objs[i], 0);
+        coarse[i] = objs[i] < 0x6100u ? (int16_t)v : (int32_t)v;
+        if (coarse[i] != div_round(before[i], 10)) {
+            fprintf(stderr, "  %04Xh: %ld at 0.01 deg, %ld at 0.1 deg\n", (unsigned)objs[i],
+                    (long)before[i], (long)coarse[i]);
+            FAIL("not rounded into the coarser unit");
+        }
+    }
+    SDO(d, "22 00 60 00 0A 00 00 00", "60 00 60 00 00 00 00 00"); /* 0.01 deg again */
+    for (unsigned i = 0; i < N; i++) {
+        long long v = h_read(d, objs[i], 0);
+        int32_t fine = objs[i] < 0x6100u ? (int16_t)v : (int32_t)v;
+        if (fine != coarse[i] * 10) {
+            fprintf(stderr, "  %04Xh: %ld at 0.1 deg, %ld at 0.01 deg\n", (unsigned)objs[i],
+                    (long)coarse[i], (long)fine);
+            FAIL("not multiplied into the finer unit");
+        }
+    }
+}
+
+/* R20: the cyclic time (2200h = 1800h/1801h sub 5) applies at once to
+ * both TPDOs, also while operational. */
+static void test_jd2_cyclic_time_while_operational(void)
+{
+    boot(&jd2xxx);
+    SDO(d, "22 00 18 02 FE 00 00 00", "60 00 18 02 00 00 00 00"); /* both on the timer */
+    SDO(d, "22 01 18 02 FE 00 00 00", "60 01 18 02 00 00 00 00");
+    h_rx(d, 0x000, "01 0A");
+    h_advance(d, 100000);
+    SDO(d, "2B 00 22 00 32 00 00 00", "60 00 22 00 00 00 00 00"); /* 50 ms */
+    h_drain(d);
+    h_advance(d, 500000);
+    unsigned n1 = 0;
+    unsigned n2 = 0;
+    for (const co_frame_t *f = h_next(d); f != NULL; f = h_next(d)) {
+        n1 += f->id == 0x18A;
+        n2 += f->id == 0x28A;
+    }
+    CHECK(n1 >= 9u && n1 <= 11u);
+    CHECK(n2 >= 9u && n2 <= 11u);
+}
+
 /* R53: the 16-bit slope is clamped to INTEGER16 only; R56: the 32-bit one
  * carries the same sum unclamped. A differential offset beyond +-90 deg is
  * refused (spec 6014h/6114h, 0x06090030), so only a stored offset reaches
@@ -378,6 +454,8 @@ int main(void)
     RUN(test_jd1_preset_and_wrap);
     RUN(test_jd2_lateral_preset_inverted);
     RUN(test_jd2_preset_offset_survives_power_cycle);
+    RUN(test_jd2_resolution_rescales_everything);
+    RUN(test_jd2_cyclic_time_while_operational);
     RUN(test_jd2_slope_limits);
     RUN(test_jd2_negative_fold);
     RUN(test_temperature);
