@@ -283,6 +283,34 @@ static void test_block_download_refusals(void)
     SDO(d, "C6 07 20 00 46 00 00 00", "80 07 20 00 05 00 04 05");
 }
 
+/* The block transfer's CRC (CiA 301: CRC-16-CCITT, x^16 + x^12 + x^5 + 1,
+ * initial value 0): the check value of "123456789" is 31C3h, chained or
+ * not; on the bus, frame by frame, both ways. */
+static void test_block_crc(void)
+{
+    static const uint8_t digits[9] = {'1', '2', '3', '4', '5', '6', '7', '8', '9'};
+    CHECK_EQ(co_crc16_ccitt(0, digits, 9), 0x31C3);
+    CHECK_EQ(co_crc16_ccitt(co_crc16_ccitt(0, digits, 4), digits + 4, 5), 0x31C3);
+    CHECK_EQ(co_crc16_ccitt(0x1D0F, digits, 0), 0x1D0F);
+    boot();
+    /* Upload of 1000h (191h): the end carries CRC 871Bh of 91 01 00 00. */
+    SDO(d, "A4 00 10 00 7F 00 00 00", "C6 00 10 00 04 00 00 00");
+    SDO(d, "A3 00 00 00 00 00 00 00", "81 91 01 00 00 00 00 00");
+    SDO(d, "A2 01 7F 00 00 00 00 00", "CD 1B 87 00 00 00 00 00");
+    h_rx(d, 0x620, "A1 00 00 00 00 00 00 00");
+    EXPECT_NONE(d);
+    /* Download of 500 to 2000h: CRC 628Ch of F4 01 00 00 taken ... */
+    SDO(d, "C6 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    SDO(d, "81 F4 01 00 00 00 00 00", "A2 01 0A 00 00 00 00 00");
+    SDO(d, "CD 8C 62 00 00 00 00 00", "A1 00 00 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x2000, 0), 500);
+    /* ... and any other refused with 05040004h, the object unchanged. */
+    SDO(d, "C6 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    SDO(d, "81 20 03 00 00 00 00 00", "A2 01 0A 00 00 00 00 00");
+    SDO(d, "CD 8C 62 00 00 00 00 00", "80 00 20 00 04 00 04 05");
+    CHECK_EQ(h_read(d, 0x2000, 0), 500);
+}
+
 /* Block upload: objects the buffer cannot hold or that have no data, bad
  * block sizes, and frames out of turn; a client without CRC gets none. */
 static void test_block_upload_refusals(void)
@@ -320,6 +348,25 @@ static void test_block_upload_timeout(void)
     EXPECT_NONE(d);
     h_advance(d, 1);
     EXPECT(d, 0x5A0, "80 00 10 00 00 00 04 05");
+}
+
+/* While a transfer waits for the client, the node asks to be polled
+ * again when the SDO timeout falls due, and after the timeout's abort,
+ * with nothing else to time, never (co_node_poll's delay). */
+static void test_poll_delay_of_a_transfer(void)
+{
+    boot();
+    uint32_t t = d->now;
+    CHECK_EQ(co_node_poll(d->node, t), CO_NEVER);
+    SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00");
+    CHECK_EQ(co_node_poll(d->node, t), CO_SDO_TIMEOUT_US);
+    CHECK_EQ(co_node_poll(d->node, t + 400000u), CO_SDO_TIMEOUT_US - 400000u);
+    CHECK_EQ(co_node_poll(d->node, t + CO_SDO_TIMEOUT_US - 1u), 1);
+    EXPECT_NONE(d);
+    CHECK_EQ(co_node_poll(d->node, t + CO_SDO_TIMEOUT_US), CO_NEVER);
+    EXPECT(d, 0x5A0, "80 00 20 00 00 00 04 05");
+    CHECK_EQ(co_node_poll(d->node, t + CO_SDO_TIMEOUT_US + 1u), CO_NEVER);
+    EXPECT_NONE(d);
 }
 
 /* 0x1003: newest first, no deeper than the dictionary, only sub 0 writable. */
@@ -509,7 +556,9 @@ int main(void)
     RUN(test_cobid_odd_base);
     RUN(test_block_download_refusals);
     RUN(test_block_upload_refusals);
+    RUN(test_block_crc);
     RUN(test_block_upload_timeout);
+    RUN(test_poll_delay_of_a_transfer);
     RUN(test_history_depth);
     RUN(test_od_api_checks);
     RUN(test_od_find_every_shape);
