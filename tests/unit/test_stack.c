@@ -1331,6 +1331,7 @@ typedef struct b_vol {
     uint8_t type3;  /* 0x1802 sub 2 */
     uint8_t count3; /* 0x1A02 sub 0 */
     uint32_t map3[3]; /* 0x1A02 sub 1..3 */
+    uint32_t w[2];    /* 0x2300, 0x2301 */
 } b_vol_t;
 
 typedef struct b_dev {
@@ -1738,6 +1739,64 @@ static void test_tpdo_big_endian_values(void)
     EXPECT(d, 0x190, "79 57 35 12 FB FF");
 }
 
+/* Two TPDOs of eight data bytes, two U32 objects: TPDO1 sent at a SYNC
+ * when its data changed (type 0), TPDO2 sampled at a SYNC and sent on
+ * request (type 252). Every byte counts, the eighth too. */
+static const co_od_entry_t e_entries[] = {
+    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
+    {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 2},
+    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = CO_A_R | CO_A_NODEID, .def = 0x180},
+    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = CO_A_R, .def = 0},
+    {.index = 0x1801, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 2},
+    {.index = 0x1801, .sub = 1, CO_TYPE_U32, .attr = CO_A_R | CO_A_NODEID, .def = 0x280},
+    {.index = 0x1801, .sub = 2, CO_TYPE_U8, .attr = CO_A_R, .def = 252},
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 2},
+    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x23000020u},
+    {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, .def = 0x23010020u},
+    {.index = 0x1A01, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 2},
+    {.index = 0x1A01, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x23000020u},
+    {.index = 0x1A01, .sub = 2, CO_TYPE_U32, .attr = CO_A_R, .def = 0x23010020u},
+    {.index = 0x2300, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, w[0])},
+    {.index = 0x2301, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, w[1])},
+};
+
+static const co_od_t e_od = {.entries = e_entries, .count = sizeof(e_entries) / sizeof(e_entries[0])};
+
+static const co_service_t *const e_services[] = {&co_rtr_service, NULL};
+
+static const co_node_cfg_t e_cfg = {
+    .od = &e_od,
+    .services = e_services,
+    .ram_size = {0, sizeof(b_vol_t), 0, 0},
+    .default_node_id = 0x20,
+};
+
+static const product_t e_prod = {.id = "eight bytes", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
+                                 .inst_size = sizeof(b_dev_t), .create = b_create,
+                                 .sample = b_sample, .cfg = &e_cfg};
+
+static void test_tpdo_eighth_byte(void)
+{
+    h_boot(d, &e_prod, false);
+    EXPECT(d, 0x720, "00");
+    b_vol_t *v = &((b_dev_t *)h_inst(d))->vol;
+    v->w[0] = 0x44332211u;
+    v->w[1] = 0x00776655u;
+    h_rx(d, 0x000, "01 20");
+    h_rx(d, 0x080, "");
+    EXPECT(d, 0x1A0, "11 22 33 44 55 66 77 00");
+    h_rx(d, 0x080, "");
+    EXPECT_NONE(d); /* the same data */
+    v->w[1] = 0x01776655u;
+    h_rx(d, 0x080, ""); /* the eighth byte changed: sent; TPDO2 samples it */
+    EXPECT(d, 0x1A0, "11 22 33 44 55 66 77 01");
+    v->w[1] = 0x02776655u;
+    co_frame_t rtr = {.id = 0x2A0, .rtr = true, .dlc = 8};
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x2A0, "11 22 33 44 55 66 77 01"); /* as sampled */
+    EXPECT_NONE(d);
+}
+
 int main(void)
 {
     RUN(test_od_find);
@@ -1783,5 +1842,6 @@ int main(void)
     RUN(test_mapping_without_tpdo);
     RUN(test_tpdo_without_mapped_objects);
     RUN(test_tpdo_big_endian_values);
+    RUN(test_tpdo_eighth_byte);
     return h_finish();
 }
