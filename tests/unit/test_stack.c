@@ -1797,6 +1797,24 @@ static void test_tpdo_eighth_byte(void)
     EXPECT_NONE(d);
 }
 
+/* Transmission type 240, the largest synchronous one: every 240th SYNC. */
+static void test_tpdo_every_240th_sync(void)
+{
+    boot();
+    SDO(d, "2F 00 18 02 F0 00 00 00", "60 00 18 02 00 00 00 00");
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    for (unsigned k = 0; k < 2u; k++) {
+        for (unsigned i = 1; i < 240u; i++) {
+            h_rx(d, 0x080, "");
+        }
+        EXPECT_NONE(d);
+        h_rx(d, 0x080, "");
+        NEXT_IS(0x190);
+        EXPECT_NONE(d);
+    }
+}
+
 int main(void)
 {
     RUN(test_od_find);
@@ -1843,5 +1861,6 @@ int main(void)
     RUN(test_tpdo_without_mapped_objects);
     RUN(test_tpdo_big_endian_values);
     RUN(test_tpdo_eighth_byte);
+    RUN(test_tpdo_every_240th_sync);
     return h_finish();
 }
