@@ -174,6 +174,42 @@ static void test_jd2_cyclic_time_while_operational(void)
     CHECK(n2 >= 9u && n2 <= 11u);
 }
 
+/* R61: the gyro rates 3400h..3402h in 0.1 deg/s, +-500 deg/s at most, from
+ * the angle's change over the 5 ms sample period, the short way round:
+ * the JD2's X and Y turn about its X and Y axes, the JD1's Z about Z. */
+static void test_gyro_rates(void)
+{
+    static const struct {
+        int32_t x, y;
+        int16_t gx, gy;
+    } v[] = {
+        {0, 0, 0, 0},
+        {500, -250, 1000, -500},         /* 100.0 and -50.0 deg/s */
+        {3500, -3250, 5000, -5000},      /* 600 deg/s: the range's ends */
+        {179000, -179000, 5000, -5000},
+        {-179000, 179000, 4000, -4000},  /* across 180 deg: 2 deg the short way */
+        {-179000, 179000, 0, 0},
+    };
+    boot(&jd2xxx);
+    jd_dev_t *j = h_inst(d);
+    for (unsigned i = 0; i < sizeof(v) / sizeof(v[0]); i++) {
+        int32_t in[3] = {v[i].x, v[i].y, 25000};
+        d->prod->sample(j, in, 0);
+        CHECK_EQ((int16_t)h_read(d, 0x3400, 0), v[i].gx);
+        CHECK_EQ((int16_t)h_read(d, 0x3401, 0), v[i].gy);
+        CHECK_EQ((int16_t)h_read(d, 0x3402, 0), 0);
+    }
+    boot(&jd1xxx);
+    j = h_inst(d);
+    for (unsigned i = 0; i < sizeof(v) / sizeof(v[0]); i++) {
+        int32_t in[2] = {v[i].y, 25000};
+        d->prod->sample(j, in, 0);
+        CHECK_EQ((int16_t)h_read(d, 0x3400, 0), 0);
+        CHECK_EQ((int16_t)h_read(d, 0x3401, 0), 0);
+        CHECK_EQ((int16_t)h_read(d, 0x3402, 0), v[i].gy);
+    }
+}
+
 /* R53: the 16-bit slope is clamped to INTEGER16 only; R56: the 32-bit one
  * carries the same sum unclamped. A differential offset beyond +-90 deg is
  * refused (spec 6014h/6114h, 0x06090030), so only a stored offset reaches
@@ -456,6 +492,7 @@ int main(void)
     RUN(test_jd2_preset_offset_survives_power_cycle);
     RUN(test_jd2_resolution_rescales_everything);
     RUN(test_jd2_cyclic_time_while_operational);
+    RUN(test_gyro_rates);
     RUN(test_jd2_slope_limits);
     RUN(test_jd2_negative_fold);
     RUN(test_temperature);

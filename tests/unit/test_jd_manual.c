@@ -162,6 +162,10 @@ static void test_t1_inhibit_only_while_invalid(void)
     SDO(d, "22 00 18 01 8A 01 00 00", "60 00 18 01 00 00 00 00");
     SDO(d, "40 00 18 03 00 00 00 00", "4B 00 18 03 E8 03 00 00");
     SDO(d, "40 01 18 03 00 00 00 00", "4B 01 18 03 01 00 00 00"); /* TPDO2 default 1 (C10) */
+    /* Valid is bit 31 clear, whatever the CAN-ID: an odd one too. */
+    SDO(d, "22 00 18 01 A1 01 00 80", "60 00 18 01 00 00 00 00");
+    SDO(d, "22 00 18 01 A1 01 00 00", "60 00 18 01 00 00 00 00");
+    SDO(d, "22 00 18 03 64 00 00 00", "80 00 18 03 30 00 09 06");
 }
 
 static void test_derived_s_vectors(void)
