@@ -210,6 +210,24 @@ static void test_gyro_rates(void)
     }
 }
 
+/* R41, R42: 3000h = node-ID - 1, 0x7E the last (node 127); read with 3001h
+ * at power-on and reset node after a save: a reset communication keeps
+ * the running node-ID and bit rate. */
+static void test_node_number_at_reset_node_only(void)
+{
+    boot(&jd2xxx);
+    SDO(d, "22 00 30 00 7E 00 00 00", "60 00 30 00 00 00 00 00");
+    SDO(d, "22 01 30 00 05 00 00 00", "60 01 30 00 00 00 00 00"); /* 500 kbit/s */
+    SDO(d, "22 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x000, "82 0A");
+    EXPECT(d, 0x70A, "00");
+    CHECK_EQ(d->port.kbps, 125);
+    h_rx(d, 0x000, "81 0A");
+    EXPECT(d, 0x77F, "00");
+    CHECK_EQ(d->port.kbps, 500);
+}
+
 /* R53: the 16-bit slope is clamped to INTEGER16 only; R56: the 32-bit one
  * carries the same sum unclamped. A differential offset beyond +-90 deg is
  * refused (spec 6014h/6114h, 0x06090030), so only a stored offset reaches
@@ -493,6 +511,7 @@ int main(void)
     RUN(test_jd2_resolution_rescales_everything);
     RUN(test_jd2_cyclic_time_while_operational);
     RUN(test_gyro_rates);
+    RUN(test_node_number_at_reset_node_only);
     RUN(test_jd2_slope_limits);
     RUN(test_jd2_negative_fold);
     RUN(test_temperature);
