@@ -131,6 +131,8 @@ static const co_node_cfg_t n_min_cfg = {
     .ram_size = {0, 0, sizeof(n_para_t), 0},
     .default_node_id = 0x40,
     .default_bitrate = 3,
+    .lss = true,
+    .lss_bitrates = 0x0008,
 };
 
 /* variant: NULL = the test dictionary; otherwise what it points to. */
@@ -706,6 +708,27 @@ static void test_fewest_objects(void)
     EXPECT_NONE(d);
     /* A consumer time without RAM cannot be written (read only). */
     SDO(d, "23 16 10 01 64 00 05 00", "80 16 10 01 02 00 01 06");
+    /* No identity object: LSS inquiries answer 0. */
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("5A 00 00 00 00 00 00 00", "5A 00 00 00 00 00 00 00");
+    LSS("5D 00 00 00 00 00 00 00", "5D 00 00 00 00 00 00 00");
+}
+
+/* A reset starts LSS afresh: waiting state, no selection sequence in
+ * progress. */
+static void test_lss_reset_starts_afresh(void)
+{
+    boot();
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("5E 00 00 00 00 00 00 00", "5E 40 00 00 00 00 00 00");
+    h_rx(d, 0x000, "82 40");
+    LSS("5E 00 00 00 00 00 00 00", NULL); /* waiting */
+    LSS("40 78 56 34 12 00 00 00", NULL);
+    LSS("41 CD AB 00 00 00 00 00", NULL);
+    h_rx(d, 0x000, "82 40");
+    LSS("42 02 00 01 00 00 00 00", NULL);
+    LSS("43 42 00 00 00 00 00 00", NULL); /* the selection began before the reset */
+    LSS("5E 00 00 00 00 00 00 00", NULL);
 }
 
 int main(void)
@@ -715,6 +738,7 @@ int main(void)
     RUN(test_lss_bit_timing_table);
     RUN(test_lss_identity_bounds);
     RUN(test_lss_fastscan_no_part_4);
+    RUN(test_lss_reset_starts_afresh);
     RUN(test_life_guard_event_cleared_by_reset_communication);
     RUN(test_life_guard_starts_with_a_request);
     RUN(test_guard_and_consumer_events_apart);
