@@ -228,6 +228,46 @@ static void test_node_number_at_reset_node_only(void)
     CHECK_EQ(d->port.kbps, 500);
 }
 
+/* R2, R64, C33: 3005h = 1 starts the node on its own right after every
+ * boot-up (power-on after a save, and a reset communication); 0 leaves it
+ * pre-operational. */
+static void test_autostart(void)
+{
+    boot(&jd2xxx);
+    SDO(d, "22 05 30 00 01 00 00 00", "60 05 30 00 00 00 00 00");
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP); /* at the next boot */
+    SDO(d, "22 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_power_cycle(d);
+    EXPECT(d, 0x70A, "00");
+    CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
+    SDO(d, "22 05 30 00 00 00 00 00", "60 05 30 00 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x000, "82 0A");
+    EXPECT(d, 0x70A, "00");
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
+}
+
+/* R46: CiA 305 bit-timing indices (0 = 1000 ... 4 = 125, 6 = 50, 7 = 20
+ * kbit/s) stored by LSS as the 3001h codes (0 = 20 ... 7 = 1000 kbit/s). */
+static void test_lss_bit_timing_codes(void)
+{
+    static const uint8_t code[8] = {7, 6, 5, 4, 3, 0xFF, 1, 0};
+    boot(&jd2xxx);
+    h_rx(d, 0x7E5, "04 01 00 00 00 00 00 00");
+    for (uint8_t i = 0; i < 8u; i++) {
+        if (code[i] == 0xFFu) {
+            continue;
+        }
+        co_frame_t f = {.id = 0x7E5, .dlc = 8, .data = {0x13, 0x00, i}};
+        h_drain(d);
+        h_rx_frame(d, &f);
+        EXPECT(d, 0x7E4, "13 00 00 00 00 00 00 00");
+        h_rx(d, 0x7E5, "17 00 00 00 00 00 00 00");
+        EXPECT(d, 0x7E4, "17 00 00 00 00 00 00 00");
+        CHECK_EQ(h_read(d, 0x3001, 0), code[i]);
+    }
+}
+
 /* R53: the 16-bit slope is clamped to INTEGER16 only; R56: the 32-bit one
  * carries the same sum unclamped. A differential offset beyond +-90 deg is
  * refused (spec 6014h/6114h, 0x06090030), so only a stored offset reaches
@@ -512,6 +552,8 @@ int main(void)
     RUN(test_jd2_cyclic_time_while_operational);
     RUN(test_gyro_rates);
     RUN(test_node_number_at_reset_node_only);
+    RUN(test_autostart);
+    RUN(test_lss_bit_timing_codes);
     RUN(test_jd2_slope_limits);
     RUN(test_jd2_negative_fold);
     RUN(test_temperature);
