@@ -309,6 +309,23 @@ static void test_failed_autosave_changes_nothing(void)
     CHECK_EQ(h_read(d, 0x6012, 0), 0);
 }
 
+/* R56: the zero point sets the offset once, at the position of that
+ * moment; stored at once (G2), the offset comes back at power-on as it
+ * was, the sensor elsewhere by then (the preset is not taken again). */
+static void test_zero_point_kept_across_power_cycle(void)
+{
+    boot(&pf_inx360d);
+    settle(131700, 0);
+    SDO(d, "2F 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00"); /* scaling on */
+    SDO(d, "2B 12 60 00 00 00 00 00", "60 12 60 00 00 00 00 00"); /* zero here */
+    d->truth[0] = 140000;
+    h_power_cycle(d);
+    EXPECT(d, 0x701, "00");
+    settle(140000, 0);
+    SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 53 00 00 00"); /* 8.3 deg past it */
+    SDO(d, "40 13 60 00 00 00 00 00", "4B 13 60 00 EB 08 00 00"); /* 2283, as set */
+}
+
 static void test_d25_stopped_and_d26_store(void)
 {
     boot(&pf_inx360d);
@@ -386,6 +403,7 @@ int main(void)
     RUN(test_v19_v20_guarding_d22_d24);
     RUN(test_v21_to_v24_zero_point_d12_to_d18);
     RUN(test_failed_autosave_changes_nothing);
+    RUN(test_zero_point_kept_across_power_cycle);
     RUN(test_d25_stopped_and_d26_store);
     RUN(test_eeprom_checksum_6300);
     RUN(test_dynamic_mapping_and_cobid);
