@@ -1815,6 +1815,77 @@ static void test_tpdo_every_240th_sync(void)
     }
 }
 
+/* The RTR service passes on every frame that is not a remote request for
+ * one of its TPDOs: listed first, it leaves node guarding its requests and
+ * the heartbeat consumer its heartbeats (here producer 5, 100 ms). */
+static const co_od_entry_t r_entries[] = {
+    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
+    {.index = 0x100C, .sub = 0, CO_TYPE_U16, .attr = CO_A_R | CO_A_CONST, .def = 0},
+    {.index = 0x100D, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 0},
+    {.index = 0x1016, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 1},
+    {.index = 0x1016, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x00050064u},
+    {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 2},
+    {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = CO_A_R | CO_A_NODEID, .def = 0x180},
+    {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = CO_A_R, .def = 253},
+    {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
+    {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
+    {.index = 0x2101, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_PDO, .def = 0x5A},
+};
+
+static const co_od_t r_od = {.entries = r_entries, .count = sizeof(r_entries) / sizeof(r_entries[0])};
+
+static const co_service_t *const r_services[] = {&co_rtr_service, &co_guard_service,
+                                                 &co_hbc_service, NULL};
+
+static const co_node_cfg_t r_cfg = {
+    .od = &r_od,
+    .services = r_services,
+    .ram_size = {0, sizeof(b_vol_t), 0, 0},
+    .default_node_id = 0x20,
+};
+
+static const product_t r_prod = {.id = "rtr first", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
+                                 .inst_size = sizeof(b_dev_t), .create = b_create,
+                                 .sample = b_sample, .cfg = &r_cfg};
+
+static void test_rtr_service_passes_other_frames_on(void)
+{
+    h_boot(d, &r_prod, false);
+    EXPECT(d, 0x720, "00");
+    h_rx(d, 0x000, "01 20");
+    co_frame_t rtr = {.id = 0x1A0, .rtr = true, .dlc = 1};
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x1A0, "5A");
+    rtr.id = 0x720;
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x720, "05"); /* guarded */
+    h_rx(d, 0x705, "05"); /* producer 5's heartbeat: the consumer runs */
+    h_advance(d, 99000);
+    CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
+    h_advance(d, 2000);
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP); /* producer 5 lost */
+}
+
+/* Two TPDOs on one COB-ID: a remote request is answered once, by the
+ * first. */
+static void test_rtr_answered_once(void)
+{
+    boot();
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* TPDO1 quiet */
+    SDO(d, "23 01 18 01 90 02 00 80", "60 01 18 01 00 00 00 00");
+    SDO(d, "2F 01 1A 00 00 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 1A 01 10 00 01 20", "60 01 1A 01 00 00 00 00"); /* 0x2001, 16 bits */
+    SDO(d, "2F 01 1A 00 01 00 00 00", "60 01 1A 00 00 00 00 00");
+    SDO(d, "23 01 18 01 90 01 00 00", "60 01 18 01 00 00 00 00"); /* TPDO1's CAN-ID */
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    co_frame_t rtr = {.id = 0x190, .rtr = true, .dlc = 6};
+    h_rx_frame(d, &rtr);
+    const co_frame_t *f = h_next(d);
+    CHECK(f != NULL && f->id == 0x190 && f->dlc == 6);
+    EXPECT_NONE(d);
+}
+
 int main(void)
 {
     RUN(test_od_find);
@@ -1862,5 +1933,7 @@ int main(void)
     RUN(test_tpdo_big_endian_values);
     RUN(test_tpdo_eighth_byte);
     RUN(test_tpdo_every_240th_sync);
+    RUN(test_rtr_service_passes_other_frames_on);
+    RUN(test_rtr_answered_once);
     return h_finish();
 }
