@@ -1886,6 +1886,24 @@ static void test_rtr_answered_once(void)
     EXPECT_NONE(d);
 }
 
+/* co_tpdo_changed() (a product's change-of-state check, co_tpdo.h):
+ * whether an event-driven TPDO's data differ from what it last sent; false
+ * outside operational, for an invalid TPDO and for one that is not
+ * event-driven. */
+static void test_tpdo_changed(void)
+{
+    boot();
+    CHECK(!co_tpdo_changed(d->node, 0)); /* pre-operational */
+    h_rx(d, 0x000, "01 10");
+    NEXT_IS(0x190); /* sent at once: the event timer */
+    CHECK(!co_tpdo_changed(d->node, 0));
+    CHECK(!co_tpdo_changed(d->node, 1)); /* TPDO2: its default mapping is unusable */
+    SDO(d, "2B 01 20 00 03 00 00 00", "60 01 20 00 00 00 00 00");
+    CHECK(co_tpdo_changed(d->node, 0));
+    SDO(d, "2F 00 18 02 01 00 00 00", "60 00 18 02 00 00 00 00"); /* synchronous */
+    CHECK(!co_tpdo_changed(d->node, 0));
+}
+
 int main(void)
 {
     RUN(test_od_find);
@@ -1935,5 +1953,6 @@ int main(void)
     RUN(test_tpdo_every_240th_sync);
     RUN(test_rtr_service_passes_other_frames_on);
     RUN(test_rtr_answered_once);
+    RUN(test_tpdo_changed);
     return h_finish();
 }
