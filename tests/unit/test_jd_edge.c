@@ -268,6 +268,31 @@ static void test_lss_bit_timing_codes(void)
     }
 }
 
+/* R47: LSS "store" writes the node-ID (1 and 127, the ends, as 3000h 00h
+ * and 7Eh) and the manufacturer parameters (2000h-5FFFh) only: an
+ * application parameter changed meanwhile (6000h) is not saved with them. */
+static void test_lss_store_node_id_ends(void)
+{
+    boot(&jd2xxx);
+    SDO(d, "22 00 60 00 64 00 00 00", "60 00 60 00 00 00 00 00"); /* 0.1 deg, not saved */
+    h_rx(d, 0x7E5, "04 01 00 00 00 00 00 00");
+    h_rx(d, 0x7E5, "11 01 00 00 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x7E5, "17 00 00 00 00 00 00 00");
+    EXPECT(d, 0x7E4, "17 00 00 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x3000, 0), 0x00);
+    h_rx(d, 0x7E5, "11 7F 00 00 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x7E5, "17 00 00 00 00 00 00 00");
+    EXPECT(d, 0x7E4, "17 00 00 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x3000, 0), 0x7E);
+    h_power_cycle(d);
+    EXPECT(d, 0x77F, "00");
+    h_drain(d);
+    h_rx(d, 0x67F, "40 00 60 00 00 00 00 00");
+    EXPECT(d, 0x5FF, "4B 00 60 00 0A 00 00 00"); /* 0.01 deg: not stored by LSS */
+}
+
 /* R53: the 16-bit slope is clamped to INTEGER16 only; R56: the 32-bit one
  * carries the same sum unclamped. A differential offset beyond +-90 deg is
  * refused (spec 6014h/6114h, 0x06090030), so only a stored offset reaches
@@ -554,6 +579,7 @@ int main(void)
     RUN(test_node_number_at_reset_node_only);
     RUN(test_autostart);
     RUN(test_lss_bit_timing_codes);
+    RUN(test_lss_store_node_id_ends);
     RUN(test_jd2_slope_limits);
     RUN(test_jd2_negative_fold);
     RUN(test_temperature);
