@@ -654,8 +654,10 @@ static void test_tpdo_reconfig_out_of_range(void)
 }
 
 /* The contract's setters (co_node.h): node-ID, bit rate and automatic
- * start only from the reset hook; a TPDO's byte order, a store status and
- * a corrupt mark only for what exists. Anything else: a CO_CHECK report, nothing changed. */
+ * start only from the reset hook; a TPDO's byte order, event and change
+ * check, a store status and a corrupt mark only for what exists (TPDO
+ * number CO_TPDO_MAX is the first that does not). Anything else: a
+ * CO_CHECK report, nothing changed. */
 static void test_contract_broken_changes_nothing(void)
 {
     boot();
@@ -663,22 +665,26 @@ static void test_contract_broken_changes_nothing(void)
     static co_node_t before;
     memcpy(&before, n, sizeof(before));
     unsigned seen = h_asserts;
-    h_expect_assert(7);
+    h_expect_assert(9);
     co_node_set_id(n, 0x20);        /* pre-operational: not in a reset */
     co_node_set_bitrate(n, 1);
     co_node_set_autostart(n, true);
     co_tpdo_set_msb_first(n, CO_TPDO_MAX, true);
+    co_tpdo_event(n, CO_TPDO_MAX);
+    CHECK(!co_tpdo_changed(n, CO_TPDO_MAX));
     CHECK_EQ(co_node_store_status(n, CO_CLS_VOL), CO_STORE_BLANK);
     CHECK_EQ(co_node_store_status(n, CO_CLS_COUNT), CO_STORE_BLANK);
     co_store_mark_corrupt(n, CO_CLS_COUNT);
-    CHECK_EQ(h_asserts, seen + 7u);
+    CHECK_EQ(h_asserts, seen + 9u);
     CHECK(memcmp(&before, n, sizeof(before)) == 0);
     CHECK_EQ(co_node_id(n), 0x10);
     CHECK_EQ(co_node_nmt_state(n), CO_NMT_PREOP);
     /* What exists: no report. */
     CHECK_EQ(co_node_store_status(n, CO_CLS_PARA), CO_STORE_BLANK); /* a fresh EEPROM */
     co_tpdo_set_msb_first(n, CO_TPDO_MAX - 1u, false);
-    CHECK_EQ(h_asserts, seen + 7u);
+    co_tpdo_event(n, CO_TPDO_MAX - 1u);
+    (void)co_tpdo_changed(n, CO_TPDO_MAX - 1u);
+    CHECK_EQ(h_asserts, seen + 9u);
 }
 
 static void test_emcy(void)
