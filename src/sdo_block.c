@@ -54,15 +54,15 @@ static void block_download_segment(co_node_t *node, const uint8_t *d)
     bool last = c;
     sdo_restart(sdo);
     if (seqno == (uint8_t)(sdo->seq + 1u)) {
-        if (sdo->pos + 7u > CO_SDO_BUF + 7u) {
+        if (sdo->pos > CO_SDO_BUF) { /* earlier segments brought more than the buffer */
             uint8_t mux[4];
             sdo_mux(sdo, mux);
             sdo_abort(node, mux, CO_E_LEN_HIGH);
             return;
         }
-        /* Keep at most the buffer; bytes past it make the end check fail. */
-        uint32_t room = sdo->pos < CO_SDO_BUF ? CO_SDO_BUF - sdo->pos : 0u;
-        memcpy(&sdo->buf[sdo->pos], &d[1], co_min_u32(7u, room));
+        /* Keep at most the buffer (pos <= CO_SDO_BUF here); bytes past it
+         * make the end check fail. */
+        memcpy(&sdo->buf[sdo->pos], &d[1], co_min_u32(7u, CO_SDO_BUF - sdo->pos));
         sdo->pos += 7u;
         sdo->seq = seqno;
     } else {
@@ -188,9 +188,6 @@ static void block_upload_client(co_node_t *node, const uint8_t *d)
         sdo->blksize = d[2];
         if (sdo->blk_start >= sdo->size) {
             uint32_t unused = (7u - sdo->size % 7u) % 7u;
-            if (sdo->size == 0u) {
-                unused = 0;
-            }
             uint8_t out[8] = {(uint8_t)(0xC1u | (unused << 2)), 0, 0, 0, 0, 0, 0, 0};
             if (sdo->crc) {
                 co_put_u16(&out[1], co_crc16_ccitt(0, sdo->buf, sdo->size));

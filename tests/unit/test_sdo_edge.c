@@ -311,6 +311,55 @@ static void test_block_crc(void)
     CHECK_EQ(h_read(d, 0x2000, 0), 500);
 }
 
+/* A block download's segments: a new transfer after one the client
+ * aborted in mid-block starts at sequence number 1 again; each segment
+ * restarts the SDO timeout; a download that fills the transfer buffer
+ * leaves the rest of the node as it was. */
+static void test_block_download_segments(void)
+{
+    boot();
+    SDO(d, "C6 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    h_rx(d, 0x620, "01 F4 01 00 00 00 00 00"); /* not the last: no answer */
+    EXPECT_NONE(d);
+    h_rx(d, 0x620, "80 00 20 00 00 00 04 05");
+    EXPECT_NONE(d);
+    SDO(d, "C6 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    SDO(d, "81 C8 00 00 00 00 00 00", "A2 01 0A 00 00 00 00 00");
+    SDO(d, "CD 67 36 00 00 00 00 00", "A1 00 00 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x2000, 0), 200);
+    /* Segment and end each 0.9 s after the frame before. */
+    SDO(d, "C6 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    h_advance(d, 900000);
+    SDO(d, "81 F4 01 00 00 00 00 00", "A2 01 0A 00 00 00 00 00");
+    h_advance(d, 900000);
+    EXPECT_NONE(d);
+    SDO(d, "CD 8C 62 00 00 00 00 00", "A1 00 00 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x2000, 0), 500);
+    /* 64 bytes of FFh into the 64-byte string: the buffer is full, the
+     * string refuses the write, and the node runs on. */
+    SDO(d, "C2 0A 20 00 40 00 00 00", "A4 0A 20 00 0A 00 00 00"); /* no CRC */
+    for (unsigned k = 1; k <= 10u; k++) {
+        co_frame_t f = {.id = 0x620, .dlc = 8, .data = {(uint8_t)(k | (k == 10u ? 0x80u : 0u)),
+                                                        0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF}};
+        h_rx_frame(d, &f);
+    }
+    EXPECT(d, 0x5A0, "A2 0A 0A 00 00 00 00 00");
+    SDO(d, "D9 00 00 00 00 00 00 00", "80 0A 20 00 02 00 01 06"); /* 6 unused */
+    /* "ABCDEFGH" into the 8-byte string, in two segments: every byte is
+     * kept (the CRC, 10D1h, matches), then the string refuses the write. */
+    SDO(d, "C6 04 20 00 08 00 00 00", "A4 04 20 00 0A 00 00 00");
+    h_rx(d, 0x620, "01 41 42 43 44 45 46 47");
+    EXPECT_NONE(d);
+    SDO(d, "82 48 00 00 00 00 00 00", "A2 02 0A 00 00 00 00 00");
+    SDO(d, "D9 D1 10 00 00 00 00 00", "80 04 20 00 02 00 01 06");
+    h_rx(d, 0x000, "01 20");
+    h_advance(d, 100000);
+    h_rx(d, 0x080, "");
+    h_advance(d, 100000);
+    h_drain(d);
+    CHECK_EQ(h_read(d, 0x2000, 0), 500);
+}
+
 /* Block upload: objects the buffer cannot hold or that have no data, bad
  * block sizes, and frames out of turn; a client without CRC gets none. */
 static void test_block_upload_refusals(void)
@@ -557,6 +606,7 @@ int main(void)
     RUN(test_block_download_refusals);
     RUN(test_block_upload_refusals);
     RUN(test_block_crc);
+    RUN(test_block_download_segments);
     RUN(test_block_upload_timeout);
     RUN(test_poll_delay_of_a_transfer);
     RUN(test_history_depth);
