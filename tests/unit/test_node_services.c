@@ -340,7 +340,9 @@ static void test_lss_fastscan_ignored_requests(void)
 }
 
 /* Fastscan knows LSS address parts 0..3 only: after a master named a
- * part 4 to go on with, no request for it is answered. */
+ * part 4 to go on with, no request for it is answered. A restart begins
+ * at part 0; the node is selected when part 3 is confirmed with 0 to go
+ * on with, not before; a scan after that needs a restart. */
 static void test_lss_fastscan_no_part_4(void)
 {
     boot();
@@ -352,6 +354,22 @@ static void test_lss_fastscan_no_part_4(void)
     LSS("51 78 56 34 12 00 00 04", "4F 00 00 00 00 00 00 00"); /* vendor; next: 4 */
     LSS("51 00 00 00 00 1F 04 00", NULL);
     LSS("51 00 00 00 00 00 04 00", NULL);
+    /* A restart begins at part 0 again. */
+    LSS("51 00 00 00 00 80 00 00", "4F 00 00 00 00 00 00 00");
+    LSS("51 00 00 00 00 1F 00 00", "4F 00 00 00 00 00 00 00");
+    /* Part 0 confirmed with 0 to go on with: not yet the whole address. */
+    LSS("51 78 56 34 12 00 00 00", "4F 00 00 00 00 00 00 00");
+    LSS("5E 00 00 00 00 00 00 00", NULL); /* still waiting */
+    /* All four parts confirmed: selected (configuration state). */
+    LSS("51 78 56 34 12 00 00 01", "4F 00 00 00 00 00 00 00");
+    LSS("51 CD AB 00 00 00 01 02", "4F 00 00 00 00 00 00 00");
+    LSS("51 02 00 01 00 00 02 03", "4F 00 00 00 00 00 00 00");
+    LSS("51 42 00 00 00 00 03 00", "4F 00 00 00 00 00 00 00");
+    LSS("5E 00 00 00 00 00 00 00", "5E FF 00 00 00 00 00 00");
+    /* Back in waiting, a new scan needs its restart first. */
+    LSS("04 00 00 00 00 00 00 00", NULL);
+    LSS("51 78 56 34 12 00 00 01", NULL);
+    LSS("51 00 00 00 00 1F 00 00", NULL);
 }
 
 /* A life-guarding event is cleared by reset communication: error register 0. */
