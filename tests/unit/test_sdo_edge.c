@@ -386,6 +386,53 @@ static void test_block_upload_refusals(void)
     SDO(d, "A3 00 00 00 00 00 00 00", "80 00 10 00 01 00 04 05");
 }
 
+/* Block upload in more than one block, frame by frame: blocks of one
+ * segment; blocks of two where the client got the first segment only and
+ * is sent the rest again; an acknowledge of more segments than were sent
+ * (05040003h); a new block size of 127 taken and of 128 refused
+ * (05040002h); an object of the transfer buffer's 64 bytes in one block. */
+static void test_block_upload_blocks(void)
+{
+    boot();
+    SDO(d, "A4 04 20 00 01 00 00 00", "C6 04 20 00 08 00 00 00");
+    SDO(d, "A3 00 00 00 00 00 00 00", "01 31 32 33 34 35 36 37");
+    SDO(d, "A2 01 01 00 00 00 00 00", "81 38 00 00 00 00 00 00");
+    SDO(d, "A2 01 01 00 00 00 00 00", "D9 15 90 00 00 00 00 00"); /* 6 unused, CRC */
+    h_rx(d, 0x620, "A1 00 00 00 00 00 00 00");
+    EXPECT_NONE(d);
+    SDO(d, "A4 04 20 00 02 00 00 00", "C6 04 20 00 08 00 00 00");
+    h_rx(d, 0x620, "A3 00 00 00 00 00 00 00");
+    EXPECT(d, 0x5A0, "01 31 32 33 34 35 36 37");
+    EXPECT(d, 0x5A0, "82 38 00 00 00 00 00 00");
+    SDO(d, "A2 01 02 00 00 00 00 00", "81 38 00 00 00 00 00 00");
+    SDO(d, "A2 01 02 00 00 00 00 00", "D9 15 90 00 00 00 00 00");
+    h_rx(d, 0x620, "A1 00 00 00 00 00 00 00");
+    EXPECT_NONE(d);
+    SDO(d, "A4 04 20 00 02 00 00 00", "C6 04 20 00 08 00 00 00");
+    h_rx(d, 0x620, "A3 00 00 00 00 00 00 00");
+    h_drain(d);
+    SDO(d, "A2 03 02 00 00 00 00 00", "80 04 20 00 03 00 04 05");
+    SDO(d, "A4 04 20 00 01 00 00 00", "C6 04 20 00 08 00 00 00");
+    SDO(d, "A3 00 00 00 00 00 00 00", "01 31 32 33 34 35 36 37");
+    SDO(d, "A2 01 7F 00 00 00 00 00", "81 38 00 00 00 00 00 00");
+    SDO(d, "A2 01 7F 00 00 00 00 00", "D9 15 90 00 00 00 00 00");
+    h_rx(d, 0x620, "A1 00 00 00 00 00 00 00");
+    SDO(d, "A4 04 20 00 01 00 00 00", "C6 04 20 00 08 00 00 00");
+    SDO(d, "A3 00 00 00 00 00 00 00", "01 31 32 33 34 35 36 37");
+    SDO(d, "A2 01 80 00 00 00 00 00", "80 04 20 00 02 00 04 05");
+    SDO(d, "A4 0A 20 00 7F 00 00 00", "C6 0A 20 00 40 00 00 00");
+    h_rx(d, 0x620, "A3 00 00 00 00 00 00 00");
+    for (unsigned k = 1; k <= 10u; k++) {
+        const co_frame_t *f = h_next(d);
+        CHECK(f != NULL && f->data[0] == (k | (k == 10u ? 0x80u : 0u)) &&
+              memcmp(&f->data[1], &BUF_NAME[7u * (k - 1u)], k == 10u ? 1u : 7u) == 0);
+    }
+    EXPECT_NONE(d);
+    SDO(d, "A2 0A 7F 00 00 00 00 00", "D9 93 04 00 00 00 00 00");
+    h_rx(d, 0x620, "A1 00 00 00 00 00 00 00");
+    EXPECT_NONE(d);
+}
+
 /* A block upload the client never acknowledges times out like any transfer. */
 static void test_block_upload_timeout(void)
 {
@@ -608,6 +655,7 @@ int main(void)
     RUN(test_block_crc);
     RUN(test_block_download_segments);
     RUN(test_block_upload_timeout);
+    RUN(test_block_upload_blocks);
     RUN(test_poll_delay_of_a_transfer);
     RUN(test_history_depth);
     RUN(test_od_api_checks);
