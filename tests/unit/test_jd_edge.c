@@ -191,6 +191,8 @@ static void test_gyro_rates(void)
         {-179000, 179000, 0, 0},
     };
     boot(&jd2xxx);
+    CHECK_EQ(h_read(d, 0x3400, 0), 0); /* at rest from power-on */
+    CHECK_EQ(h_read(d, 0x3401, 0), 0);
     jd_dev_t *j = h_inst(d);
     for (unsigned i = 0; i < sizeof(v) / sizeof(v[0]); i++) {
         int32_t in[3] = {v[i].x, v[i].y, 25000};
@@ -291,6 +293,69 @@ static void test_lss_store_node_id_ends(void)
     h_drain(d);
     h_rx(d, 0x67F, "40 00 60 00 00 00 00 00");
     EXPECT(d, 0x5FF, "4B 00 60 00 0A 00 00 00"); /* 0.01 deg: not stored by LSS */
+}
+
+/* R59: 3100h = N averages the last N samples (fewer while the window
+ * fills); a new N starts a new window. */
+static void test_moving_average_window(void)
+{
+    static const struct {
+        uint16_t n;
+        int32_t x;
+        int16_t out; /* 6010h, 0.01 deg */
+    } v[] = {
+        {4, 4000, 400},   {4, 8000, 600},   {4, 12000, 800},  {4, 16000, 1000},
+        {4, 20000, 1400}, {4, 24000, 1800}, {2, 28000, 2800}, {2, 32000, 3000},
+        {2, 36000, 3400}, {0, -5000, -500}, {1, 7000, 700},   {1, 9000, 900},
+    };
+    boot(&jd2xxx);
+    jd_dev_t *j = h_inst(d);
+    for (unsigned i = 0; i < sizeof(v) / sizeof(v[0]); i++) {
+        if (i == 0u || v[i].n != v[i - 1u].n) {
+            co_frame_t f = {.id = 0x60A, .dlc = 8, .data = {0x2B, 0x00, 0x31, 0x00}};
+            co_put_u16(&f.data[4], v[i].n);
+            h_drain(d);
+            h_rx_frame(d, &f);
+            EXPECT(d, 0x58A, "60 00 31 00 00 00 00 00");
+        }
+        int32_t in[3] = {v[i].x, 0, 25000};
+        d->prod->sample(j, in, 0);
+        CHECK_EQ((int16_t)h_read(d, 0x6010, 0), v[i].out);
+    }
+}
+
+/* R49: beyond +-90 deg the JD2 folds back exactly: 100.006 deg is 79.994
+ * (79.99 at 0.01 deg), -100.006 deg -79.994. */
+static void test_jd2_fold_is_exact(void)
+{
+    boot(&jd2xxx);
+    tilt(100006, -100006);
+    CHECK_EQ((int16_t)h_read(d, 0x6010, 0), 7999);
+    CHECK_EQ((int16_t)h_read(d, 0x6020, 0), -7999);
+}
+
+/* R18: transmission type 254 without an event timer sends a TPDO when its
+ * data changed, both TPDOs, and nothing while the data stay the same. */
+static void test_change_of_state_both_tpdos(void)
+{
+    boot(&jd2xxx);
+    SDO(d, "2B 00 22 00 00 00 00 00", "60 00 22 00 00 00 00 00"); /* no timer */
+    SDO(d, "22 00 18 02 FE 00 00 00", "60 00 18 02 00 00 00 00");
+    SDO(d, "22 01 18 02 FE 00 00 00", "60 01 18 02 00 00 00 00");
+    h_rx(d, 0x000, "01 0A");
+    h_advance(d, 100000);
+    h_drain(d);
+    h_advance(d, 100000);
+    EXPECT_NONE(d);
+    tilt(5000, -3000);
+    unsigned n1 = 0;
+    unsigned n2 = 0;
+    for (const co_frame_t *f = h_next(d); f != NULL; f = h_next(d)) {
+        n1 += f->id == 0x18A;
+        n2 += f->id == 0x28A;
+    }
+    CHECK(n1 >= 1u);
+    CHECK(n2 >= 1u);
 }
 
 /* R53: the 16-bit slope is clamped to INTEGER16 only; R56: the 32-bit one
@@ -580,6 +645,9 @@ int main(void)
     RUN(test_autostart);
     RUN(test_lss_bit_timing_codes);
     RUN(test_lss_store_node_id_ends);
+    RUN(test_moving_average_window);
+    RUN(test_jd2_fold_is_exact);
+    RUN(test_change_of_state_both_tpdos);
     RUN(test_jd2_slope_limits);
     RUN(test_jd2_negative_fold);
     RUN(test_temperature);
