@@ -424,8 +424,7 @@ void jd_sample(void *mem, const int32_t values[], uint32_t faults)
     /* Types 254/255: a PDO whenever its data changed (R18), within the inhibit time. */
     for (unsigned n = 0; n < 2u; n++) {
         if (co_tpdo_changed(&d->node, n)) {
-            co_tpdo_event(&d->node, n);
+            co_tpdo_event(&d->node, n); /* wakes the node */
         }
     }
-    co_node_wake(&d->node); /* every product wakes its nodes on a sample */
 }
