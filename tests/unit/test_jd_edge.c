@@ -358,6 +358,36 @@ static void test_change_of_state_both_tpdos(void)
     CHECK(n2 >= 1u);
 }
 
+/* The TPDOs' factory settings (spec section 2, C10): TPDO1 inhibit 0,
+ * TPDO2 inhibit 1 as printed; JD2 maps both slopes into each TPDO, the JD1
+ * its one slope (the second entry names 6020h, unused). */
+static void test_tpdo_defaults(void)
+{
+    static const struct {
+        uint16_t index;
+        uint8_t sub;
+        long long jd2, jd1;
+    } v[] = {
+        {0x1800, 3, 0, 0},           {0x1801, 3, 1, 1},
+        {0x1A00, 0, 2, 1},           {0x1A01, 0, 2, 1},
+        {0x1A00, 1, 0x60100010, 0x60100010}, {0x1A01, 1, 0x60100010, 0x60100010},
+        {0x1A00, 2, 0x60200010, 0x60200010}, {0x1A01, 2, 0x60200010, 0x60200010},
+    };
+    const product_t *const p[2] = {&jd2xxx, &jd1xxx};
+    for (unsigned k = 0; k < 2u; k++) {
+        boot(p[k]);
+        for (unsigned i = 0; i < sizeof(v) / sizeof(v[0]); i++) {
+            long long want = k == 0u ? v[i].jd2 : v[i].jd1;
+            long long got = h_read(d, v[i].index, v[i].sub);
+            if (got != want) {
+                fprintf(stderr, "  %s %04Xh:%u = %lld, expected %lld\n", p[k]->id,
+                        (unsigned)v[i].index, (unsigned)v[i].sub, got, want);
+                FAIL("a TPDO default differs");
+            }
+        }
+    }
+}
+
 /* R53: the 16-bit slope is clamped to INTEGER16 only; R56: the 32-bit one
  * carries the same sum unclamped. A differential offset beyond +-90 deg is
  * refused (spec 6014h/6114h, 0x06090030), so only a stored offset reaches
@@ -648,6 +678,7 @@ int main(void)
     RUN(test_moving_average_window);
     RUN(test_jd2_fold_is_exact);
     RUN(test_change_of_state_both_tpdos);
+    RUN(test_tpdo_defaults);
     RUN(test_jd2_slope_limits);
     RUN(test_jd2_negative_fold);
     RUN(test_temperature);
