@@ -733,7 +733,7 @@ static void test_fewest_objects(void)
 }
 
 /* A reset starts LSS afresh: waiting state, no selection sequence in
- * progress. */
+ * progress; "store configuration" keeps the node-ID for power-on. */
 static void test_lss_reset_starts_afresh(void)
 {
     boot();
@@ -747,6 +747,26 @@ static void test_lss_reset_starts_afresh(void)
     LSS("42 02 00 01 00 00 00 00", NULL);
     LSS("43 42 00 00 00 00 00 00", NULL); /* the selection began before the reset */
     LSS("5E 00 00 00 00 00 00 00", NULL);
+    /* So does a switch mode global: a selection runs from its vendor part. */
+    LSS("40 78 56 34 12 00 00 00", NULL);
+    LSS("41 CD AB 00 00 00 00 00", NULL);
+    LSS("04 00 00 00 00 00 00 00", NULL);
+    LSS("42 02 00 01 00 00 00 00", NULL);
+    LSS("43 42 00 00 00 00 00 00", NULL);
+    LSS("04 00 00 00 00 00 00 00", NULL);
+    LSS("41 CD AB 00 00 00 00 00", NULL);
+    LSS("42 02 00 01 00 00 00 00", NULL);
+    LSS("43 42 00 00 00 00 00 00", NULL);
+    LSS("5E 00 00 00 00 00 00 00", NULL);
+    /* Store without a node-ID configured stores the active one; with 1
+     * configured, 1 (active after reset, and after power-on). */
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("17 00 00 00 00 00 00 00", "17 00 00 00 00 00 00 00");
+    CHECK_EQ(inst()->lss.node_id, 0x40);
+    LSS("11 01 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
+    LSS("17 00 00 00 00 00 00 00", "17 00 00 00 00 00 00 00");
+    h_power_cycle(d);
+    EXPECT(d, 0x701, "00");
 }
 
 int main(void)
