@@ -415,11 +415,10 @@ uint32_t co_tpdo_poll(co_node_t *node, uint32_t now)
     if (node->nmt.state != CO_NMT_OPERATIONAL) {
         return next;
     }
+    /* Only a valid event-driven TPDO has its timer armed (start_one) or an
+     * event pending (co_tpdo_event): the others pass through untouched. */
     for (unsigned n = 0; n < CO_TPDO_MAX; n++) {
         co_tpdo_t *t = &node->tpdo[n];
-        if (!t->valid || !event_driven(t)) {
-            continue;
-        }
         uint32_t period = (uint32_t)t->event_ms * 1000u; /* <= 65 535 000 us: no overflow */
         bool timer_due = t->timer_armed && !co_time_before(now, t->next_event);
         if (timer_due || t->pending) {
@@ -427,9 +426,10 @@ uint32_t co_tpdo_poll(co_node_t *node, uint32_t now)
              * (one compare). Not co_time_before(): an end that seems further
              * ahead went stale more than 2^31 us ago without a send since
              * (an event-driven PDO whose data did not change for 36 min),
-             * and the event waited up to 36 min for it (fuzz_node.c). */
+             * and the event waited up to 36 min for it (fuzz_node.c). What
+             * waits stays: a pending event, or a timer still due (its
+             * deadline moves only when it sends). */
             if (t->inhibit_end - now - 1u < t->inhibit_us) {
-                t->pending = true; /* keep the event until the inhibit time ends */
                 next = co_min_u32(next, t->inhibit_end - now);
                 continue;
             }

@@ -1910,6 +1910,32 @@ static void test_tpdo_changed(void)
     CHECK(!co_tpdo_changed(d->node, 0));
 }
 
+/* The inhibit time runs while its end is 1 us .. the inhibit time ahead of
+ * the clock (which wraps after 2^32 us). An event 2^32 - 1 us (71.6 min)
+ * after the last send finds that end the inhibit time + 1 us "ahead":
+ * outside the window, the event goes out at once. */
+static void test_tpdo_event_a_clock_turn_later(void)
+{
+    boot();
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* no timer */
+    SDO(d, "2B 00 18 03 E8 03 00 00", "60 00 18 03 00 00 00 00"); /* 100 ms */
+    h_rx(d, 0x000, "01 10");
+    h_drain(d);
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 0);
+    NEXT_IS(0x190);
+    d->now -= 1u; /* + 2^32 - 1 us */
+    d->next_sample = d->now + CO_FILTER_PERIOD_US;
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 0);
+    NEXT_IS(0x190);
+    co_tpdo_event(d->node, 0); /* and the inhibit time from this send on */
+    h_advance(d, 99999);
+    EXPECT_NONE(d);
+    h_advance(d, 1);
+    NEXT_IS(0x190);
+}
+
 int main(void)
 {
     RUN(test_od_find);
@@ -1960,5 +1986,6 @@ int main(void)
     RUN(test_rtr_service_passes_other_frames_on);
     RUN(test_rtr_answered_once);
     RUN(test_tpdo_changed);
+    RUN(test_tpdo_event_a_clock_turn_later);
     return h_finish();
 }
