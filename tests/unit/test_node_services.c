@@ -370,6 +370,12 @@ static void test_lss_fastscan_no_part_4(void)
     LSS("04 00 00 00 00 00 00 00", NULL);
     LSS("51 78 56 34 12 00 00 01", NULL);
     LSS("51 00 00 00 00 1F 00 00", NULL);
+    /* Node-ID 1 given: the node starts with it once back in waiting. */
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("11 01 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x7E5, "04 00 00 00 00 00 00 00");
+    EXPECT(d, 0x701, "00");
 }
 
 /* A life-guarding event is cleared by reset communication: error register 0. */
