@@ -137,7 +137,6 @@ static void block_upload_initiate(co_node_t *node, const uint8_t *d)
     sdo->state = SDO_BLK_UL_START;
     sdo->e = e;
     sdo->size = len;
-    sdo->pos = 0;
     sdo->blk_start = 0;
     sdo->crc = (d[0] & 0x04u) != 0u;
     sdo->blksize = d[4];
