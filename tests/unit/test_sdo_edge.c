@@ -640,6 +640,13 @@ static void test_answers_are_data_frames(void)
         const co_frame_t *f = h_next(d);
         CHECK(f != NULL && f->id == 0x5A0 && f->dlc == 8u && !f->rtr);
     }
+    h_rx(d, 0x620, "80 00 10 00 00 00 04 05"); /* the client ends the block upload */
+    h_drain(d);
+    /* A last upload segment's bytes after its data are 0 (CiA 301). */
+    SDO(d, "40 04 20 00 00 00 00 00", "41 04 20 00 08 00 00 00");
+    SDO(d, "60 00 00 00 00 00 00 00", "00 31 32 33 34 35 36 37");
+    paint_stack();
+    SDO(d, "70 00 00 00 00 00 00 00", "1D 38 00 00 00 00 00 00");
 }
 
 int main(void)
