@@ -447,6 +447,21 @@ static void test_block_upload_timeout(void)
     EXPECT_NONE(d);
     h_advance(d, 1);
     EXPECT(d, 0x5A0, "80 00 10 00 00 00 04 05");
+    /* Every block sent and every answer restarts it: steps 0.9 s apart. */
+    SDO(d, "A4 00 10 00 04 00 00 00", "C6 00 10 00 04 00 00 00");
+    h_advance(d, 900000);
+    SDO(d, "A3 00 00 00 00 00 00 00", "81 91 01 00 00 00 00 00");
+    h_advance(d, 900000);
+    EXPECT_NONE(d);
+    SDO(d, "A2 00 04 00 00 00 00 00", "81 91 01 00 00 00 00 00"); /* sent again */
+    h_advance(d, 900000);
+    EXPECT_NONE(d);
+    SDO(d, "A2 01 04 00 00 00 00 00", "CD 1B 87 00 00 00 00 00");
+    h_advance(d, 900000);
+    EXPECT_NONE(d);
+    h_rx(d, 0x620, "A1 00 00 00 00 00 00 00");
+    h_advance(d, 2u * CO_SDO_TIMEOUT_US);
+    EXPECT_NONE(d);
 }
 
 /* While a transfer waits for the client, the node asks to be polled
