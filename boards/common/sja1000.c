@@ -16,6 +16,11 @@
 #define RX_FIFO_FRAMES 21u
 #define TIME_QUANTA_MIN 8u
 #define TIME_QUANTA_MAX 25u
+/* TSEG2 is (q + 4) / 8 <= 3 quanta, or q - 17 when TSEG1 is full: within
+ * the 8 its field holds for every q up to TIME_QUANTA_MAX. */
+#if TIME_QUANTA_MAX - 17u > 8u
+#error "TSEG2 could exceed 8 quanta"
+#endif
 #define ERR_PASSIVE 128u
 
 static uint8_t rd(const sja1000_t *c, uint8_t reg)
@@ -58,7 +63,7 @@ bool sja1000_timing(uint32_t clock_hz, uint16_t kbps, uint8_t *btr0, uint8_t *bt
         if (q - 1u - tseg2 > 16u) {
             tseg2 = q - 17u; /* TSEG1 holds at most 16 quanta */
         }
-        if (brp < 1u || brp > 64u || tseg2 > 8u) {
+        if (brp < 1u || brp > 64u) {
             continue;
         }
         /* Sample point (after SYNC and TSEG1) in permille, its distance to 875. */
@@ -156,9 +161,8 @@ static void choose_filters(sja1000_t *c, const uint16_t *u, unsigned m)
             }
             mk[g] = (uint16_t)(mk[g] | (u[i] ^ first[g]));
         }
-        if (!used) { /* one group: the second filter repeats the first */
-            mk[1] = mk[0];
-        }
+        /* One group (exact choice only): the second filter is u[0] alone,
+         * far in that choice, which the first passes already. */
         uint32_t total = cost(mk[0], true) + cost(mk[1], used);
         if (total < best) {
             best = total;

@@ -187,8 +187,8 @@ uint8_t sja_model_read(void *ctx, uint8_t reg)
             return status(m);
         case A_CDR:
             return m->cdr;
-        default:
-            return 0xFF; /* a BasicCAN register: not modelled */
+        default: /* a BasicCAN register: not modelled */
+            return reg == A_BUF && m->basic_echo ? m->basic16 : 0xFF;
         }
     }
     switch (reg) {
@@ -232,7 +232,8 @@ uint8_t sja_model_read(void *ctx, uint8_t reg)
     if (reg >= A_BUF && reg <= 28u) {
         unsigned k = reg - A_BUF;
         if (in_reset(m)) {
-            return k < 4u ? m->acr[k] : k < 8u ? m->amr[k - 4u] : 0u;
+            uint8_t v = k < 4u ? m->acr[k] : k < 8u ? m->amr[k - 4u] : 0u;
+            return k == 0u && m->acr_broken ? (uint8_t)(v ^ 1u) : v;
         }
         if (m->rmc == 0u) {
             violation(m, "RX buffer (address %u) read with RBS 0", reg);
@@ -294,7 +295,10 @@ static void write_mod(sja_model_t *m, uint8_t v)
     } else if (((m->mod ^ v) & cfg) != 0u) {
         violation(m, "MOD LOM/STM/AFM changed in operating mode (reset mode only)");
     }
-    if ((v & MOD_RM) != 0u && !in_reset(m) && !m->stuck_operating) {
+    bool change = ((v & MOD_RM) != 0u) != in_reset(m);
+    if (change && m->mode_lag > 0u) {
+        m->mode_lag--; /* not yet */
+    } else if ((v & MOD_RM) != 0u && !in_reset(m) && !m->stuck_operating) {
         enter_reset(m, true);
     } else if ((v & MOD_RM) == 0u && in_reset(m) && !m->stuck_reset) {
         leave_reset(m);
@@ -334,6 +338,9 @@ void sja_model_write(void *ctx, uint8_t reg, uint8_t v)
             write_mod(m, v & MOD_RM);
         } else if (reg == A_CDR) {
             write_cdr(m, v);
+        } else if (reg == A_BUF && m->basic_echo) {
+            m->basic16 = v;
+            violation(m, "address %u written in BasicCAN mode (CDR.7 0)", reg);
         } else {
             violation(m, "address %u written in BasicCAN mode (CDR.7 0)", reg);
         }

@@ -80,6 +80,12 @@ typedef struct sja_model {
     bool stuck_operating; /* MOD.RM cannot be set by the CPU */
     bool basic_only;      /* CDR.7 stays 0 (a BasicCAN-only part, PCA82C200) */
     bool no_ack;          /* nobody acknowledges: a transmission stays pending */
+    bool acr_broken;      /* not an SJA1000: ACR0 reads back with bit 0 flipped */
+    bool basic_echo;      /* with basic_only: address 16 reads back what was
+                           * last written to it (a BasicCAN buffer byte) */
+    uint8_t basic16;
+    unsigned mode_lag;    /* a slow part: writes of MOD asking for another mode
+                           * (RM set or cleared) it ignores before it takes one */
 
     /* Registers (PeliCAN). */
     uint8_t mod, ier, btr0, btr1, ocr, ewlr, rxerr, txerr, cdr, rbsa;

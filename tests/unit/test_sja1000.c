@@ -388,6 +388,47 @@ static void test_timing_every_product_rate(void)
     CHECK(b0 == 0x40 && b1 == 0x1C); /* 16 quanta: 1 + 13 + 2, 87.5 %, SJW 2 */
 }
 
+/* sja1000_timing against the search at one clock and rate: a setting
+ * exactly when one exists, as near 87.5 % as any, of the most quanta. */
+static void check_best(uint32_t clk, uint16_t kbps)
+{
+    unsigned nq = 0, num = 0;
+    uint8_t b0 = 0xEE, b1 = 0xDD;
+    bool exists = best_timing(clk, kbps, &nq, &num);
+    bool got = sja1000_timing(clk, kbps, &b0, &b1);
+    CHECK_EQ(got, exists);
+    if (got) {
+        unsigned t1 = (b1 & 0x0Fu) + 1u, t2 = ((b1 >> 4) & 7u) + 1u;
+        unsigned n = 1u + t1 + t2;
+        CHECK_EQ((uint64_t)clk, 2ull * ((b0 & 0x3Fu) + 1u) * n * 1000u * kbps);
+        CHECK_EQ((unsigned)abs((int)(8u * (1u + t1)) - (int)(7u * n)) * nq, num * n);
+        CHECK_EQ(n, nq);
+        CHECK_EQ((b0 >> 6) + 1u, t2 < 4u ? t2 : 4u);
+        CHECK_EQ(b1 & 0x80u, 0); /* one sample a bit (SAM 0) */
+    } else {
+        CHECK(b0 == 0xEE && b1 == 0xDD);
+    }
+}
+
+/* Every quanta count 8..25 on a clock that leaves it alone or with few
+ * others (125 kbit/s x 2 x quanta x prescaler, the prescaler 1, 3, 64
+ * and 65, one more than BRP holds), against the search. */
+static void test_timing_every_quanta_count(void)
+{
+    static const uint32_t brps[] = {1, 3, 64, 65};
+    for (uint32_t q = 8; q <= 25u; q++) {
+        for (unsigned k = 0; k < 4u; k++) {
+            check_best(2u * 125000u * q * brps[k], 125);
+        }
+    }
+    /* 24 MHz at 1000 kbit/s: 12 quanta, sample points 10/12 and 11/12 as
+     * near 87.5 %; the earlier one is taken, whose phase segment 2 of two
+     * quanta allows a resynchronisation jump of two (SJW 2) rather than one. */
+    uint8_t b0 = 0, b1 = 0;
+    CHECK(sja1000_timing(24000000u, 1000, &b0, &b1));
+    CHECK(b0 == 0x40 && b1 == 0x18); /* BRP 0, SJW 2; TSEG1 9 + 1, TSEG2 1 + 1 */
+}
+
 static void test_timing_every_rate_and_refusals(void)
 {
     /* every whole kbit/s up to 1000 at the three clocks: a setting exactly
@@ -465,6 +506,7 @@ static void test_init(void)
      * bus error or arbitration lost (nor wake-up: sleep is never used) */
     CHECK_EQ(m.ier & 0xEFu, 0x2F);
     CHECK(filter_open());
+    CHECK(m.amr[0] == 0xFF && m.amr[1] == 0xFF && m.amr[2] == 0xFF && m.amr[3] == 0xFF);
     CHECK_EQ(c.kbps, 250);
     CHECK_EQ(c.tx_len, 0);
     CHECK_EQ(c.overruns, 0);
@@ -528,6 +570,20 @@ static void test_init_refused(void)
      * a transmit buffer byte, in reset mode, harmless) before it read CDR
      * back: taken, not judged */
     (void)sja_model_take_violations(&m);
+    /* a part that takes PeliCAN mode whose acceptance code does not hold
+     * what is written, and a BasicCAN-only one whose address 16 does:
+     * neither is taken for an SJA1000 */
+    sja_model_new(&m);
+    m.acr_broken = true;
+    CHECK(!sja1000_init(&c, &sja_model_io, &m, 16000000u, 125u));
+    CHECK_EQ(m.mod & 0x01, 0x01);
+    CLEAN();
+    sja_model_new(&m);
+    m.basic_only = true;
+    m.basic_echo = true;
+    CHECK(!sja1000_init(&c, &sja_model_io, &m, 16000000u, 125u));
+    CHECK_EQ(m.mod & 0x01, 0x01);
+    (void)sja_model_take_violations(&m); /* its BasicCAN writes, as above */
     /* a rate the clock cannot make: left in reset mode, off the bus */
     sja_model_new(&m);
     CHECK(!sja1000_init(&c, &sja_model_io, &m, 8000000u, 1000u));
@@ -621,6 +677,30 @@ static void test_set_bitrate(void)
     CLEAN();
 }
 
+/* A controller slower to change mode than the data sheet's: one that
+ * shows reset mode at the 64th write of the mode register is waited for
+ * (up to MODE_TRIES polls, sja1000.c); one that needs a 65th counts as
+ * refusing, and nothing reset mode guards is written. */
+static void test_slow_mode_change(void)
+{
+    up();
+    m.mode_lag = 63;
+    CHECK(sja1000_set_bitrate(&c, 500));
+    CHECK_EQ(m.mode_lag, 0);
+    uint8_t b0 = 0, b1 = 0;
+    CHECK(sja1000_timing(16000000u, 500, &b0, &b1));
+    CHECK(m.btr0 == b0 && m.btr1 == b1);
+    CHECK_EQ(m.mod & 0x01, 0x00);
+    CLEAN();
+    m.mode_lag = 64;
+    CHECK(!sja1000_set_bitrate(&c, 250));
+    CHECK_EQ(m.mode_lag, 0);
+    CHECK(m.btr0 == b0 && m.btr1 == b1);
+    CHECK_EQ(c.kbps, 500);
+    CHECK_EQ(m.mod & 0x01, 0x00);
+    CLEAN();
+}
+
 /* ---- acceptance filter ---------------------------------------------------- */
 
 static bool listed(const co_rx_id_t *ids, unsigned n, uint16_t id, bool rtr)
@@ -693,7 +773,7 @@ static unsigned fewest_passed(const uint16_t *u, unsigned nu)
  * (unless the list is too long: then every standard frame is received);
  * extended frames never come out. open: the list is too long for the filter.
  */
-static void check_list(const co_rx_id_t *ids, unsigned n, bool open)
+static unsigned check_list(const co_rx_id_t *ids, unsigned n, bool open)
 {
     sja1000_set_filter(&c, ids, n);
     CLEAN();
@@ -757,6 +837,7 @@ static void check_list(const co_rx_id_t *ids, unsigned n, bool open)
         CHECK_EQ(m.rmc, 0);
     }
     CLEAN();
+    return passed;
 }
 
 static void test_filter_one_node(void)
@@ -776,6 +857,12 @@ static void test_filter_one_node(void)
     shuffled[NODE5_N] = node5[0];
     shuffled[NODE5_N + 1u] = node5[4];
     sja1000_set_filter(&c, shuffled, NODE5_N + 2u);
+    CHECK_EQ(m.reset_entries, resets);
+    /* the first entry again at the end: still the same list */
+    co_rx_id_t again[NODE5_N + 1u];
+    memcpy(again, node5, sizeof node5);
+    again[NODE5_N] = node5[0];
+    sja1000_set_filter(&c, again, NODE5_N + 1u);
     CHECK_EQ(m.reset_entries, resets);
     /* a changed list (the SDO COB-ID of node-ID 6): once */
     co_rx_id_t moved[NODE5_N];
@@ -826,19 +913,68 @@ static void test_filter_two_nodes_and_long_lists(void)
         many[k].id = (uint16_t)(0x100u + 37u * k);
         many[k].rtr = (k % 3u) == 0u;
     }
-    check_list(many, SJA1000_IDS_MAX, false);
+    /* the greedy choice no worse than now: 1024 CAN-IDs (the fewest: 768) */
+    CHECK(check_list(many, SJA1000_IDS_MAX, false) <= 1024u);
     /* two clusters of 8 (0x100.., 0x600..), each in order */
     co_rx_id_t cl[16];
     for (unsigned k = 0; k < 16u; k++) {
         cl[k].id = (uint16_t)(k < 8u ? 0x100u + k : 0x600u + k - 8u);
         cl[k].rtr = false;
     }
-    check_list(cl, 16, false);
+    CHECK_EQ(check_list(cl, 16, false), 16); /* each cluster its filter: the fewest */
+    /* two clusters of 8 each, their IDs mixed, the first not 0: the same */
+    static const uint16_t mixed_a[] = {0x5EE, 0x5EC, 0x5EB, 0x5EA, 0x606, 0x5ED, 0x607, 0x5E9,
+                                       0x602, 0x5EF, 0x605, 0x5E8, 0x600, 0x604};
+    static const uint16_t mixed_b[] = {0x0FA, 0x551, 0x556, 0x557, 0x552, 0x555, 0x550, 0x0F9,
+                                       0x553, 0x0FD, 0x554, 0x0FE, 0x0FF, 0x0FB, 0x0FC, 0x0F8};
+    co_rx_id_t mixed[16];
+    for (unsigned k = 0; k < 14u; k++) {
+        mixed[k] = (co_rx_id_t){.id = mixed_a[k], .rtr = false};
+    }
+    CHECK_EQ(check_list(mixed, 14, false), 16);
+    for (unsigned k = 0; k < 16u; k++) {
+        mixed[k] = (co_rx_id_t){.id = mixed_b[k], .rtr = false};
+    }
+    CHECK_EQ(check_list(mixed, 16, false), 16);
     check_list(many, SJA1000_EXACT_IDS, false);
-    check_list(many, SJA1000_EXACT_IDS + 1u, false);
+    CHECK(check_list(many, SJA1000_EXACT_IDS + 1u, false) <= 1024u); /* the fewest: 512 */
+    /* Nodes 3 and 2 (guarding, an RPDO each, node 3 consuming node 2's
+     * heartbeat, TPDO 1 by remote request on node 2): 22 CAN-IDs pass,
+     * the fewest two filters can (the first of the splits of least cost). */
+    static const co_rx_id_t nodes_32[] = {
+        {0x000, false}, {0x080, false}, {0x603, false}, {0x703, true}, {0x203, false},
+        {0x702, false}, {0x602, false}, {0x182, true}, {0x282, false}};
+    CHECK_EQ(check_list(nodes_32, sizeof nodes_32 / sizeof nodes_32[0], false), 22);
+    /* 13 entries, 12 CAN-IDs (0x72C both kinds: guarding and a heartbeat
+     * consumed on it): the exact choice, as for any 12 CAN-IDs. */
+    static const co_rx_id_t nodes_12[] = {
+        {0x000, false}, {0x080, false}, {0x7E5, false}, {0x62C, false}, {0x72C, true},
+        {0x1AC, true}, {0x2AC, false}, {0x709, false}, {0x63E, false}, {0x73E, true},
+        {0x23E, false}, {0x73D, false}, {0x72C, false}};
+    CHECK_EQ(check_list(nodes_12, sizeof nodes_12 / sizeof nodes_12[0], false), 480);
+    /* the same, the doubled one first (after another list) */
+    check_list(node5, NODE5_N, false);
+    co_rx_id_t first_both[sizeof nodes_12 / sizeof nodes_12[0]];
+    memcpy(first_both, nodes_12, sizeof nodes_12);
+    first_both[0] = nodes_12[4];
+    first_both[4] = nodes_12[0];
+    CHECK_EQ(check_list(first_both, sizeof nodes_12 / sizeof nodes_12[0], false), 480);
+    /* Two nodes with PDOs and heartbeat consumers, 15 and 13 CAN-IDs: the
+     * greedy choice no worse than now (the fewest: 768 and 1024). */
+    static const co_rx_id_t nodes_a[] = {
+        {0x000, false}, {0x080, false}, {0x7E5, false},
+        {0x659, false}, {0x759, true}, {0x1D9, true}, {0x259, false}, {0x754, false}, {0x2D9, false},
+        {0x657, false}, {0x757, true}, {0x1D7, true}, {0x257, false}, {0x751, false}, {0x2D7, false}};
+    static const co_rx_id_t nodes_b[] = {
+        {0x000, false}, {0x080, false}, {0x7E5, false},
+        {0x635, false}, {0x735, true}, {0x1B5, true}, {0x235, false}, {0x72D, false}, {0x2B5, false},
+        {0x646, false}, {0x746, true}, {0x1C6, true}, {0x73B, false}};
+    CHECK(check_list(nodes_a, sizeof nodes_a / sizeof nodes_a[0], false) <= 768u);
+    CHECK(check_list(nodes_b, sizeof nodes_b / sizeof nodes_b[0], false) <= 1280u);
     /* one more: the filter opens, nothing is dropped */
     check_list(many, SJA1000_IDS_MAX + 1u, true);
     CHECK(filter_open());
+    CHECK(m.amr[0] == 0xFF && m.amr[1] == 0xFF && m.amr[2] == 0xFF && m.amr[3] == 0xFF);
     /* back to a short list: closed again */
     check_list(node5, NODE5_N, false);
     CHECK(!filter_open());
@@ -921,6 +1057,38 @@ static void test_filter_change_keeps_received(void)
     CHECK_EQ(m.reset_entries, resets + 1u);
     sja1000_service(&c);
     CHECK_EQ(m.reset_entries, resets + 1u);
+    CLEAN();
+}
+
+/* A list whose first entry alone changed is a new list; a list change
+ * also starts a queued frame, as the service does. */
+static void test_filter_first_entry_and_transmit(void)
+{
+    up();
+    static const co_rx_id_t l1[] = {{0x605, false}, {0x000, false}, {0x080, false}};
+    static const co_rx_id_t l2[] = {{0x606, false}, {0x000, false}, {0x080, false}};
+    check_list(l1, 3, false);
+    unsigned resets = m.reset_entries;
+    check_list(l2, 3, false);
+    CHECK_EQ(m.reset_entries, resets + 1u);
+    co_frame_t f = frame(0x185, false, 2, 1);
+    CHECK(sja1000_send(&c, &f));
+    CHECK(!m.tx_pending);
+    sja1000_set_filter(&c, l2, 3);
+    CHECK(m.tx_pending);
+    CHECK(sja_model_bus(&m));
+    EXPECT_SENT(&f);
+    /* a DLC above 8 from the stack goes out as 8, with 8 bytes */
+    co_frame_t big = frame(0x186, false, 8, 3);
+    big.dlc = 12;
+    CHECK(sja1000_send(&c, &big));
+    CHECK_EQ(bus_run(4), 1);
+    big.dlc = 9;
+    CHECK(sja1000_send(&c, &big));
+    CHECK_EQ(bus_run(4), 1);
+    big.dlc = 8;
+    EXPECT_SENT(&big);
+    EXPECT_SENT(&big);
     CLEAN();
 }
 
@@ -1046,6 +1214,13 @@ static void test_receive_fifo_and_overrun(void)
     CHECK(sja_model_rx(&m, 0x123, false, false, 12, d));
     CHECK(sja1000_receive(&c, &g));
     CHECK(g.id == 0x123 && !g.rtr && g.dlc == 8 && memcmp(g.data, d, 8) == 0);
+    /* every DLC above 8 means 8 bytes (ISO 11898-1): 9 and 15 too */
+    CHECK(sja_model_rx(&m, 0x124, false, false, 9, d));
+    CHECK(sja1000_receive(&c, &g));
+    CHECK(g.id == 0x124 && !g.rtr && g.dlc == 8 && memcmp(g.data, d, 8) == 0);
+    CHECK(sja_model_rx(&m, 0x125, false, false, 15, d));
+    CHECK(sja1000_receive(&c, &g));
+    CHECK(g.id == 0x125 && !g.rtr && g.dlc == 8 && memcmp(g.data, d, 8) == 0);
     /* a second overrun later: counted again */
     for (uint8_t i = 0; i < 6u; i++) {
         f[i] = frame((uint16_t)(0x200u + i), false, 8, i);
@@ -1079,6 +1254,32 @@ static void test_receive_skips_bounded(void)
     CHECK(sja1000_receive(&c, &g) && same_frame(&g, &want));
     CHECK_EQ(c.filtered_out, out + 6u);
     CHECK(!sja1000_receive(&c, &g));
+    CHECK_EQ(m.rmc, 0);
+    CLEAN();
+}
+
+/* A FIFO full of frames (21 without data), the listed one last: one call
+ * reads through all 20 unlisted ones to it. */
+static void test_receive_reaches_the_last_in_a_full_fifo(void)
+{
+    up();
+    sja1000_set_filter(&c, node5, NODE5_N);
+    co_frame_t g, want = frame(0x080, false, 0, 0);
+    const uint8_t d[8] = {0};
+    unsigned out = c.filtered_out;
+    unsigned stored = 0;
+    for (uint16_t id = 0x7FF; stored < 20u && id > 0u; id--) {
+        co_frame_t f = frame(id, false, 0, 0);
+        if (!listed(node5, NODE5_N, id, false) && sja_model_accepts(&m, id, false, false, 0, d) &&
+            inject(&f)) {
+            stored++;
+        }
+    }
+    CHECK_EQ(stored, 20);
+    CHECK(inject(&want));
+    CHECK_EQ(m.rmc, 21);
+    CHECK(sja1000_receive(&c, &g) && same_frame(&g, &want));
+    CHECK_EQ(c.filtered_out, out + 20u);
     CHECK_EQ(m.rmc, 0);
     CLEAN();
 }
@@ -1221,19 +1422,23 @@ int main(void)
     RUN(test_model_bus_off);
     RUN(test_timing_every_product_rate);
     RUN(test_timing_every_rate_and_refusals);
+    RUN(test_timing_every_quanta_count);
     RUN(test_init);
     RUN(test_init_refused);
     RUN(test_set_bitrate);
+    RUN(test_slow_mode_change);
     RUN(test_filter_one_node);
     RUN(test_filter_two_nodes_and_long_lists);
     RUN(test_filter_every_product);
     RUN(test_filter_change_keeps_transmit);
     RUN(test_filter_change_keeps_received);
     RUN(test_filter_change_applied_by_service);
+    RUN(test_filter_first_entry_and_transmit);
     RUN(test_transmit_queue);
     RUN(test_receive_fifo_and_overrun);
     RUN(test_receive_skips_bounded);
     RUN(test_receive_bounded_under_flood);
+    RUN(test_receive_reaches_the_last_in_a_full_fifo);
     RUN(test_error_states);
     RUN(test_bus_off_and_recovery);
     return h_finish();
