@@ -101,10 +101,73 @@ bool co_port_can_bitrate(void *port, uint16_t kbps);
 #undef rx_filter
 #undef co_port_can_bitrate
 
+/* And as a JD2xxx's image (node 0x0A): its 2300h resets the node after
+ * the confirmation, at the poll after the frame. */
+#undef PRODUCT_SYM
+#undef PRODUCT_HEADER
+#undef PRODUCT_INST_SIZE
+#define main mcu_main_jd
+#define leds mcu_main_jd_leds
+#define rx_filter mcu_main_jd_rx_filter
+#define co_port_can_bitrate mcu_main_jd_can_bitrate
+#define PRODUCT_SYM jd2xxx
+#define PRODUCT_HEADER "jd.h"
+#define PRODUCT_INST_SIZE sizeof(jd_dev_t)
+int main(void); /* mcu_main_jd: declared, for -Wmissing-prototypes */
+bool co_port_can_bitrate(void *port, uint16_t kbps);
+#include "mcu_main.c"
+#undef main
+#undef leds
+#undef rx_filter
+#undef co_port_can_bitrate
+
+/* Images built with a fixed node config (CO_FIXED_CFG): the DST X730 with
+ * its own, which runs; the redundant GSH-A with channel 1's, whose second
+ * node has channel 2's, which must not. */
+#undef PRODUCT_SYM
+#undef PRODUCT_HEADER
+#undef PRODUCT_INST_SIZE
+#define main mcu_main_paired
+#define leds mcu_main_paired_leds
+#define rx_filter mcu_main_paired_rx_filter
+#define co_port_can_bitrate mcu_main_paired_can_bitrate
+#define PRODUCT_SYM dst_x730_xy30
+#define PRODUCT_HEADER "dst.h"
+#define PRODUCT_INST_SIZE sizeof(dst_dev_t)
+#define CO_FIXED_CFG dst_x730_cfg
+int main(void); /* mcu_main_paired: declared, for -Wmissing-prototypes */
+bool co_port_can_bitrate(void *port, uint16_t kbps);
+#include "mcu_main.c"
+#undef main
+#undef leds
+#undef rx_filter
+#undef co_port_can_bitrate
+#undef CO_FIXED_CFG
+#undef PRODUCT_SYM
+#undef PRODUCT_HEADER
+#undef PRODUCT_INST_SIZE
+#define main mcu_main_two_fixed
+#define leds mcu_main_two_fixed_leds
+#define rx_filter mcu_main_two_fixed_rx_filter
+#define co_port_can_bitrate mcu_main_two_fixed_can_bitrate
+#define PRODUCT_SYM gsh_a_redundant
+#define PRODUCT_HEADER "gsh.h"
+#define PRODUCT_INST_SIZE sizeof(gsh_dev_t)
+#define CO_FIXED_CFG gsh_ch1_cfg
+int main(void); /* mcu_main_two_fixed: declared, for -Wmissing-prototypes */
+bool co_port_can_bitrate(void *port, uint16_t kbps);
+#include "mcu_main.c"
+#undef main
+#undef leds
+#undef rx_filter
+#undef co_port_can_bitrate
+#undef CO_FIXED_CFG
+
 int mcu_main_fixed(void); /* mcu_main_fixed.c: the X730 with the X710's fixed config */
 
 #define TX_MAX 1024u
 #define RX_MAX 8u
+#define TXQ_MAX 32u
 
 static struct board {
     jmp_buf out;        /* where the endless loop is left */
@@ -119,6 +182,8 @@ static struct board {
     unsigned samples;
     uint32_t last_sample;
     uint32_t max_gap;   /* longest time between two samples */
+    uint32_t min_gap;   /* shortest */
+    uint32_t x_change_at; /* x reads 20 deg from here on (relative to the start; 0: never) */
     co_frame_t rx[RX_MAX]; /* frames to receive, in order ... */
     uint32_t rx_at[RX_MAX]; /* ... each at its time */
     unsigned nrx;
@@ -128,7 +193,9 @@ static struct board {
     uint32_t start;
     unsigned state_calls; /* board_can_state() calls */
     unsigned unfiltered_bootups; /* boot-ups whose SDO request the filter stopped */
-    unsigned nbootup_seen; /* tx[] checked for that up to here */
+    co_frame_t txq[TXQ_MAX]; /* frames the node queued, not yet sent ... */
+    unsigned ntxq;
+    unsigned slept_queued; /* ... while the board went to sleep */
     co_frame_t tx[TX_MAX];
     uint32_t tx_at[TX_MAX];
     unsigned ntx;
@@ -153,6 +220,7 @@ static void board_reset(bool init_ok, bool bitrate_ok, uint32_t run_us)
     bd.now = 0xFFF00000u; /* 1 s before the 32-bit clock wraps */
     bd.end = bd.now + run_us;
     bd.start = bd.now;
+    bd.min_gap = UINT32_MAX;
 }
 
 /* A frame from the bus at time at (frames are queued in time order). */
@@ -198,19 +266,29 @@ bool board_can_receive(co_frame_t *f)
 
 static bool in_filter(uint16_t id, bool rtr);
 
-/* Where a board with a transmit queue (rv32-virt's SJA1000) sends what
- * the node queued: every boot-up sent since the last call must find its
- * node's SDO request in the receive filter by now. */
-uint8_t board_can_state(void)
+/* The fake board is one with a transmit queue, as rv32-virt's SJA1000:
+ * co_port_can_send() only queues, the frames leave when the board is
+ * asked for its state or given a receive list (its driver's service and
+ * filter calls start the transmitter). A boot-up leaving must find its
+ * node's SDO request in the receive filter already. */
+static void flush(void)
 {
-    bd.state_calls++;
-    for (; bd.nbootup_seen < bd.ntx; bd.nbootup_seen++) {
-        const co_frame_t *t = &bd.tx[bd.nbootup_seen];
+    for (unsigned k = 0; k < bd.ntxq && bd.ntx < TX_MAX; k++) {
+        const co_frame_t *t = &bd.txq[k];
         if (t->id > 0x700u && t->id <= 0x77Fu && t->dlc == 1u && t->data[0] == 0x00u &&
             !in_filter((uint16_t)(t->id - 0x100u), false)) {
             bd.unfiltered_bootups++;
         }
+        bd.tx_at[bd.ntx] = bd.now;
+        bd.tx[bd.ntx++] = *t;
     }
+    bd.ntxq = 0;
+}
+
+uint8_t board_can_state(void)
+{
+    bd.state_calls++;
+    flush();
     uint32_t t = bd.now - bd.start;
     return t >= bd.passive_from && t < bd.passive_until ? CO_CAN_PASSIVE : CO_CAN_ACTIVE;
 }
@@ -237,9 +315,13 @@ void board_sensor(const product_t *p, int32_t values[], uint32_t *faults)
     if (bd.samples > 0u && bd.now - bd.last_sample > bd.max_gap) {
         bd.max_gap = bd.now - bd.last_sample;
     }
+    if (bd.samples > 0u && bd.now - bd.last_sample < bd.min_gap) {
+        bd.min_gap = bd.now - bd.last_sample;
+    }
     bd.last_sample = bd.now;
     bd.samples++;
-    values[0] = 12500; /* x = 12.5 deg */
+    bool changed = bd.x_change_at != 0u && bd.now - bd.start >= bd.x_change_at;
+    values[0] = changed ? 20000 : 12500; /* x = 12.5 deg, later 20 deg */
     values[1] = -3000;
     *faults = 0;
 }
@@ -254,6 +336,7 @@ uint32_t board_serial(unsigned node)
 void board_sleep(uint32_t us)
 {
     bd.sleeps++;
+    bd.slept_queued += bd.ntxq != 0u ? 1u : 0u;
     bd.max_sleep = us > bd.max_sleep ? us : bd.max_sleep;
     uint32_t wake = bd.now + us;
     if (rx_pending() && co_time_before(bd.rx_at[bd.irx], wake)) {
@@ -272,6 +355,7 @@ void board_can_filter(const co_rx_id_t *ids, unsigned n)
     bd.sleeps_at_filter = bd.sleeps;
     bd.nfilter = n <= 2u * CO_NODE_RX_IDS_MAX ? n : 0u;
     memcpy(bd.filter, ids, bd.nfilter * sizeof ids[0]);
+    flush();
 }
 
 static bool in_filter(uint16_t id, bool rtr)
@@ -287,11 +371,10 @@ static bool in_filter(uint16_t id, bool rtr)
 bool co_port_can_send(void *port, const co_frame_t *frame)
 {
     (void)port;
-    if (bd.ntx >= TX_MAX) {
+    if (bd.ntxq >= TXQ_MAX) {
         return false;
     }
-    bd.tx_at[bd.ntx] = bd.now;
-    bd.tx[bd.ntx++] = *frame;
+    bd.txq[bd.ntxq++] = *frame;
     return true;
 }
 
@@ -355,11 +438,13 @@ static void test_main_loop_runs_the_product(void)
     /* A sample every 5 ms, on time, across the wrap of the clock. */
     CHECK(bd.samples >= 200u && bd.samples <= 202u);
     CHECK_EQ(bd.max_gap, CO_FILTER_PERIOD_US);
+    CHECK_EQ(bd.min_gap, CO_FILTER_PERIOD_US);
     CHECK(bd.max_sleep <= CO_FILTER_PERIOD_US);
     /* Pre-operational: the green LED blinks, red stays off. */
     CHECK(bd.green_seen[0] && bd.green_seen[1]);
     CHECK_EQ(bd.red_only, 0);
     CHECK_EQ(sent_on(0x1FF, 0, start), 0); /* no PDO before NMT start */
+    CHECK_EQ(bd.slept_queued, 0); /* what a pass queued left before the core slept */
 }
 
 /* A board that filters (BOARD_RX_FILTER) gets the node's receive list after
@@ -430,7 +515,8 @@ static void test_main_loop_nmt_start(void)
     if (setjmp(bd.out) == 0) {
         (void)mcu_main_any();
     }
-    CHECK(sent_on(0x1FF, 100000u, start) >= 1u);
+    CHECK(sent_on(0x1FF, 100000u, start) >= 5u);
+    CHECK_EQ(bd.slept_queued, 0); /* each TPDO left in the pass that made it */
     CHECK_EQ(sent_on(0x1FF, 0, start), sent_on(0x1FF, 100000u, start));
 }
 
@@ -489,6 +575,25 @@ static void test_main_loop_refuses_to_run(void)
     CHECK_EQ(bd.ntx, 0);
     CHECK_EQ(bd.samples, 0);
     CHECK_EQ(bd.nkbps, 0);
+    board_reset(true, true, 1000000u);
+    bd.red_limit = 3;
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_two_fixed();
+    }
+    CHECK_EQ(bd.red_only, 3);
+    CHECK_EQ(bd.ntx, 0);
+    CHECK_EQ(bd.samples, 0);
+    CHECK_EQ(bd.nkbps, 0);
+    /* Built with its own config, the image runs. */
+    board_reset(true, true, 100000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    bd.red_limit = 1;
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_paired();
+    }
+    CHECK(bd.ntx >= 1u && bd.tx[0].id == 0x77F);
+    CHECK_EQ(bd.red_only, 0);
+    CHECK(bd.samples >= 20u);
 }
 
 /* The first frame on id sent at or after time t (relative to the start),
@@ -582,6 +687,63 @@ static void test_main_loop_two_nodes(void)
         CHECK(sent_on((uint16_t)(0x193u + k), 200000u, start) >= 5u);
     }
     CHECK(bd.max_sleep <= CO_FILTER_PERIOD_US);
+    CHECK_EQ(bd.slept_queued, 0);
+}
+
+/* Each frame is served to its end before the next: the JD2xxx's "save
+ * with reset" (2300h) confirms, then resets the node (JD manual R38), and
+ * an SDO request right behind it in the same pass is answered by the
+ * node after its reset, behind the boot-up. */
+static void test_main_loop_reset_between_frames(void)
+{
+    board_reset(true, true, 300000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    uint32_t start = bd.now;
+    deliver((co_frame_t){.id = 0x60A, .dlc = 8, .data = {0x23, 0x00, 0x23, 0x00, 0x55, 0xAA, 0xAA, 0x55}},
+            start + 100000u);
+    deliver((co_frame_t){.id = 0x60A, .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}}, start + 100000u);
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_jd();
+    }
+    unsigned confirm = first_on(0x58A, 100000u, start);
+    unsigned boot = first_on(0x70A, 100000u, start);
+    CHECK(confirm < boot && boot < bd.ntx);
+    if (confirm < boot && boot < bd.ntx) {
+        CHECK(bd.tx[confirm].data[0] == 0x60 && bd.tx[confirm].data[1] == 0x00 &&
+              bd.tx[confirm].data[2] == 0x23);
+        CHECK_EQ(bd.tx_at[boot] - start, 100000);
+        unsigned answer = boot + 1u;
+        while (answer < bd.ntx && bd.tx[answer].id != 0x58A) {
+            answer++;
+        }
+        CHECK(answer < bd.ntx && bd.tx[answer].data[0] == 0x43 && bd.tx_at[answer] == bd.tx_at[boot]);
+    }
+}
+
+/* The node's inclination follows the sensor: sampled once before the
+ * start (0x6010 answers 12.5 deg, in 0.05 deg, before the first period
+ * ends), then every period (the sensor at 20 deg from 0.1 s on: at 0.3 s
+ * the filtered output is on its way there). */
+static void test_main_loop_feeds_samples(void)
+{
+    board_reset(true, true, 400000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    uint32_t start = bd.now;
+    bd.x_change_at = 100000u;
+    deliver((co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x40, 0x10, 0x60, 0x00}}, start + 1000u);
+    deliver((co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x40, 0x10, 0x60, 0x00}}, start + 300000u);
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_any();
+    }
+    unsigned first = first_on(0x5FF, 0, start);
+    unsigned later = first_on(0x5FF, 300000u, start);
+    CHECK(first < later && later < bd.ntx);
+    if (first < later && later < bd.ntx) {
+        CHECK_EQ(bd.tx_at[first] - start, 1000);
+        CHECK_EQ(co_get_u16(&bd.tx[first].data[4]), 250);
+        uint16_t x = co_get_u16(&bd.tx[later].data[4]); /* on its way, through the filter */
+        CHECK(x > 250u && x <= 400u);
+    }
 }
 
 int main(void)
@@ -598,5 +760,7 @@ int main(void)
     RUN(test_main_loop_frames_of_one_pass);
     RUN(test_main_loop_can_state);
     RUN(test_main_loop_two_nodes);
+    RUN(test_main_loop_reset_between_frames);
+    RUN(test_main_loop_feeds_samples);
     return h_finish();
 }
