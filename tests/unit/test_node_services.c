@@ -269,6 +269,31 @@ static void test_lss_bit_timing_table(void)
     LSS("13 00 09 00 00 00 00 00", "13 01 00 00 00 00 00 00");
 }
 
+/* LSS switch mode selective (CiA 305): the four parts in order, each
+ * sequence from its vendor part: a vendor part starts it again, a wrong
+ * part ends it (the right one after it is too late), and a completed
+ * selection leaves nothing for the next. */
+static void test_lss_switch_selective_sequence(void)
+{
+    boot();
+    LSS("40 78 56 34 12 00 00 00", NULL);
+    LSS("41 CD AB 00 00 00 00 00", NULL);
+    LSS("40 78 56 34 12 00 00 00", NULL); /* again from the start */
+    LSS("41 CD AB 00 00 00 00 00", NULL);
+    LSS("42 02 00 01 00 00 00 00", NULL);
+    LSS("43 42 00 00 00 00 00 00", "44 00 00 00 00 00 00 00");
+    LSS("41 CD AB 00 00 00 00 00", NULL); /* no vendor part: nothing */
+    LSS("42 02 00 01 00 00 00 00", NULL);
+    LSS("43 42 00 00 00 00 00 00", NULL);
+    LSS("04 00 00 00 00 00 00 00", NULL);
+    LSS("40 78 56 34 12 00 00 00", NULL);
+    LSS("41 CE AB 00 00 00 00 00", NULL); /* wrong product code */
+    LSS("41 CD AB 00 00 00 00 00", NULL);
+    LSS("42 02 00 01 00 00 00 00", NULL);
+    LSS("43 42 00 00 00 00 00 00", NULL);
+    LSS("5E 00 00 00 00 00 00 00", NULL); /* still waiting */
+}
+
 /* LSS identify remote slave (CiA 305): the revision and serial ranges
  * include both their bounds; a bound one past the node's value leaves it
  * out. Inquire identity: each part of 0x1018. Configure node-ID: 1..127
@@ -781,6 +806,7 @@ int main(void)
     RUN(test_lss_fastscan_ignored_requests);
     RUN(test_lss_bit_timing_table);
     RUN(test_lss_identity_bounds);
+    RUN(test_lss_switch_selective_sequence);
     RUN(test_lss_fastscan_no_part_4);
     RUN(test_lss_reset_starts_afresh);
     RUN(test_life_guard_event_cleared_by_reset_communication);
