@@ -451,6 +451,70 @@ static void test_reset_communication_restores_its_area(void)
     CHECK_EQ(h_read(d, 0x5FFF, 0), 1);
 }
 
+/* A record under another magic is none of ours, even with a CRC that
+ * matches it (another firmware's data): the set is reported corrupt and
+ * its defaults are used. */
+static void test_record_without_its_magic(void)
+{
+    boot();
+    set_all(100, 200, 0x11223344u, 300);
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00"); /* slot 0 only */
+    d->port.nvm[0] ^= 0x01u;
+    co_put_u32(&d->port.nvm[CO_STORE_HDR + 32u], co_crc32(0, d->port.nvm, CO_STORE_HDR + 32u));
+    h_power_cycle(d);
+    EXPECT(d, 0x730, "00");
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    EXPECT_ALL(0, 100, 0xA5A5A5A5u, 7);
+}
+
+/* The smallest parameter set, one byte, is stored and restored too. */
+typedef struct one_dev {
+    co_node_t node;
+    uint8_t para;
+} one_dev_t;
+
+static const co_od_entry_t one_entries[] = {
+    {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
+    {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
+    SAVE(1, co_store_write_save),
+    {.index = 0x2000, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, PARA(0), .def = 7},
+};
+
+static const co_od_t one_od = {.entries = one_entries,
+                               .count = sizeof(one_entries) / sizeof(one_entries[0])};
+
+static const co_node_cfg_t one_cfg = {
+    .od = &one_od,
+    .ram_size = {0, 0, 1, 0},
+    .default_node_id = 0x31,
+};
+
+static void one_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
+{
+    (void)p;
+    one_dev_t *t = mem;
+    memset(t, 0, sizeof(*t));
+    void *const ram[CO_CLS_COUNT] = {NULL, NULL, &t->para, NULL};
+    co_node_init(&t->node, &one_cfg, ports[0], t, ram, 0);
+    nodes[0] = &t->node;
+}
+
+static const product_t one_prod = {.id = "one byte", .inputs = {{NULL, NULL, 0, 0}},
+                                   .nodes = 1, .inst_size = sizeof(one_dev_t),
+                                   .create = one_create, .sample = s_sample};
+
+static void test_one_byte_set(void)
+{
+    h_boot(d, &one_prod, false);
+    EXPECT(d, 0x731, "00");
+    SDO(d, "2F 00 20 00 42 00 00 00", "60 00 20 00 00 00 00 00");
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_power_cycle(d);
+    EXPECT(d, 0x731, "00");
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_OK);
+    CHECK_EQ(h_read(d, 0x2000, 0), 0x42);
+}
+
 /* The slot at NVM offset at holds exactly these bytes (hex). */
 static void expect_slot(unsigned at, const char *hex, int line)
 {
@@ -507,6 +571,8 @@ int main(void)
     RUN(test_record_bytes);
     RUN(test_group_edges);
     RUN(test_reset_communication_restores_its_area);
+    RUN(test_record_without_its_magic);
+    RUN(test_one_byte_set);
     RUN(test_group_save);
     RUN(test_group_load);
     RUN(test_group_save_after_load);
