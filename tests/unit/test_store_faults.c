@@ -515,6 +515,59 @@ static void test_one_byte_set(void)
     CHECK_EQ(h_read(d, 0x2000, 0), 0x42);
 }
 
+/* A node whose records end where the EEPROM ends, with a node-ID set that
+ * fills its slots (the product keeps more beside node-ID and bit rate):
+ * saved into both slots, every byte and the CRC read back, nothing past
+ * the end. */
+typedef struct big_lss {
+    co_lss_para_t id;
+    uint8_t more[CO_STORE_MAX_DATA - sizeof(co_lss_para_t)];
+} big_lss_t;
+
+typedef struct end_dev {
+    co_node_t node;
+    uint8_t para[1];
+    big_lss_t lss;
+} end_dev_t;
+
+static const co_node_cfg_t end_cfg = {
+    .od = &one_od,
+    .ram_size = {0, 0, 1, sizeof(big_lss_t)},
+    .default_node_id = 0x32,
+    .save_includes_lss = true,
+};
+
+static void end_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
+{
+    (void)p;
+    end_dev_t *t = mem;
+    memset(t, 0, sizeof(*t));
+    void *const ram[CO_CLS_COUNT] = {NULL, NULL, t->para, &t->lss};
+    co_node_init(&t->node, &end_cfg, ports[0], t, ram, FAKE_NVM_SIZE - CO_STORE_NVM_SIZE);
+    nodes[0] = &t->node;
+}
+
+static const product_t end_prod = {.id = "at the end", .inputs = {{NULL, NULL, 0, 0}},
+                                   .nodes = 1, .inst_size = sizeof(end_dev_t),
+                                   .create = end_create, .sample = s_sample};
+
+static void test_records_at_the_end_of_the_eeprom(void)
+{
+    _Static_assert(sizeof(big_lss_t) == CO_STORE_MAX_DATA, "the node-ID set fills its slot");
+    h_boot(d, &end_prod, false);
+    EXPECT(d, 0x732, "00");
+    end_dev_t *t = h_inst(d);
+    for (unsigned k = 0; k < 2u; k++) { /* both slots */
+        t->lss.more[sizeof(t->lss.more) - 1u] = (uint8_t)(0x5Au + k);
+        SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    }
+    h_power_cycle(d);
+    EXPECT(d, 0x732, "00");
+    t = h_inst(d);
+    CHECK_EQ(d->node->store.status[CO_CLS_LSS], CO_STORE_OK);
+    CHECK_EQ(t->lss.more[sizeof(t->lss.more) - 1u], 0x5B);
+}
+
 /* The slot at NVM offset at holds exactly these bytes (hex). */
 static void expect_slot(unsigned at, const char *hex, int line)
 {
@@ -573,6 +626,7 @@ int main(void)
     RUN(test_reset_communication_restores_its_area);
     RUN(test_record_without_its_magic);
     RUN(test_one_byte_set);
+    RUN(test_records_at_the_end_of_the_eeprom);
     RUN(test_group_save);
     RUN(test_group_load);
     RUN(test_group_save_after_load);
