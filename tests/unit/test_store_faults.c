@@ -568,6 +568,23 @@ static void test_records_at_the_end_of_the_eeprom(void)
     CHECK_EQ(t->lss.more[sizeof(t->lss.more) - 1u], 0x5B);
 }
 
+/* Two valid records of one sequence number (never written so by a save:
+ * each takes the newest one's number + 1) are a tie the first slot wins,
+ * the same at every power-on. */
+static void test_sequence_tie(void)
+{
+    boot();
+    set_all(100, 200, 0x11223344u, 300);
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00"); /* slot 0 */
+    uint8_t *s1 = &d->port.nvm[CO_STORE_SLOT];
+    memcpy(s1, d->port.nvm, CO_STORE_SLOT);
+    co_put_u16(&s1[CO_STORE_HDR], 101); /* 0x1017 */
+    co_put_u32(&s1[CO_STORE_HDR + 32u], co_crc32(0, s1, CO_STORE_HDR + 32u));
+    h_power_cycle(d);
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_OK);
+    EXPECT_ALL(100, 200, 0x11223344u, 300);
+}
+
 /* The slot at NVM offset at holds exactly these bytes (hex). */
 static void expect_slot(unsigned at, const char *hex, int line)
 {
@@ -627,6 +644,7 @@ int main(void)
     RUN(test_record_without_its_magic);
     RUN(test_one_byte_set);
     RUN(test_records_at_the_end_of_the_eeprom);
+    RUN(test_sequence_tie);
     RUN(test_group_save);
     RUN(test_group_load);
     RUN(test_group_save_after_load);
