@@ -55,6 +55,8 @@ static const co_od_entry_t e_entries[] = {
     /* Writable strings of exactly the transfer buffer, and of 5 bytes. */
     {.index = 0x200A, .sub = 0, CO_TYPE_STR(BUF_NAME), .attr = CO_A_RW},
     {.index = 0x200B, .sub = 0, CO_TYPE_STR("12345"), .attr = CO_A_RW},
+    /* A string of one whole segment. */
+    {.index = 0x200C, .sub = 0, CO_TYPE_STR("7 bytes"), .attr = CO_A_R},
 };
 
 static const co_od_t e_od = {.entries = e_entries, .count = sizeof(e_entries) / sizeof(e_entries[0])};
@@ -404,6 +406,23 @@ static void test_block_upload_blocks(void)
     }
     EXPECT_NONE(d);
     SDO(d, "A2 0A 7F 00 00 00 00 00", "D9 93 04 00 00 00 00 00");
+    h_rx(d, 0x620, "A1 00 00 00 00 00 00 00");
+    EXPECT_NONE(d);
+    /* The same with blocks of one segment, then of three. */
+    SDO(d, "A4 0A 20 00 01 00 00 00", "C6 0A 20 00 40 00 00 00");
+    SDO(d, "A3 00 00 00 00 00 00 00", "01 41 20 73 74 72 69 6E");
+    h_rx(d, 0x620, "A2 01 03 00 00 00 00 00");
+    EXPECT(d, 0x5A0, "01 67 20 6F 66 20 73 69");
+    EXPECT(d, 0x5A0, "02 78 74 79 2D 66 6F 75");
+    EXPECT(d, 0x5A0, "03 72 20 62 79 74 65 73");
+    EXPECT_NONE(d);
+    /* A new upload request in the middle: 05040001h, and nothing else. */
+    SDO(d, "A4 0A 20 00 7F 00 00 00", "80 0A 20 00 01 00 04 05");
+    EXPECT_NONE(d);
+    /* 7 bytes: one full segment, no byte of it unused. */
+    SDO(d, "A0 0C 20 00 7F 00 00 00", "C6 0C 20 00 07 00 00 00");
+    SDO(d, "A3 00 00 00 00 00 00 00", "81 37 20 62 79 74 65 73");
+    SDO(d, "A2 01 7F 00 00 00 00 00", "C1 00 00 00 00 00 00 00");
     h_rx(d, 0x620, "A1 00 00 00 00 00 00 00");
     EXPECT_NONE(d);
     /* The 8-byte string: its last segment's bytes after the data are 0,
