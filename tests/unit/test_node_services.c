@@ -267,6 +267,8 @@ static void test_lss_bit_timing_table(void)
     }
     LSS("13 00 05 00 00 00 00 00", "13 01 00 00 00 00 00 00");
     LSS("13 00 09 00 00 00 00 00", "13 01 00 00 00 00 00 00");
+    LSS("13 00 80 00 00 00 00 00", "13 01 00 00 00 00 00 00"); /* no such index */
+    LSS("13 00 FF 00 00 00 00 00", "13 01 00 00 00 00 00 00");
 }
 
 /* LSS switch mode selective (CiA 305): the four parts in order, each
@@ -296,8 +298,9 @@ static void test_lss_switch_selective_sequence(void)
 
 /* LSS identify remote slave (CiA 305): the revision and serial ranges
  * include both their bounds; a bound one past the node's value leaves it
- * out. Inquire identity: each part of 0x1018. Configure node-ID: 1..127
- * and FFh (none) taken, 0, 80h and FEh refused. */
+ * out. Inquire identity: each part of 0x1018; other command specifiers
+ * are no service. Configure node-ID: 1..127 and FFh (none) taken, 0, 80h
+ * and FEh refused. */
 static void test_lss_identity_bounds(void)
 {
     boot();
@@ -321,6 +324,10 @@ static void test_lss_identity_bounds(void)
     LSS("5B 00 00 00 00 00 00 00", "5B CD AB 00 00 00 00 00");
     LSS("5C 00 00 00 00 00 00 00", "5C 02 00 01 00 00 00 00");
     LSS("5D 00 00 00 00 00 00 00", "5D 42 00 00 00 00 00 00");
+    /* Command specifiers of no service: no answer (CiA 305). */
+    LSS("20 00 00 00 00 00 00 00", NULL);
+    LSS("59 00 00 00 00 00 00 00", NULL);
+    LSS("5F 00 00 00 00 00 00 00", NULL);
     LSS("11 01 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
     LSS("11 7F 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
     LSS("11 80 00 00 00 00 00 00", "11 01 00 00 00 00 00 00");
