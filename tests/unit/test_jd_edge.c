@@ -325,13 +325,26 @@ static void test_moving_average_window(void)
 }
 
 /* R49: beyond +-90 deg the JD2 folds back exactly: 100.006 deg is 79.994
- * (79.99 at 0.01 deg), -100.006 deg -79.994. */
+ * (79.99 at 0.01 deg), 100.005 is 79.995 (80.00), and the same negative. */
 static void test_jd2_fold_is_exact(void)
 {
     boot(&jd2xxx);
     tilt(100006, -100006);
     CHECK_EQ((int16_t)h_read(d, 0x6010, 0), 7999);
     CHECK_EQ((int16_t)h_read(d, 0x6020, 0), -7999);
+    tilt(100005, -100005); /* 79.995: 80.00 */
+    CHECK_EQ((int16_t)h_read(d, 0x6010, 0), 8000);
+    CHECK_EQ((int16_t)h_read(d, 0x6020, 0), -8000);
+    /* From just beyond: 90.001 folds to 89.999, seen in the average of two
+     * samples with 0.009 deg: 45.004, 45.00 at 0.01 deg. */
+    SDO(d, "2B 00 31 00 02 00 00 00", "60 00 31 00 00 00 00 00");
+    jd_dev_t *j = h_inst(d);
+    int32_t a[3] = {90001, -90001, 25000};
+    int32_t b[3] = {9, -9, 25000};
+    d->prod->sample(j, a, 0);
+    d->prod->sample(j, b, 0);
+    CHECK_EQ((int16_t)h_read(d, 0x6010, 0), 4500);
+    CHECK_EQ((int16_t)h_read(d, 0x6020, 0), -4500);
 }
 
 /* R18: transmission type 254 without an event timer sends a TPDO when its
