@@ -110,6 +110,16 @@ static void test_segmented_download_refusals(void)
     /* Size not indicated, then a 7-byte segment for a 4-byte object: too high. */
     SDO(d, "20 00 20 00 00 00 00 00", "60 00 20 00 00 00 00 00");
     SDO(d, "00 01 02 03 04 05 06 07", "80 00 20 00 12 00 07 06");
+    EXPECT_NONE(d);
+    CHECK_EQ(h_read(d, 0x2000, 0), 100);
+    /* Fewer bytes than the object (06070013h), a value the object refuses
+     * (06090032h): the abort alone, the value kept. */
+    SDO(d, "20 00 20 00 00 00 00 00", "60 00 20 00 00 00 00 00");
+    SDO(d, "0B 01 02 00 00 00 00 00", "80 00 20 00 13 00 07 06");
+    EXPECT_NONE(d);
+    SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00");
+    SDO(d, "07 05 00 00 00 00 00 00", "80 00 20 00 32 00 09 06");
+    EXPECT_NONE(d);
     CHECK_EQ(h_read(d, 0x2000, 0), 100);
     /* An upload segment while a download is in progress: wrong command. */
     SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00");
@@ -183,6 +193,23 @@ static void test_short_segmented_download_toggles(void)
 static void test_writable_string_refused(void)
 {
     boot();
+    /* Three segments: the toggle alternates 0, 1, 0; each segment restarts
+     * the timeout (0.9 s apart); the last one, empty, ends the transfer. */
+    SDO(d, "21 04 20 00 08 00 00 00", "60 04 20 00 00 00 00 00");
+    h_advance(d, 900000);
+    SDO(d, "00 41 42 43 44 45 46 47", "20 00 00 00 00 00 00 00");
+    h_advance(d, 900000);
+    SDO(d, "1C 48 00 00 00 00 00 00", "30 00 00 00 00 00 00 00");
+    h_advance(d, 900000);
+    EXPECT_NONE(d);
+    SDO(d, "0F 00 00 00 00 00 00 00", "80 04 20 00 02 00 01 06");
+    /* A completed transfer is over: no timeout, its segments out of turn. */
+    SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00");
+    SDO(d, "07 C8 00 00 00 00 00 00", "20 00 00 00 00 00 00 00");
+    h_advance(d, 2u * CO_SDO_TIMEOUT_US);
+    EXPECT_NONE(d);
+    SDO(d, "17 C8 00 00 00 00 00 00", "80 C8 00 00 01 00 04 05");
+    CHECK_EQ(h_read(d, 0x2000, 0), 200);
     SDO(d, "21 04 20 00 08 00 00 00", "60 04 20 00 00 00 00 00");
     SDO(d, "00 41 42 43 44 45 46 47", "20 00 00 00 00 00 00 00");
     SDO(d, "1D 48 00 00 00 00 00 00", "80 04 20 00 02 00 01 06"); /* toggle 1, n = 6, last */
@@ -368,6 +395,11 @@ static void test_block_download_segments(void)
 static void test_block_upload_refusals(void)
 {
     boot();
+    /* Block upload frames other than the initiate while none is in
+     * progress: 05040001h. */
+    SDO(d, "A3 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05");
+    SDO(d, "A1 00 10 00 04 00 00 00", "80 00 10 00 01 00 04 05");
+    SDO(d, "A2 00 10 00 04 00 00 00", "80 00 10 00 01 00 04 05");
     SDO(d, "A4 08 10 00 10 00 00 00", "80 08 10 00 05 00 04 05"); /* 70 bytes: no room */
     SDO(d, "A4 03 10 01 10 00 00 00", "80 03 10 01 24 00 00 08"); /* empty history */
     SDO(d, "A4 00 10 00 80 00 00 00", "80 00 10 00 02 00 04 05"); /* 128 segments */
