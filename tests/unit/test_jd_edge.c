@@ -324,6 +324,38 @@ static void test_moving_average_window(void)
     }
 }
 
+/* R59 with R54 on the JD1: two samples average the short way round,
+ * from the second sample of a new window on (359 and 1 deg: 0; 1 and 359:
+ * 0; 10 and 160: 85); exactly half a turn apart either midpoint is as
+ * near, and the device takes the one between the two readings as 0..360
+ * values (10 and 190 deg: 100, also 190 and 10). */
+static void test_jd1_average_of_two(void)
+{
+    static const struct {
+        int32_t a, b, out; /* 6010h, 0.01 deg */
+    } v[] = {{359000, 1000, 0}, {1000, 359000, 0}, {10000, 160000, 8500},
+             {160000, 10000, 8500}, {10000, 190000, 10000}, {190000, 10000, 10000}};
+    boot(&jd1xxx);
+    jd_dev_t *j = h_inst(d);
+    for (unsigned i = 0; i < sizeof(v) / sizeof(v[0]); i++) {
+        /* A new window each time: a sample with the average off (3100h =
+         * 0), then 3100h = 2 and the pair. */
+        int32_t a[2] = {v[i].a, 25000};
+        int32_t b[2] = {v[i].b, 25000};
+        SDO(d, "2B 00 31 00 00 00 00 00", "60 00 31 00 00 00 00 00");
+        d->prod->sample(j, a, 0);
+        SDO(d, "2B 00 31 00 02 00 00 00", "60 00 31 00 00 00 00 00");
+        d->prod->sample(j, a, 0);
+        d->prod->sample(j, b, 0);
+        long long got = h_read(d, 0x6010, 0);
+        if (got != v[i].out) {
+            fprintf(stderr, "  %ld and %ld mdeg: %lld, expected %ld\n", (long)v[i].a, (long)v[i].b,
+                    got, (long)v[i].out);
+            FAIL("the average of two samples is not the short way round");
+        }
+    }
+}
+
 /* R49: beyond +-90 deg the JD2 folds back exactly: 100.006 deg is 79.994
  * (79.99 at 0.01 deg), 100.005 is 79.995 (80.00), and the same negative. */
 static void test_jd2_fold_is_exact(void)
@@ -690,6 +722,7 @@ int main(void)
     RUN(test_lss_store_node_id_ends);
     RUN(test_moving_average_window);
     RUN(test_jd2_fold_is_exact);
+    RUN(test_jd1_average_of_two);
     RUN(test_change_of_state_both_tpdos);
     RUN(test_tpdo_defaults);
     RUN(test_jd2_slope_limits);
