@@ -68,7 +68,8 @@ typedef struct co_store {
     uint8_t status[CO_CLS_COUNT]; /* co_store_status_t of the last restore */
 } co_store_t;
 
-/* Scan the NVM for the write count. Call once before the first restore. */
+/* Scan the NVM for the write count. Call once, on a node fresh from
+ * co_node_init(), before the first restore (co_node_start does). */
 void co_store_init(co_node_t *node);
 
 /*

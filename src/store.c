@@ -148,8 +148,8 @@ static CO_NOINLINE newest_t newest(co_node_t *node, co_cls_t cls)
 
 void co_store_init(co_node_t *node)
 {
-    /* Every save counts once, in every class's newest record from then on. */
-    node->store.writes = 0;
+    /* Every save counts once, in every class's newest record from then on:
+     * the count is the largest of them (co_node_init() zeroed it). */
     for (unsigned cls = CO_CLS_PARA; cls <= CO_CLS_LSS; cls++) {
         if (stored_class(node, (co_cls_t)cls)) {
             newest_t nw = newest(node, (co_cls_t)cls);

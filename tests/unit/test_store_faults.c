@@ -222,6 +222,10 @@ static void test_unchanged_lss_set_not_rewritten(void)
     CHECK_EQ(w1 - w0, 2); /* first save: both sets */
     SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
     CHECK_EQ(d->node->store.writes - w1, 1); /* the parameters only */
+    h_drain(d);
+    h_power_cycle(d); /* the count is the newest record's, the parameters' here */
+    EXPECT(d, 0x730, "00");
+    CHECK_EQ(d->node->store.writes, w1 + 1u);
     inst()->lss.node_id = 0x31; /* the product changed its node-ID set */
     w1 = d->node->store.writes;
     SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
