@@ -65,6 +65,7 @@ static const co_node_cfg_t s_cfg = {
     .default_node_id = 0x30,
     .default_bitrate = 3,
     .save_includes_lss = true,
+    .id_index = 0x5FFF, /* the node-ID's object, given a factory node-ID */
 };
 
 static void s_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
@@ -507,6 +508,29 @@ static const product_t one_prod = {.id = "one byte", .inputs = {{NULL, NULL, 0, 
                                    .nodes = 1, .inst_size = sizeof(one_dev_t),
                                    .create = one_create, .sample = s_sample};
 
+/* The same with its node-ID object named as 0x1000, a constant: a broken
+ * contract (co_node_cfg_t.id_index names a PARA object). */
+static const co_node_cfg_t bad_id_cfg = {
+    .od = &one_od,
+    .ram_size = {0, 0, 1, 0},
+    .default_node_id = 0x31,
+    .id_index = 0x1000,
+};
+
+static void bad_id_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
+{
+    (void)p;
+    one_dev_t *t = mem;
+    memset(t, 0, sizeof(*t));
+    void *const ram[CO_CLS_COUNT] = {NULL, NULL, &t->para, NULL};
+    co_node_init(&t->node, &bad_id_cfg, ports[0], t, ram, 0);
+    nodes[0] = &t->node;
+}
+
+static const product_t bad_id_prod = {.id = "bad id object", .inputs = {{NULL, NULL, 0, 0}},
+                                      .nodes = 1, .inst_size = sizeof(one_dev_t),
+                                      .create = bad_id_create, .sample = s_sample};
+
 static void test_one_byte_set(void)
 {
     h_boot(d, &one_prod, false);
@@ -589,6 +613,31 @@ static void test_sequence_tie(void)
     EXPECT_ALL(100, 200, 0x11223344u, 300);
 }
 
+/* Given a factory node-ID, the node-ID's own object (id_index) takes it as
+ * its default: with nothing stored, and not over a stored value when only
+ * the node-ID set has nothing stored. An id_index naming no PARA object is
+ * a broken contract, reported (CO_CHECK) at each reset. */
+static void test_node_id_object_default(void)
+{
+    static const uint8_t ids[PRODUCT_MAX_NODES] = {0x40};
+    h_boot_ids(d, &s_prod, ids);
+    EXPECT(d, 0x740, "00");
+    CHECK_EQ(h_read(d, 0x5FFF, 0), 0x40);
+    SDO(d, "2F FF 5F 00 22 00 00 00", "60 FF 5F 00 00 00 00 00");
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    memset(&d->port.nvm[2u * CO_STORE_SLOT], 0xFF, 2u * CO_STORE_SLOT); /* the node-ID set: blank */
+    h_power_cycle(d);
+    EXPECT(d, 0x740, "00");
+    CHECK_EQ(d->node->store.status[CO_CLS_LSS], CO_STORE_BLANK);
+    CHECK_EQ(h_read(d, 0x5FFF, 0), 0x22);
+    unsigned seen = h_asserts;
+    h_expect_assert(1);
+    static const uint8_t ids1[PRODUCT_MAX_NODES] = {0x41};
+    h_boot_ids(d, &bad_id_prod, ids1);
+    CHECK_EQ(h_asserts, seen + 1u);
+    EXPECT(d, 0x741, "00");
+}
+
 /* The slot at NVM offset at holds exactly these bytes (hex). */
 static void expect_slot(unsigned at, const char *hex, int line)
 {
@@ -649,6 +698,7 @@ int main(void)
     RUN(test_one_byte_set);
     RUN(test_records_at_the_end_of_the_eeprom);
     RUN(test_sequence_tie);
+    RUN(test_node_id_object_default);
     RUN(test_group_save);
     RUN(test_group_load);
     RUN(test_group_save_after_load);
