@@ -356,6 +356,25 @@ static void test_jd1_average_of_two(void)
     }
 }
 
+/* R59 with R54: the JD1 turning one way for many turns under the longest
+ * average (250 samples): the output keeps following in 0..360 deg, the
+ * mean of the last 250 angles (the averaged values stay within a turn, so
+ * nothing grows with the turns). 1 deg a sample, 10 000 samples. */
+static void test_jd1_longest_average_many_turns(void)
+{
+    boot(&jd1xxx);
+    jd_dev_t *j = h_inst(d);
+    SDO(d, "2B 00 31 00 FA 00 00 00", "60 00 31 00 00 00 00 00");
+    const int32_t k_end = 10000;
+    for (int32_t k = 1; k <= k_end; k++) {
+        int32_t in[2] = {(k % 360) * 1000, 25000};
+        d->prod->sample(j, in, 0);
+    }
+    /* The last 250 angles, k_end - 249 .. k_end deg: their mean in 0.01 deg. */
+    int32_t mean = (int32_t)(((int64_t)k_end * 1000 - 124500) % 360000);
+    CHECK_EQ(h_read(d, 0x6010, 0), mean / 10);
+}
+
 /* R49: beyond +-90 deg the JD2 folds back exactly: 100.006 deg is 79.994
  * (79.99 at 0.01 deg), 100.005 is 79.995 (80.00), and the same negative. */
 static void test_jd2_fold_is_exact(void)
@@ -723,6 +742,7 @@ int main(void)
     RUN(test_moving_average_window);
     RUN(test_jd2_fold_is_exact);
     RUN(test_jd1_average_of_two);
+    RUN(test_jd1_longest_average_many_turns);
     RUN(test_change_of_state_both_tpdos);
     RUN(test_tpdo_defaults);
     RUN(test_jd2_slope_limits);
