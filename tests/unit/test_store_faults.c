@@ -638,6 +638,40 @@ static void test_node_id_object_default(void)
     EXPECT(d, 0x741, "00");
 }
 
+/* A corrupt set stays reported until a full save (co_store.h): a group
+ * save or a "load" leaves it so; "save all" makes it sound again. */
+static void test_corrupt_until_full_save(void)
+{
+    boot();
+    set_all(100, 200, 0x11223344u, 300);
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    d->port.nvm[CO_STORE_HDR + 5u] ^= 0x5Au; /* slot 0's data: its CRC fails */
+    h_power_cycle(d);
+    EXPECT(d, 0x730, "00");
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    SDO(d, "23 10 10 03 73 61 76 65", "60 10 10 03 00 00 00 00");
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    SDO(d, "23 11 10 01 6C 6F 61 64", "60 11 10 01 00 00 00 00");
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_OK);
+}
+
+/* "save" after a "load" (before the reset that would apply it) stores the
+ * running sets again, the node-ID set too: the load is undone. */
+static void test_save_after_load(void)
+{
+    boot();
+    inst()->lss.node_id = 0x31; /* the product changed its node-ID set */
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    SDO(d, "23 11 10 01 6C 6F 61 64", "60 11 10 01 00 00 00 00");
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    h_drain(d);
+    h_power_cycle(d);
+    EXPECT(d, 0x731, "00");
+    CHECK_EQ(d->node->store.status[CO_CLS_LSS], CO_STORE_OK);
+}
+
 /* The slot at NVM offset at holds exactly these bytes (hex). */
 static void expect_slot(unsigned at, const char *hex, int line)
 {
@@ -699,6 +733,8 @@ int main(void)
     RUN(test_records_at_the_end_of_the_eeprom);
     RUN(test_sequence_tie);
     RUN(test_node_id_object_default);
+    RUN(test_corrupt_until_full_save);
+    RUN(test_save_after_load);
     RUN(test_group_save);
     RUN(test_group_load);
     RUN(test_group_save_after_load);
