@@ -16,6 +16,7 @@ static void test_boot_and_identity(void)
     h_boot(d, &skel_incl, false);
     EXPECT(d, 0x720, "00");
     CHECK_EQ(co_node_nmt_state(d->node), CO_NMT_PREOP);
+    CHECK_EQ(d->port.kbps, 250); /* the default bit-rate code 3 */
     SDO(d, "40 00 10 00 00 00 00 00", "43 00 10 00 9A 01 00 00"); /* device type: CiA 410 */
     SDO(d, "40 18 10 02 00 00 00 00", "43 18 10 02 01 00 00 00"); /* product code */
     SDO(d, "40 99 10 00 00 00 00 00", "80 99 10 00 00 00 02 06"); /* no such object */
@@ -43,18 +44,25 @@ static void test_slope_on_tpdo(void)
     EXPECT_ID(d, 0x1A0, "00 00");
 }
 
-/* A fault raises its EMCY and the error register; clearing it resets both. */
+/* A fault raises its EMCY and the error register, and the slope holds
+ * its last value; clearing it resets both, and the slope follows again. */
 static void test_fault_emcy(void)
 {
     h_boot(d, &skel_incl, false);
     h_drain(d);
+    d->truth[0] = 10000;
+    h_advance(d, 20000);
+    CHECK_EQ(h_read(d, 0x6010, 0), 1000);
     d->fault = SKEL_FAULT_SENSOR;
+    d->truth[0] = 20000;
     h_advance(d, 20000);
     EXPECT_ID(d, 0xA0, "00 50 01 00 00 00 00 00");
     SDO(d, "40 01 10 00 00 00 00 00", "4F 01 10 00 01 00 00 00");
+    CHECK_EQ(h_read(d, 0x6010, 0), 1000); /* no valid reading: the output holds */
     d->fault = 0;
     h_advance(d, 20000);
     EXPECT_ID(d, 0xA0, "00 00 00 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x6010, 0), 2000);
 }
 
 /* 0x1010 "save" keeps a parameter across a power cycle; 0x1011 "load"
