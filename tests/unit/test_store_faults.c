@@ -239,9 +239,11 @@ static void test_unchanged_lss_set_not_rewritten(void)
     h_drain(d);
     h_power_cycle(d);
     EXPECT(d, 0x730, "00");
-    /* A class that is not stored cannot be saved. */
+    /* A class that is not stored cannot be saved, and restores nothing. */
     CHECK(co_store_save(d->node, CO_CLS_VOL) == CO_E_STORE);
     CHECK(co_store_save(d->node, CO_CLS_NONE) == CO_E_STORE);
+    CHECK(co_store_restore(d->node, CO_CLS_VOL, 0, 0xFFFF) == CO_STORE_BLANK);
+    CHECK(co_store_restore(d->node, CO_CLS_NONE, 0, 0xFFFF) == CO_STORE_BLANK);
 }
 
 /* A valid record of the parameters copied into the node-ID set's slots is
