@@ -223,6 +223,7 @@ static void test_write_only_reads(void)
 {
     boot();
     SDO(d, "40 05 20 00 00 00 00 00", "80 05 20 00 01 00 01 06");
+    EXPECT_NONE(d);
     SDO(d, "A4 05 20 00 10 00 00 00", "80 05 20 00 01 00 01 06");
     SDO(d, "A4 05 20 00 00 00 00 00", "80 05 20 00 01 00 01 06"); /* before the block size */
     /* Writable without RAM: 0x06010002, and it still reads its constant. */
