@@ -209,7 +209,20 @@ static void test_writable_string_refused(void)
     h_advance(d, 2u * CO_SDO_TIMEOUT_US);
     EXPECT_NONE(d);
     SDO(d, "17 C8 00 00 00 00 00 00", "80 C8 00 00 01 00 04 05");
+    EXPECT_NONE(d);
     CHECK_EQ(h_read(d, 0x2000, 0), 200);
+    /* Segmented upload the same way: each segment restarts the timeout,
+     * the last one ends the transfer. */
+    SDO(d, "40 04 20 00 00 00 00 00", "41 04 20 00 08 00 00 00");
+    h_advance(d, 900000);
+    SDO(d, "60 00 00 00 00 00 00 00", "00 31 32 33 34 35 36 37");
+    h_advance(d, 900000);
+    EXPECT_NONE(d);
+    SDO(d, "70 00 00 00 00 00 00 00", "1D 38 00 00 00 00 00 00");
+    h_advance(d, 2u * CO_SDO_TIMEOUT_US);
+    EXPECT_NONE(d);
+    SDO(d, "60 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05");
+    EXPECT_NONE(d);
     SDO(d, "21 04 20 00 08 00 00 00", "60 04 20 00 00 00 00 00");
     SDO(d, "00 41 42 43 44 45 46 47", "20 00 00 00 00 00 00 00");
     SDO(d, "1D 48 00 00 00 00 00 00", "80 04 20 00 02 00 01 06"); /* toggle 1, n = 6, last */
