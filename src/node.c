@@ -11,7 +11,7 @@
 void co_node_init(co_node_t *node, const co_node_cfg_t *cfg, void *port, void *app,
                   void *const ram[CO_CLS_COUNT], uint32_t nvm_base)
 {
-    memset(node, 0, sizeof(*node));
+    memset(node, 0, sizeof(*node)); /* the NMT state too: CO_NMT_INIT is 0 */
     node->cfg = cfg;
     node->port = port;
     node->app = app;
@@ -20,7 +20,6 @@ void co_node_init(co_node_t *node, const co_node_cfg_t *cfg, void *port, void *a
     }
     node->nvm_base = nvm_base;
     node->node_id = cfg->default_node_id;
-    node->nmt.state = CO_NMT_INIT;
 }
 
 const co_od_entry_t *co_node_entry(const co_node_t *node, uint16_t index, uint8_t sub)

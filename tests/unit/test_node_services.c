@@ -269,6 +269,14 @@ static void test_lss_bit_timing_table(void)
     LSS("13 00 09 00 00 00 00 00", "13 01 00 00 00 00 00 00");
     LSS("13 00 80 00 00 00 00 00", "13 01 00 00 00 00 00 00"); /* no such index */
     LSS("13 00 FF 00 00 00 00 00", "13 01 00 00 00 00 00 00");
+    /* The board's poll is asked for at the switch, and for nothing after. */
+    LSS("13 00 04 00 00 00 00 00", "13 00 00 00 00 00 00 00");
+    LSS("15 0A 00 00 00 00 00 00", NULL);
+    CHECK_EQ(co_node_poll(d->node, d->now), 10000);
+    h_advance(d, 9999);
+    d->now++;
+    CHECK_EQ(co_node_poll(d->node, d->now), CO_NEVER);
+    CHECK_EQ(d->port.kbps, 125);
 }
 
 /* LSS switch mode selective (CiA 305): the four parts in order, each
@@ -739,6 +747,20 @@ static void test_emcy_table_full_and_cobid(void)
     CHECK_EQ(h_read(d, 0x1014, 0), 0xC0);
 }
 
+/* A frame the board cannot queue is not sent: the sender learns it and
+ * the node counts it. */
+static void test_send_refused(void)
+{
+    boot();
+    uint32_t dropped = co_node_tx_dropped(d->node);
+    d->port.tx_full = true;
+    CHECK(!co_emcy_send(d->node, 0x1000, 0x01, NULL));
+    CHECK_EQ(co_node_tx_dropped(d->node), dropped + 1u);
+    d->port.tx_full = false;
+    CHECK(co_emcy_send(d->node, 0x1000, 0x01, NULL));
+    EXPECT(d, 0xC0, "00 10 01 00 00 00 00 00");
+}
+
 /* The fewest objects: an EMCY on 80h + node-ID without 0x1014; an error
  * history the dictionary keeps no field of counts 0 errors; a guard time
  * without a life time factor (0x100D) is node guarding without life
@@ -827,6 +849,7 @@ int main(void)
     RUN(test_tpdo_mapping_longer_than_8_bytes);
     RUN(test_tpdo_mapping_count_beyond_entries);
     RUN(test_emcy_table_full_and_cobid);
+    RUN(test_send_refused);
     RUN(test_fewest_objects);
     return h_finish();
 }
