@@ -25,11 +25,13 @@ typedef struct n_para {
     uint32_t cob[2];
     uint32_t map0[3];
     uint32_t map1[3];
+    uint16_t c;
 } n_para_t;
 
 typedef struct n_vol {
     uint32_t a;
     uint16_t b;
+    uint16_t emcy_inhibit;
 } n_vol_t;
 
 typedef struct n_dev {
@@ -54,6 +56,7 @@ static const co_od_entry_t n_entries[] = {
     {.index = 0x100C, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(guard_ms), .def = 0},
     {.index = 0x100D, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, P(life), .def = 0},
     {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, P(emcy_cob), .def = 0x80, CO_EXT(.write = co_emcy_write_cobid)},
+    {.index = 0x1015, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, V(emcy_inhibit), .def = 0},
     {.index = 0x1016, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
     {.index = 0x1016, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, P(hbc), .def = 0, CO_EXT(.write = co_hbc_write_time)},
     {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(hb), .def = 0, CO_EXT(.write = co_hb_write_time)},
@@ -80,6 +83,7 @@ static const co_od_entry_t n_entries[] = {
     {.index = 0x1A01, .sub = 3, CO_TYPE_U32, .attr = CO_A_RW, P(map1[2]), .def = 0x20000020u, MAPW},
     {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW | CO_A_PDO, V(a), .def = 0x11223344u},
     {.index = 0x2001, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW | CO_A_PDO, V(b), .def = 0x5566u},
+    {.index = 0x2002, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(c), .def = 0x7788u},
 };
 
 static const co_od_t n_od = {.entries = n_entries, .count = sizeof(n_entries) / sizeof(n_entries[0])};
@@ -747,6 +751,43 @@ static void test_emcy_table_full_and_cobid(void)
     CHECK_EQ(h_read(d, 0x1014, 0), 0xC0);
 }
 
+/* Reset communication puts the communication objects (1000h..1FFFh) back
+ * to their defaults, or to what is stored, and leaves the others alone;
+ * reset node puts every one back (CiA 301). */
+static void test_reset_areas(void)
+{
+    boot();
+    SDO(d, "2B 15 10 00 0A 00 00 00", "60 15 10 00 00 00 00 00"); /* RAM only */
+    SDO(d, "2B 17 10 00 64 00 00 00", "60 17 10 00 00 00 00 00"); /* stored set */
+    SDO(d, "23 00 20 00 01 02 03 04", "60 00 20 00 00 00 00 00");
+    SDO(d, "2B 02 20 00 99 00 00 00", "60 02 20 00 00 00 00 00");
+    h_rx(d, 0x000, "82 40");
+    CHECK_EQ(h_read(d, 0x1015, 0), 0);
+    CHECK_EQ(h_read(d, 0x1017, 0), 0);
+    CHECK_EQ(h_read(d, 0x2000, 0), 0x04030201);
+    CHECK_EQ(h_read(d, 0x2002, 0), 0x99);
+    h_rx(d, 0x000, "81 40");
+    CHECK_EQ(h_read(d, 0x2000, 0), 0x11223344);
+    CHECK_EQ(h_read(d, 0x2002, 0), 0x7788);
+}
+
+/* A node started late in the clock's range (past 2^31 us, about 36 min
+ * after the board's clock began) runs its timers as at any other time:
+ * the stored heartbeat goes out after its period. */
+static void test_start_late_in_the_clock(void)
+{
+    boot();
+    SDO(d, "2B 17 10 00 64 00 00 00", "60 17 10 00 00 00 00 00"); /* 100 ms */
+    CHECK(co_store_save(d->node, CO_CLS_PARA) == CO_OK);
+    d->now = 0x90000000u - 1000000u;
+    h_power_cycle(d);
+    EXPECT(d, 0x740, "00");
+    h_advance(d, 99999);
+    EXPECT_NONE(d);
+    h_advance(d, 1);
+    EXPECT(d, 0x740, "7F");
+}
+
 /* A frame the board cannot queue is not sent: the sender learns it and
  * the node counts it. */
 static void test_send_refused(void)
@@ -849,6 +890,8 @@ int main(void)
     RUN(test_tpdo_mapping_longer_than_8_bytes);
     RUN(test_tpdo_mapping_count_beyond_entries);
     RUN(test_emcy_table_full_and_cobid);
+    RUN(test_reset_areas);
+    RUN(test_start_late_in_the_clock);
     RUN(test_send_refused);
     RUN(test_fewest_objects);
     return h_finish();
