@@ -39,7 +39,7 @@ static const co_od_entry_t s_entries[] = {
     LOAD(4, co_store_write_group_load),
     {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, PARA(0), .def = 0, CO_EXT(.write = co_hb_write_time)},
     {.index = 0x1FFF, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, PARA(2), .def = 0},
-    {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, PARA(4), .def = 100},
+    {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, PARA(4), .def = 100, CO_EXT(.min = 10, .max = 1000)},
     {.index = 0x2001, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, PARA(22), .def = 0xA5A5A5A5u},
     {.index = 0x5FFF, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, PARA(3), .def = 0},
     {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, PARA(28), .def = 7},
@@ -674,6 +674,36 @@ static void test_save_after_load(void)
     CHECK_EQ(d->node->store.status[CO_CLS_LSS], CO_STORE_OK);
 }
 
+/* A stored set whose CRC holds but whose 0x2000 is out of its range
+ * (other firmware's, or forged): 0x2000 takes its default and the set is
+ * reported corrupt. Reset communication restores the communication area
+ * only, so the report stays; reset node judges the whole set afresh. */
+static void test_corrupt_report_across_resets(void)
+{
+    boot();
+    set_all(100, 200, 0x11223344u, 300);
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00"); /* slot 0 */
+    co_put_u32(&d->port.nvm[CO_STORE_HDR + 4u], 5000u);
+    co_put_u32(&d->port.nvm[CO_STORE_HDR + 32u], co_crc32(0, d->port.nvm, CO_STORE_HDR + 32u));
+    h_power_cycle(d);
+    EXPECT(d, 0x730, "00");
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    EXPECT_ALL(100, 100, 0x11223344u, 300);
+    h_rx(d, 0x000, "82 30");
+    EXPECT(d, 0x730, "00");
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    /* Repaired: a set marked corrupt (here by the product) is sound again
+     * once a reset node finds it so. */
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    co_store_mark_corrupt(d->node, CO_CLS_PARA);
+    h_rx(d, 0x000, "82 30");
+    EXPECT(d, 0x730, "00");
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    h_rx(d, 0x000, "81 30");
+    EXPECT(d, 0x730, "00");
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_OK);
+}
+
 /* The slot at NVM offset at holds exactly these bytes (hex). */
 static void expect_slot(unsigned at, const char *hex, int line)
 {
@@ -737,6 +767,7 @@ int main(void)
     RUN(test_node_id_object_default);
     RUN(test_corrupt_until_full_save);
     RUN(test_save_after_load);
+    RUN(test_corrupt_report_across_resets);
     RUN(test_group_save);
     RUN(test_group_load);
     RUN(test_group_save_after_load);
