@@ -665,6 +665,17 @@ static void test_cia303_led_mapping(void)
         CHECK(strcmp(co_led_pattern_name(pats[i]), names[i]) == 0);
     }
     CHECK(strcmp(co_led_pattern_name((co_led_pattern_t)99), "?") == 0);
+    /* The levels with CiA 303-3's timing (blinking: 200 ms on, 200 off). */
+    boot();
+    bool gl = false;
+    bool rl = true;
+    uint32_t next = 0;
+    co_node_leds(d->node, 4000000u, &gl, &rl, &next);
+    CHECK(gl && !rl);
+    CHECK_EQ(next, 200000);
+    co_node_leds(d->node, 4250000u, &gl, &rl, &next);
+    CHECK(!gl && !rl);
+    CHECK_EQ(next, 150000);
 }
 
 /* A mapping of more than 8 bytes: refused when written (0x06040042), and a
@@ -868,6 +879,11 @@ static void test_lss_reset_starts_afresh(void)
     LSS("17 00 00 00 00 00 00 00", "17 00 00 00 00 00 00 00");
     h_power_cycle(d);
     EXPECT(d, 0x701, "00");
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("11 7F 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
+    LSS("17 00 00 00 00 00 00 00", "17 00 00 00 00 00 00 00");
+    h_power_cycle(d);
+    EXPECT(d, 0x77F, "00");
 }
 
 int main(void)
