@@ -731,6 +731,48 @@ static void test_accel_between_degrees(void)
     }
 }
 
+/* The accelerations across the tilt are the cosines: the JD1's Y
+ * (3404h) is -cos z and the JD2's Z (3405h) cos x cos y, each the sine
+ * of 90 deg - a, also between whole degrees; the JD1 lies flat: Z 0. */
+static void test_accel_cosines(void)
+{
+    static const int32_t fracs[] = {0, 1, 112, 500, 889, 999};
+    boot(&jd1xxx);
+    jd_dev_t *j = h_inst(d);
+    unsigned bad = 0;
+    for (int deg = 0; deg < 90; deg++) {
+        for (unsigned k = 0; k < sizeof(fracs) / sizeof(fracs[0]); k++) {
+            int32_t a = deg * 1000 + fracs[k];
+            int32_t s[2] = {90000 - a, 25000};
+            d->prod->sample(j, s, 0);
+            int16_t sine = j->accel[0];
+            int32_t c[2] = {a, 25000};
+            d->prod->sample(j, c, 0);
+            bad += j->accel[1] != -sine || j->accel[2] != 0;
+        }
+    }
+    CHECK_EQ(bad, 0);
+    CHECK_EQ(h_read(d, 0x3405, 0), 0);
+    boot(&jd2xxx);
+    j = h_inst(d);
+    bad = 0;
+    for (int deg = 0; deg < 90; deg++) {
+        for (unsigned k = 0; k < sizeof(fracs) / sizeof(fracs[0]); k++) {
+            int32_t a = deg * 1000 + fracs[k];
+            int32_t s[3] = {90000 - a, 0, 25000};
+            d->prod->sample(j, s, 0);
+            int16_t sine = j->accel[0];
+            int32_t cx[3] = {a, 0, 25000};
+            d->prod->sample(j, cx, 0);
+            bad += j->accel[2] != sine;
+            int32_t cy[3] = {0, a, 25000};
+            d->prod->sample(j, cy, 0);
+            bad += j->accel[2] != sine;
+        }
+    }
+    CHECK_EQ(bad, 0);
+}
+
 int main(void)
 {
     RUN(test_lss_activate_bit_timing);
@@ -757,6 +799,7 @@ int main(void)
     RUN(test_leds);
     RUN(test_accel_sine_table);
     RUN(test_accel_between_degrees);
+    RUN(test_accel_cosines);
     RUN(test_lss_stores_across_power_cycles);
     RUN(test_lss_store_edges);
     return h_finish();
