@@ -427,7 +427,8 @@ static void test_change_of_state_both_tpdos(void)
     CHECK(n2 >= 1u);
 }
 
-/* The TPDOs' factory settings (spec section 2, C10): TPDO1 inhibit 0,
+/* The TPDOs' factory settings (spec section 2, C10): COB-IDs 180h and
+ * 280h + node-ID, TPDO1 inhibit 0,
  * TPDO2 inhibit 1 as printed; JD2 maps both slopes into each TPDO, the JD1
  * its one slope (the second entry names 6020h, unused). */
 static void test_tpdo_defaults(void)
@@ -437,6 +438,7 @@ static void test_tpdo_defaults(void)
         uint8_t sub;
         long long jd2, jd1;
     } v[] = {
+        {0x1800, 1, 0x18A, 0x18A},   {0x1801, 1, 0x28A, 0x28A},
         {0x1800, 3, 0, 0},           {0x1801, 3, 1, 1},
         {0x1A00, 0, 2, 1},           {0x1A01, 0, 2, 1},
         {0x1A00, 1, 0x60100010, 0x60100010}, {0x1A01, 1, 0x60100010, 0x60100010},
