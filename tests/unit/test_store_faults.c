@@ -704,6 +704,56 @@ static void test_corrupt_report_across_resets(void)
     CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_OK);
 }
 
+/* A product that reports a corrupt stored set with EMCY 6300h from its
+ * poll hook (co_store_report_emcy): while stopped nothing is raised, so
+ * that the EMCY goes out once pre-operational (CiA 301: none in stopped). */
+static uint32_t r_poll(co_node_t *n, uint32_t now)
+{
+    (void)now;
+    co_store_report_emcy(n);
+    return CO_NEVER;
+}
+
+static const co_node_ops_t r_ops = {.poll = r_poll};
+
+static const co_node_cfg_t r_cfg = {
+    .od = &s_od,
+    .ops = &r_ops,
+    .ram_size = {0, 0, 32, sizeof(co_lss_para_t)},
+    .default_node_id = 0x30,
+};
+
+static void r_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
+{
+    (void)p;
+    s_dev_t *t = mem;
+    memset(t, 0, sizeof(*t));
+    void *const ram[CO_CLS_COUNT] = {NULL, NULL, t->para, &t->lss};
+    co_node_init(&t->node, &r_cfg, ports[0], t, ram, 0);
+    nodes[0] = &t->node;
+}
+
+static const product_t r_prod = {.id = "emcy 6300h", .inputs = {{NULL, NULL, 0, 0}},
+                                 .nodes = 1, .inst_size = sizeof(s_dev_t),
+                                 .create = r_create, .sample = s_sample};
+
+static void test_corrupt_set_emcy_after_stopped(void)
+{
+    h_boot(d, &r_prod, false);
+    EXPECT(d, 0x730, "00");
+    h_advance(d, 1000);
+    EXPECT_NONE(d); /* nothing stored: nothing to report */
+    h_rx(d, 0x000, "02 30");
+    co_store_mark_corrupt(d->node, CO_CLS_PARA);
+    co_node_wake(d->node); /* polled while stopped */
+    h_advance(d, 1000);
+    EXPECT_NONE(d);
+    h_rx(d, 0x000, "80 30");
+    h_advance(d, 1000);
+    EXPECT(d, 0xB0, "00 63 01 00 00 00 00 00");
+    EXPECT_NONE(d);
+}
+
 /* The slot at NVM offset at holds exactly these bytes (hex). */
 static void expect_slot(unsigned at, const char *hex, int line)
 {
@@ -768,6 +818,7 @@ int main(void)
     RUN(test_corrupt_until_full_save);
     RUN(test_save_after_load);
     RUN(test_corrupt_report_across_resets);
+    RUN(test_corrupt_set_emcy_after_stopped);
     RUN(test_group_save);
     RUN(test_group_load);
     RUN(test_group_save_after_load);
