@@ -543,6 +543,60 @@ static void test_init(void)
     CLEAN();
 }
 
+/* The register accesses of a start, watched: a frame arrives as soon as
+ * the controller leaves reset mode, and the interrupt line is looked at
+ * after every access. */
+static unsigned watch_n, watch_first_irq, watch_ier_last;
+static bool watch_frame;
+
+static void watch_step(void)
+{
+    watch_n++;
+    if (watch_first_irq == 0u && irq_line()) {
+        watch_first_irq = watch_n;
+    }
+}
+
+static uint8_t watch_read(void *ctx, uint8_t reg)
+{
+    uint8_t v = sja_model_read(ctx, reg);
+    watch_step();
+    return v;
+}
+
+static void watch_write(void *ctx, uint8_t reg, uint8_t v)
+{
+    sja_model_write(ctx, reg, v);
+    if (reg == SJA_IER) {
+        watch_ier_last = watch_n + 1u;
+    }
+    if (reg == SJA_MOD && (v & 0x01u) == 0u && watch_frame) {
+        watch_frame = false;
+        co_frame_t f = frame(0x123, false, 1, 1);
+        CHECK(inject(&f));
+    }
+    watch_step();
+}
+
+/* A start on a controller left running with its interrupts enabled: no
+ * interrupt before the start enables them, last (a board's handler would
+ * find the driver half set up), though a frame arrives on the way. */
+static void test_init_quiet_until_started(void)
+{
+    static const sja1000_io_t watch_io = {watch_read, watch_write};
+    up();
+    CHECK_EQ(m.ier & 0x2Fu, 0x2F);
+    watch_n = watch_first_irq = watch_ier_last = 0;
+    watch_frame = true;
+    CHECK(sja1000_init(&c, &watch_io, &m, 16000000u, 125u));
+    CHECK(!watch_frame);
+    CHECK(watch_first_irq == 0u || watch_first_irq >= watch_ier_last); /* from that write on */
+    c.io = &sja_model_io;
+    co_frame_t g, f = frame(0x123, false, 1, 1);
+    CHECK(sja1000_receive(&c, &g) && same_frame(&g, &f));
+    CLEAN();
+}
+
 static void test_init_refused(void)
 {
     /* no controller at the address: every read 0xFF */
@@ -1425,6 +1479,7 @@ int main(void)
     RUN(test_timing_every_quanta_count);
     RUN(test_init);
     RUN(test_init_refused);
+    RUN(test_init_quiet_until_started);
     RUN(test_set_bitrate);
     RUN(test_slow_mode_change);
     RUN(test_filter_one_node);
