@@ -46,8 +46,9 @@ static void test_jd1_preset_and_wrap(void)
     SDO(d, "23 12 61 00 00 00 00 00", "60 12 61 00 00 00 00 00"); /* 0 */
     SDO(d, "40 13 60 00 00 00 00 00", "4B 13 60 00 F0 D8 00 00"); /* -10000 */
     SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 00 00 00 00");
-    /* 6020h reads 0 on the JD1 (L1671). */
+    /* 6020h and 6120h read 0 on the JD1 (L1671). */
     SDO(d, "40 20 60 00 00 00 00 00", "4B 20 60 00 00 00 00 00");
+    SDO(d, "40 20 61 00 00 00 00 00", "43 20 61 00 00 00 00 00");
 }
 
 /* JD2 lateral axis: 2601h, 6022h and 6122h set the one preset; the offset

@@ -16,6 +16,7 @@
 #include "dst.h"
 #include "gsh.h"
 #include "harness.h"
+#include "jd.h"
 #include "pf.h"
 
 static h_dev_t dev;
@@ -426,6 +427,26 @@ static void test_written_mapping_sets_the_dlc(void)
     CHECK(writable >= 2u); /* JD1, JD2, INX, INY */
 }
 
+/* The simulated inputs a board offers for the JD models: the angles in
+ * deg (level at power-on, PRODUCT_ANGLE_LIMIT), then the PCB temperature
+ * (3411h) in degC, 25 degC at power-on, +-200 degC accepted. */
+static void test_jd_inputs(void)
+{
+    const product_t *const p[2] = {&jd2xxx, &jd1xxx};
+    for (unsigned k = 0; k < 2u; k++) {
+        unsigned angles = k == 0u ? 2u : 1u;
+        for (unsigned i = 0; i < angles; i++) {
+            CHECK_EQ(p[k]->inputs[i].initial, 0);
+            CHECK_EQ(p[k]->inputs[i].limit, PRODUCT_ANGLE_LIMIT);
+        }
+        const product_input_t *t = &p[k]->inputs[angles];
+        CHECK(t->name != NULL && strcmp(t->name, "temp") == 0);
+        CHECK_EQ(t->initial, 25000);
+        CHECK_EQ(t->limit, 200);
+        CHECK(p[k]->inputs[angles + 1u].name == NULL);
+    }
+}
+
 /* ---- every product: its nodes' ports and EEPROM areas ------------------ */
 
 /* product.h: node i talks through ports[i]. Each port gets its node's
@@ -596,6 +617,7 @@ int main(void)
     RUN(test_pf_stored_set_unusable);
     RUN(test_mapped_length_is_the_dlc);
     RUN(test_written_mapping_sets_the_dlc);
+    RUN(test_jd_inputs);
     RUN(test_each_node_talks_through_its_port);
     RUN(test_each_node_stores_in_its_area);
     RUN(test_create_on_used_memory);
