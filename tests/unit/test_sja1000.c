@@ -930,6 +930,18 @@ static void test_filter_one_node(void)
     co_rx_id_t both[] = {{0x000, false}, {0x705, true}, {0x705, false}};
     check_list(both, 3, false);
     check_list(both, 1, false);
+    /* a list of one right after a longer one: the hardware passes that
+     * CAN-ID alone (the second filter too holds nothing of the last list) */
+    sja1000_set_filter(&c, both, 3);
+    sja1000_set_filter(&c, both, 1);
+    const uint8_t d0[8] = {0};
+    unsigned passing = 0;
+    for (uint16_t id = 0; id < 0x800u; id++) {
+        passing += sja_model_accepts(&m, id, false, false, 0, d0) ? 1u : 0u;
+        passing += sja_model_accepts(&m, id, false, true, 0, d0) ? 1u : 0u;
+    }
+    CHECK_EQ(passing, 2);
+    CHECK(sja_model_accepts(&m, 0x000, false, false, 0, d0));
     /* a remote frame on a data-only ID and a data frame on a remote-only
      * one are dropped (check_list judged every kind; here the count) */
     co_frame_t f = frame(0x605, true, 0, 0), g;
