@@ -754,6 +754,44 @@ static void test_corrupt_set_emcy_after_stopped(void)
     EXPECT_NONE(d);
 }
 
+/* The same product saves no node-ID set with its parameters: a group save
+ * whose reads fail at any point is answered with an abort, never "done",
+ * and the old set stays. */
+static void test_read_fault_in_group_save_alone(void)
+{
+    static const long long old_set[4] = {100, 200, 0x11223344, 300};
+    static const long long new_set[4] = {100, 200, 0x11223344, 301}; /* group 3 only */
+    h_boot(d, &r_prod, false);
+    EXPECT(d, 0x730, "00");
+    set_all(100, 200, 0x11223344u, 300);
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    unsigned refused = 0;
+    for (long k = 0; k < 1000; k++) {
+        set_all(101, 201, 0x55667788u, 301);
+        d->port.reads_left = k;
+        d->port.read_faults = 0;
+        h_drain(d);
+        h_rx(d, 0x630, "23 10 10 03 73 61 76 65");
+        bool hit = d->port.read_faults != 0;
+        d->port.reads_left = -1;
+        const co_frame_t *f = h_next(d);
+        CHECK(f != NULL && f->id == 0x5B0);
+        bool ok = f != NULL && f->data[0] == 0x60u;
+        CHECK(ok == !hit);
+        h_drain(d);
+        h_power_cycle(d);
+        h_drain(d);
+        CHECK_EQ(which_set(old_set, new_set), ok ? 1 : 0);
+        if (!hit) {
+            break;
+        }
+        refused++;
+        set_all(100, 200, 0x11223344u, 300);
+        SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    }
+    CHECK(refused >= 10);
+}
+
 /* The slot at NVM offset at holds exactly these bytes (hex). */
 static void expect_slot(unsigned at, const char *hex, int line)
 {
@@ -819,6 +857,7 @@ int main(void)
     RUN(test_save_after_load);
     RUN(test_corrupt_report_across_resets);
     RUN(test_corrupt_set_emcy_after_stopped);
+    RUN(test_read_fault_in_group_save_alone);
     RUN(test_group_save);
     RUN(test_group_load);
     RUN(test_group_save_after_load);
