@@ -41,6 +41,7 @@ typedef struct n_dev {
     co_lss_para_t lss;
     unsigned state_calls;
     co_nmt_state_t last_old;
+    bool start_once; /* the reset hook asks for one automatic start */
 } n_dev_t;
 
 #define P(f) CO_AT(CO_CLS_PARA, n_para_t, f)
@@ -95,7 +96,18 @@ static void n_state(co_node_t *n, co_nmt_state_t old)
     t->last_old = old;
 }
 
-static const co_node_ops_t n_ops = {.state = n_state, .can_state = co_emcy_can_state};
+static void n_reset(co_node_t *n, co_reset_t kind)
+{
+    (void)kind;
+    n_dev_t *t = n->app;
+    if (t->start_once) {
+        t->start_once = false;
+        co_node_set_autostart(n, true);
+    }
+}
+
+static const co_node_ops_t n_ops = {.state = n_state, .can_state = co_emcy_can_state,
+                                    .reset = n_reset};
 
 static const co_service_t *const n_services[] = {&co_guard_service, &co_hbc_service,
                                                  &co_lss_service, &co_rtr_service, NULL};
@@ -104,6 +116,7 @@ static const co_node_cfg_t n_cfg = {
     .od = &n_od,
     .ops = &n_ops,
     .services = n_services,
+    .sdo_segmented = co_sdo_segmented,
     .ram_size = {0, sizeof(n_vol_t), sizeof(n_para_t), sizeof(co_lss_para_t)},
     .default_node_id = 0x40,
     .default_bitrate = 3,
@@ -782,6 +795,43 @@ static void test_reset_areas(void)
     CHECK_EQ(h_read(d, 0x2002, 0), 0x7788);
 }
 
+/* What a reset does not keep: a stored node-ID out of 1..127 (128) is
+ * refused, the store reported corrupt, the default used; an automatic
+ * start is for the boot-up it was asked for; an SDO transfer in progress
+ * is forgotten (its next segment is no valid request); an LSS node-ID
+ * applied once is not applied again. */
+static void test_reset_forgets(void)
+{
+    boot();
+    inst()->lss.node_id = 128;
+    CHECK(co_store_save(d->node, CO_CLS_LSS) == CO_OK);
+    h_power_cycle(d);
+    EXPECT(d, 0x740, "00");
+    CHECK_EQ(co_node_store_status(d->node, CO_CLS_LSS), CO_STORE_CORRUPT);
+    inst()->start_once = true;
+    h_rx(d, 0x000, "82 40");
+    CHECK_EQ(co_node_nmt_state(d->node), CO_NMT_OPERATIONAL);
+    h_rx(d, 0x000, "82 40");
+    CHECK_EQ(co_node_nmt_state(d->node), CO_NMT_PREOP);
+    SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00"); /* segmented */
+    h_rx(d, 0x000, "82 40");
+    SDO(d, "07 00 00 00 05 00 00 00", "80 00 00 00 01 00 04 05");
+    CHECK_EQ(h_read(d, 0x2000, 0), 0x11223344);
+    /* An LSS node-ID not stored is active from reset communication until a
+     * reset node, which loads the stored set (here the default 40h). */
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("11 25 00 00 00 00 00 00", "11 00 00 00 00 00 00 00");
+    LSS("04 00 00 00 00 00 00 00", NULL);
+    h_rx(d, 0x000, "82 40");
+    EXPECT(d, 0x725, "00");
+    h_rx(d, 0x000, "81 25");
+    EXPECT(d, 0x740, "00");
+    /* Without a bit rate table the board is told 0 (its default), once a
+     * power-on (two here): the resets since changed no rate. */
+    CHECK_EQ(d->port.kbps, 0);
+    CHECK_EQ(d->port.bitrate_calls, 2);
+}
+
 /* A node started late in the clock's range (past 2^31 us, about 36 min
  * after the board's clock began) runs its timers as at any other time:
  * the stored heartbeat goes out after its period. */
@@ -907,6 +957,7 @@ int main(void)
     RUN(test_tpdo_mapping_count_beyond_entries);
     RUN(test_emcy_table_full_and_cobid);
     RUN(test_reset_areas);
+    RUN(test_reset_forgets);
     RUN(test_start_late_in_the_clock);
     RUN(test_send_refused);
     RUN(test_fewest_objects);
