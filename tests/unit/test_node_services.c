@@ -124,6 +124,20 @@ static const co_node_cfg_t n_cfg = {
     .lss_bitrates = 0x01DF, /* CiA 305 indices 0-4, 6-8 */
 };
 
+/* The test dictionary where reset communication applies the stored
+ * node-ID too (as the Gefran GSH's manual C-24 asks). */
+static const co_node_cfg_t n_comm_id_cfg = {
+    .od = &n_od,
+    .ops = &n_ops,
+    .services = n_services,
+    .ram_size = {0, sizeof(n_vol_t), sizeof(n_para_t), sizeof(co_lss_para_t)},
+    .default_node_id = 0x40,
+    .default_bitrate = 3,
+    .comm_reset_applies_id = true,
+    .lss = true,
+    .lss_bitrates = 0x01DF,
+};
+
 /* A dictionary with the fewest objects the services work with: no EMCY
  * COB-ID (the default 80h + node-ID), an error history with no field,
  * a guard time without a life time factor, a consumer time kept nowhere,
@@ -180,6 +194,7 @@ static void n_sample(void *mem, const int32_t v[], uint32_t fault)
 
 static const n_variant_t n_no_lss = {.no_lss = true, .cfg = &n_cfg};
 static const n_variant_t n_min = {.no_lss = true, .cfg = &n_min_cfg};
+static const n_variant_t n_comm_id = {.no_lss = false, .cfg = &n_comm_id_cfg};
 static const product_t n_prod = {.id = "services", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
                                   .inst_size = sizeof(n_dev_t), .create = n_create,
                                   .sample = n_sample};
@@ -187,6 +202,10 @@ static const product_t n_prod_no_lss = {.id = "services-no-lss", .inputs = {{NUL
                                          .nodes = 1, .inst_size = sizeof(n_dev_t),
                                          .create = n_create, .sample = n_sample,
                                          .variant = &n_no_lss};
+static const product_t n_prod_comm_id = {.id = "services-comm-id",
+                                          .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
+                                          .inst_size = sizeof(n_dev_t), .create = n_create,
+                                          .sample = n_sample, .variant = &n_comm_id};
 static const product_t n_prod_min = {.id = "services-min", .inputs = {{NULL, NULL, 0, 0}},
                                       .nodes = 1, .inst_size = sizeof(n_dev_t),
                                       .create = n_create, .sample = n_sample, .variant = &n_min};
@@ -832,6 +851,17 @@ static void test_reset_forgets(void)
     CHECK_EQ(d->port.bitrate_calls, 2);
 }
 
+/* Where reset communication applies the node-ID, it applies the stored
+ * one: a node-ID in RAM that was never stored is replaced by it. */
+static void test_comm_reset_applies_stored_id(void)
+{
+    h_boot(d, &n_prod_comm_id, false);
+    EXPECT(d, 0x740, "00");
+    inst()->lss.node_id = 0x30; /* not stored */
+    h_rx(d, 0x000, "82 40");
+    EXPECT(d, 0x740, "00");
+}
+
 /* A node started late in the clock's range (past 2^31 us, about 36 min
  * after the board's clock began) runs its timers as at any other time:
  * the stored heartbeat goes out after its period. */
@@ -958,6 +988,7 @@ int main(void)
     RUN(test_emcy_table_full_and_cobid);
     RUN(test_reset_areas);
     RUN(test_reset_forgets);
+    RUN(test_comm_reset_applies_stored_id);
     RUN(test_start_late_in_the_clock);
     RUN(test_send_refused);
     RUN(test_fewest_objects);
