@@ -596,6 +596,10 @@ static void test_records_at_the_end_of_the_eeprom(void)
     t = h_inst(d);
     CHECK_EQ(d->node->store.status[CO_CLS_LSS], CO_STORE_OK);
     CHECK_EQ(t->lss.more[sizeof(t->lss.more) - 1u], 0x5B);
+    /* Unchanged, all of its chunks compared: not written again. */
+    uint32_t w = d->node->store.writes;
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    CHECK_EQ(d->node->store.writes - w, 1);
 }
 
 /* Two valid records of one sequence number (never written so by a save:
