@@ -326,6 +326,38 @@ static void test_zero_point_kept_across_power_cycle(void)
     SDO(d, "40 13 60 00 00 00 00 00", "4B 13 60 00 EB 08 00 00"); /* 2283, as set */
 }
 
+/* R56 on the INY's Y axis: 6022h is the lateral zero point (6020h reads
+ * it at once, scaling on), the X axis untouched. */
+static void test_lateral_zero_point(void)
+{
+    boot(&pf_iny360d);
+    settle(10000, 20000);
+    SDO(d, "2F 21 60 00 02 00 00 00", "60 21 60 00 00 00 00 00");
+    SDO(d, "2F 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00");
+    SDO(d, "2B 22 60 00 32 00 00 00", "60 22 60 00 00 00 00 00"); /* 5.0 deg */
+    SDO(d, "40 20 60 00 00 00 00 00", "4B 20 60 00 32 00 00 00");
+    SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 64 00 00 00"); /* X still 10.0 */
+    SDO(d, "40 12 60 00 00 00 00 00", "4B 12 60 00 00 00 00 00");
+}
+
+/* The error check asks for no poll at once: in stopped an error waits for
+ * the NMT command, and once reported nothing is due (no heartbeat, no
+ * timer: CO_NEVER). */
+static void test_error_poll_leaves_nothing_due(void)
+{
+    boot(&pf_inx360d);
+    h_advance(d, 10000);
+    CHECK_EQ(co_node_poll(d->node, d->now), CO_NEVER);
+    h_rx(d, 0x000, "02 01");
+    d->fault = PF_FAULT_RANGE_X;
+    h_advance(d, 10000);
+    CHECK_EQ(co_node_poll(d->node, d->now), CO_NEVER);
+    h_drain(d);
+    h_rx(d, 0x000, "80 01");
+    EXPECT(d, 0x081, "10 50 11 00 00 00 00 00");
+    CHECK_EQ(co_node_poll(d->node, d->now), CO_NEVER);
+}
+
 static void test_d25_stopped_and_d26_store(void)
 {
     boot(&pf_inx360d);
@@ -404,6 +436,8 @@ int main(void)
     RUN(test_v21_to_v24_zero_point_d12_to_d18);
     RUN(test_failed_autosave_changes_nothing);
     RUN(test_zero_point_kept_across_power_cycle);
+    RUN(test_lateral_zero_point);
+    RUN(test_error_poll_leaves_nothing_due);
     RUN(test_d25_stopped_and_d26_store);
     RUN(test_eeprom_checksum_6300);
     RUN(test_dynamic_mapping_and_cobid);
