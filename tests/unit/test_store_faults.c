@@ -32,11 +32,13 @@ static const co_od_entry_t s_entries[] = {
     SAVE(2, co_store_write_group_save),
     SAVE(3, co_store_write_group_save),
     SAVE(4, co_store_write_group_save),
+    SAVE(5, co_store_write_group_save), /* a group the stack does not know */
     {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 4},
     LOAD(1, co_store_write_load),
     LOAD(2, co_store_write_group_load),
     LOAD(3, co_store_write_group_load),
     LOAD(4, co_store_write_group_load),
+    LOAD(5, co_store_write_group_load),
     {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, PARA(0), .def = 0, CO_EXT(.write = co_hb_write_time)},
     {.index = 0x1FFF, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, PARA(2), .def = 0},
     {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, PARA(4), .def = 100, CO_EXT(.min = 10, .max = 1000)},
@@ -170,11 +172,23 @@ static void test_group_save(void)
     SDO(d, "23 10 10 02 73 61 76 65", "60 10 10 02 00 00 00 00");
     h_power_cycle(d);
     EXPECT_ALL(102, 201, 0x55667788u, 300);
-    /* Anything but "save": 0x08000020, nothing notified. */
+    /* Anything but "save": 0x08000020, nothing notified; the same for a
+     * group sub-index beyond CiA 301's three. */
     unsigned before = inst()->stored;
     SDO(d, "23 10 10 02 73 61 76 66", "80 10 10 02 20 00 00 08");
     SDO(d, "23 11 10 03 6C 6F 61 65", "80 11 10 03 20 00 00 08");
+    SDO(d, "23 10 10 05 73 61 76 65", "80 10 10 05 20 00 00 08");
+    SDO(d, "23 11 10 05 6C 6F 61 64", "80 11 10 05 20 00 00 08");
     CHECK_EQ(inst()->stored, before);
+    /* "load" of all: notified; one the EEPROM cannot write: an abort
+     * (hardware), nothing notified. */
+    SDO(d, "23 11 10 01 6C 6F 61 64", "60 11 10 01 00 00 00 00");
+    CHECK_EQ(inst()->stored, before + 1u);
+    CHECK_EQ(inst()->sig, CO_SIG_LOAD);
+    d->port.cut_after = 0;
+    SDO(d, "23 11 10 01 6C 6F 61 64", "80 11 10 01 00 00 06 06");
+    d->port.cut_after = -1;
+    CHECK_EQ(inst()->stored, before + 1u);
 }
 
 static void test_group_load(void)
