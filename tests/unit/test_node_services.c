@@ -680,6 +680,12 @@ static void test_cia303_led_mapping(void)
     EXPECT(d, 0xC0, "20 81 11 00 00 00 00 00");
     co_node_set_can_state(d->node, CO_CAN_PASSIVE); /* no change: nothing */
     EXPECT_NONE(d);
+    co_node_set_can_state(d->node, CO_CAN_BUSOFF);
+    uint32_t dropped = co_node_tx_dropped(d->node);
+    co_node_set_can_state(d->node, CO_CAN_BUSOFF); /* no change: no EMCY tried */
+    CHECK_EQ(co_node_tx_dropped(d->node), dropped);
+    co_node_set_can_state(d->node, CO_CAN_PASSIVE);
+    h_drain(d);
     co_node_led_patterns(d->node, &g, &r);
     CHECK(r == CO_LED_FLASH1);
     /* A node without node-ID is in no NMT state: green off. */
@@ -862,6 +868,22 @@ static void test_comm_reset_applies_stored_id(void)
     EXPECT(d, 0x740, "00");
 }
 
+/* A reset requested (co_node_request_reset) happens once, at the next
+ * poll. */
+static void test_reset_request_once(void)
+{
+    boot();
+    h_drain(d);
+    co_node_request_reset(d->node, CO_RESET_COMM);
+    EXPECT_NONE(d);
+    h_advance(d, 1000);
+    EXPECT(d, 0x740, "00");
+    h_rx(d, 0x000, "01 40");
+    h_advance(d, 100000);
+    EXPECT_NONE(d);
+    CHECK_EQ(co_node_nmt_state(d->node), CO_NMT_OPERATIONAL);
+}
+
 /* A node started late in the clock's range (past 2^31 us, about 36 min
  * after the board's clock began) runs its timers as at any other time:
  * the stored heartbeat goes out after its period. */
@@ -989,6 +1011,7 @@ int main(void)
     RUN(test_reset_areas);
     RUN(test_reset_forgets);
     RUN(test_comm_reset_applies_stored_id);
+    RUN(test_reset_request_once);
     RUN(test_start_late_in_the_clock);
     RUN(test_send_refused);
     RUN(test_fewest_objects);
