@@ -340,6 +340,25 @@ static void test_lateral_zero_point(void)
     SDO(d, "40 12 60 00 00 00 00 00", "4B 12 60 00 00 00 00 00");
 }
 
+/* The INY's axes each have their own objects (CiA 410): X scaling and
+ * zero point (6011h, 6012h) leave Y alone, Y's inversion (6021h) leaves X
+ * alone; both report device type 0000019Ah (CiA 410) like the INX. */
+static void test_iny_axes_are_their_own(void)
+{
+    boot(&pf_iny360d);
+    SDO(d, "40 00 10 00 00 00 00 00", "43 00 10 00 9A 01 00 00");
+    settle(10000, 20000);
+    SDO(d, "2F 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00");
+    SDO(d, "2B 12 60 00 00 00 00 00", "60 12 60 00 00 00 00 00");
+    SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 00 00 00 00");
+    SDO(d, "40 20 60 00 00 00 00 00", "4B 20 60 00 C8 00 00 00"); /* Y 20.0 */
+    SDO(d, "2F 21 60 00 01 00 00 00", "60 21 60 00 00 00 00 00");
+    SDO(d, "40 20 60 00 00 00 00 00", "4B 20 60 00 48 0D 00 00"); /* 340.0 */
+    SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 00 00 00 00");
+    boot(&pf_inx360d);
+    SDO(d, "40 00 10 00 00 00 00 00", "43 00 10 00 9A 01 00 00");
+}
+
 /* The error check asks for no poll at once: in stopped an error waits for
  * the NMT command, and once reported nothing is due (no heartbeat, no
  * timer: CO_NEVER). */
@@ -437,6 +456,7 @@ int main(void)
     RUN(test_failed_autosave_changes_nothing);
     RUN(test_zero_point_kept_across_power_cycle);
     RUN(test_lateral_zero_point);
+    RUN(test_iny_axes_are_their_own);
     RUN(test_error_poll_leaves_nothing_due);
     RUN(test_d25_stopped_and_d26_store);
     RUN(test_eeprom_checksum_6300);

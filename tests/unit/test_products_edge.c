@@ -58,7 +58,13 @@ static void test_registry(void)
 }
 
 #define ANSWERS_MAX 128u
-static uint8_t answers[2][2][ANSWERS_MAX][8];
+/* Scratch memory of the tests below, one test at a time (the emulated
+ * Cortex-M0 has 16 KB of RAM): the answers of two power-ons, or the ports
+ * of a product's nodes. */
+static union {
+    uint8_t answers[2][2][ANSWERS_MAX][8];
+    fake_port_t ports[PRODUCT_MAX_NODES];
+} scratch;
 static unsigned power_on_answers(const product_t *p, uint8_t fill, uint8_t out[2][ANSWERS_MAX][8]);
 
 static void boot_dst(void)
@@ -133,12 +139,12 @@ static void test_dst_pair_copies_are_their_own(void)
  * request after power-on, before the node has looked for errors. */
 static void test_dst_sensor_error_holds_the_slope(void)
 {
-    (void)power_on_answers(&dst_x730_xy30, 0xA5, answers[0]);
+    (void)power_on_answers(&dst_x730_xy30, 0xA5, scratch.answers[0]);
     const co_od_t *od = co_cfg(d->node)->od;
     for (unsigned k = 0; k < od->count && k < ANSWERS_MAX; k++) {
         if (od->entries[k].index == 0x4001u) {
-            CHECK_EQ(answers[0][0][k][0], 0x4F);
-            CHECK_EQ(answers[0][0][k][4], 0);
+            CHECK_EQ(scratch.answers[0][0][k][0], 0x4F);
+            CHECK_EQ(scratch.answers[0][0][k][4], 0);
         }
     }
     boot_dst();
@@ -447,13 +453,28 @@ static void test_jd_inputs(void)
     }
 }
 
+/* Every product's simulated angles start level and take
+ * PRODUCT_ANGLE_LIMIT: a board's inputs in deg. */
+static void test_angle_inputs_start_level(void)
+{
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        const product_t *p = product_list[i];
+        for (unsigned k = 0; k < PRODUCT_MAX_INPUTS && p->inputs[k].name != NULL; k++) {
+            if (p->inputs[k].unit != NULL && strcmp(p->inputs[k].unit, "deg") == 0) {
+                CHECK_EQ(p->inputs[k].initial, 0);
+                CHECK_EQ(p->inputs[k].limit, PRODUCT_ANGLE_LIMIT);
+            }
+        }
+    }
+}
+
 /* ---- every product: its nodes' ports and EEPROM areas ------------------ */
 
 /* product.h: node i talks through ports[i]. Each port gets its node's
  * boot-up, and only that (a device's nodes on their own buses). */
 static void test_each_node_talks_through_its_port(void)
 {
-    static fake_port_t ports[PRODUCT_MAX_NODES];
+    fake_port_t *ports = scratch.ports;
     for (size_t i = 0; product_list[i] != NULL; i++) {
         const product_t *p = product_list[i];
         void *pp[PRODUCT_MAX_NODES];
@@ -530,12 +551,12 @@ static unsigned power_on_answers(const product_t *p, uint8_t fill, uint8_t out[2
 static void test_create_on_used_memory(void)
 {
     for (size_t i = 0; product_list[i] != NULL; i++) {
-        unsigned n = power_on_answers(product_list[i], 0x00, answers[0]);
-        (void)power_on_answers(product_list[i], 0xA5, answers[1]);
+        unsigned n = power_on_answers(product_list[i], 0x00, scratch.answers[0]);
+        (void)power_on_answers(product_list[i], 0xA5, scratch.answers[1]);
         const co_od_t *od = co_cfg(d->node)->od;
         for (unsigned pass = 0; pass < 2u; pass++) {
             for (unsigned k = 0; k < n; k++) {
-                if (memcmp(answers[0][pass][k], answers[1][pass][k], 8) != 0) {
+                if (memcmp(scratch.answers[0][pass][k], scratch.answers[1][pass][k], 8) != 0) {
                     fprintf(stderr, "  %s %04Xh:%u (pass %u) differs on used memory\n",
                             product_list[i]->id, (unsigned)od->entries[k].index,
                             (unsigned)od->entries[k].sub, pass);
@@ -618,6 +639,7 @@ int main(void)
     RUN(test_mapped_length_is_the_dlc);
     RUN(test_written_mapping_sets_the_dlc);
     RUN(test_jd_inputs);
+    RUN(test_angle_inputs_start_level);
     RUN(test_each_node_talks_through_its_port);
     RUN(test_each_node_stores_in_its_area);
     RUN(test_create_on_used_memory);

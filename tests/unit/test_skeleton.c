@@ -17,6 +17,7 @@ static void test_boot_and_identity(void)
     EXPECT(d, 0x720, "00");
     CHECK_EQ(co_node_nmt_state(d->node), CO_NMT_PREOP);
     CHECK_EQ(d->port.kbps, 250); /* the default bit-rate code 3 */
+    CHECK_EQ(co_node_poll(d->node, d->now), CO_NEVER); /* nothing due: no poll asked for */
     SDO(d, "40 00 10 00 00 00 00 00", "43 00 10 00 9A 01 00 00"); /* device type: CiA 410 */
     SDO(d, "40 18 10 02 00 00 00 00", "43 18 10 02 01 00 00 00"); /* product code */
     SDO(d, "40 99 10 00 00 00 00 00", "80 99 10 00 00 00 02 06"); /* no such object */
