@@ -710,6 +710,9 @@ static void test_corrupt_report_across_resets(void)
     h_rx(d, 0x000, "82 30");
     EXPECT(d, 0x730, "00");
     CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    /* Any restore of part of the set (co_store_restore), from index 0 too. */
+    CHECK_EQ(co_store_restore(d->node, CO_CLS_PARA, 0x0000, 0x1FFF), CO_STORE_OK);
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
     /* Repaired: a set marked corrupt (here by the product) is sound again
      * once a reset node finds it so. */
     SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
