@@ -884,6 +884,27 @@ static void test_reset_request_once(void)
     CHECK_EQ(co_node_nmt_state(d->node), CO_NMT_OPERATIONAL);
 }
 
+/* A reset the board's poll performs late (requested at t, polled at
+ * t + 50 ms) runs from the poll's time: an automatic start's event timer
+ * (100 ms) sends at once and then 100 ms after that poll. */
+static void test_late_reset_runs_from_the_poll(void)
+{
+    boot();
+    SDO(d, "2B 00 18 05 64 00 00 00", "60 00 18 05 00 00 00 00"); /* TPDO1 event timer */
+    CHECK(co_store_save(d->node, CO_CLS_PARA) == CO_OK);
+    inst()->start_once = true;
+    h_drain(d);
+    co_node_request_reset(d->node, CO_RESET_COMM);
+    d->now += 50000u;
+    (void)co_node_poll(d->node, d->now);
+    EXPECT(d, 0x740, "00");
+    EXPECT(d, 0x1C0, "44 33 22 11 66 55");
+    h_advance(d, 99999);
+    EXPECT_NONE(d);
+    h_advance(d, 1);
+    EXPECT(d, 0x1C0, "44 33 22 11 66 55");
+}
+
 /* A node started late in the clock's range (past 2^31 us, about 36 min
  * after the board's clock began) runs its timers as at any other time:
  * the stored heartbeat goes out after its period. */
@@ -1012,6 +1033,7 @@ int main(void)
     RUN(test_reset_forgets);
     RUN(test_comm_reset_applies_stored_id);
     RUN(test_reset_request_once);
+    RUN(test_late_reset_runs_from_the_poll);
     RUN(test_start_late_in_the_clock);
     RUN(test_send_refused);
     RUN(test_fewest_objects);
