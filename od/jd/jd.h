@@ -71,7 +71,6 @@ void jd_sample(void *mem, const int32_t values[], uint32_t faults);
 co_res_t jd_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v);
 co_res_t jd_write_inhibit(co_node_t *n, const co_od_entry_t *e, uint32_t v);
 co_res_t jd_write_save_reset(co_node_t *n, const co_od_entry_t *e, uint32_t v);
-co_res_t jd_write_node_number(co_node_t *n, const co_od_entry_t *e, uint32_t v);
 co_res_t jd_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v);
 co_res_t jd_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v);
 co_res_t jd_write_diff(co_node_t *n, const co_od_entry_t *e, uint32_t v);
