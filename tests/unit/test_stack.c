@@ -1870,6 +1870,16 @@ static void test_rtr_service_passes_other_frames_on(void)
     CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
     h_advance(d, 2000);
     CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP); /* producer 5 lost */
+    /* The RTR service looks at its TPDOs only, never at what the node
+     * keeps right behind them (the EMCY table, here with four errors, the
+     * last of code 0720h): a guard request is still answered. */
+    CHECK(co_emcy_error(d->node, 0x1000, 0, true, NULL));
+    CHECK(co_emcy_error(d->node, 0x2000, 0, true, NULL));
+    CHECK(co_emcy_error(d->node, 0x3000, 0, true, NULL));
+    CHECK(co_emcy_error(d->node, 0x0720, 0, true, NULL));
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x720, "FF"); /* toggled, pre-operational */
 }
 
 /* Two TPDOs on one COB-ID: a remote request is answered once, by the
