@@ -200,5 +200,31 @@ class Merge(unittest.TestCase):
         self.assertIn(self.ms[0].id, r.stdout)
 
 
+class Arguments(unittest.TestCase):
+    """Mistakes in the arguments stop the tool before it runs anything."""
+
+    def test_gate(self):
+        self.assertEqual(mutate.parse_gate("src=95, od = 95 ,boards/common/=90%,all=0"),
+                         [("src", 95.0), ("od", 95.0), ("boards/common", 90.0), ("all", 0.0)])
+        for bad in ("src", "src=abc", "src=95,", "nosuchdir=90", "ALL=90", "od=101", "od=95=3"):
+            with self.assertRaises(SystemExit, msg=bad):
+                mutate.parse_gate(bad)
+
+    def test_ids(self):
+        ms = mutants_of(SRC)
+        for m in ms:
+            m.file = "src/x.c"
+        with tempfile.NamedTemporaryFile("w", suffix=".txt") as fh:
+            fh.write("# a comment\n\nsrc/x.c %s\n%s\n" % (ms[0].id, ms[3].id))
+            fh.flush()
+            self.assertEqual([m.id for m in mutate.select_ids(fh.name, ms)], [ms[0].id, ms[3].id])
+            fh.write("src/x.c nosuch@0#0:a:b\n")
+            fh.flush()
+            with self.assertRaises(SystemExit):
+                mutate.select_ids(fh.name, ms)
+        with self.assertRaises(SystemExit):
+            mutate.select_ids("/nonexistent/ids.txt", ms)
+
+
 if __name__ == "__main__":
     unittest.main()
