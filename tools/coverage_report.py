@@ -38,7 +38,7 @@ def main(argv):
     missing, tables = [], []
     for d in DIRS:
         sub = [0, 0, 0, 0]
-        for src in sorted((ROOT / d).glob("*.c")):
+        for src in sorted((ROOT / d).rglob("*.c")):  # od/<family>/ too
             rel = src.relative_to(ROOT).as_posix()
             f = files.get(rel)
             if f is None:
