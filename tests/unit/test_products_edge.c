@@ -64,6 +64,10 @@ static void test_registry(void)
 static union {
     uint8_t answers[2][2][ANSWERS_MAX][8];
     fake_port_t ports[PRODUCT_MAX_NODES];
+    struct {
+        uint8_t out[2][ANSWERS_MAX][8];
+        uint8_t nvm[2][FAKE_NVM_SIZE];
+    } saved;
 } scratch;
 static unsigned power_on_answers(const product_t *p, uint8_t fill, uint8_t out[2][ANSWERS_MAX][8]);
 
@@ -567,6 +571,32 @@ static void test_create_on_used_memory(void)
     }
 }
 
+/* What a save stores is the device's parameters and nothing of what the
+ * memory held before create(): the same EEPROM bytes whether it was zero
+ * or full of other bytes (the parameter structs' padding, and the fields of
+ * an axis the product does not have, included), as CiA 301's "save all
+ * parameters" (1010h sub 1) writes them. */
+static void test_saved_set_independent_of_memory(void)
+{
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        for (unsigned k = 0; k < 2u; k++) {
+            (void)power_on_answers(product_list[i], k == 0u ? 0x00 : 0xA5, scratch.saved.out);
+            co_frame_t f = {.id = (uint16_t)(0x600u + d->node->node_id), .dlc = 8,
+                            .data = {0x23, 0x10, 0x10, 0x01, 0x73, 0x61, 0x76, 0x65}};
+            h_drain(d);
+            co_node_receive(d->node, &f, d->now);
+            const co_frame_t *r = h_next(d);
+            CHECK(r != NULL && r->data[0] == 0x60u);
+            memcpy(scratch.saved.nvm[k], d->port.nvm, FAKE_NVM_SIZE);
+        }
+        if (memcmp(scratch.saved.nvm[0], scratch.saved.nvm[1], FAKE_NVM_SIZE) != 0) {
+            fprintf(stderr, "  %s: the saved set depends on the memory before create()\n",
+                    product_list[i]->id);
+            FAIL("a stored byte depends on what the memory held before create()");
+        }
+    }
+}
+
 /* The GSH-A has two channels at most (the redundant version): a product
  * row asking for more nodes is a programming error, reported (CO_CHECK),
  * and two channels are built, no more. */
@@ -643,6 +673,7 @@ int main(void)
     RUN(test_each_node_talks_through_its_port);
     RUN(test_each_node_stores_in_its_area);
     RUN(test_create_on_used_memory);
+    RUN(test_saved_set_independent_of_memory);
     RUN(test_gsh_at_most_two_channels);
     return h_finish();
 }
