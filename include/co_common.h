@@ -21,9 +21,8 @@
 /* One classic CAN frame (11-bit identifier). Word aligned (still 12 bytes):
  * the compiler then copies a frame with three word loads and stores instead
  * of a call to memcpy, which the bare-metal images have as a byte loop
- * (libc_min.c): on the Cortex-M0 each frame handed to the port cost 77
- * instructions in that loop (issue 11: SDO read 526 -> 449, TPDO 391 ->
- * 314, JD2 SYNC 1117 -> 965, DST X730 flash +12 bytes). */
+ * (libc_min.c): on the Cortex-M0 each frame handed to the port costs 77
+ * instructions in that loop. */
 typedef struct co_frame {
     _Alignas(4) uint16_t id; /* 11-bit CAN identifier */
     uint8_t dlc;     /* 0..8 */

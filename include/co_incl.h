@@ -61,9 +61,9 @@
 /* ---- The arithmetic of one output ------------------------------------ */
 
 /* The functions of a slope read (every PDO) are inlined also at -Os, where
- * gcc called them with the co_incl_fit_t on the stack: the ifm JD2's SYNC
- * of tools/bench took 979 Cortex-M0 instructions so, 799 inlined (the JD
- * image is 350 bytes larger for it; no DST image calls them twice). */
+ * gcc calls them with the co_incl_fit_t on the stack, which makes the ifm
+ * JD2's SYNC in tools/bench a fifth slower (the JD image is 350 bytes
+ * larger for it; no DST image calls them twice). */
 #if defined(__GNUC__)
 #define CO_INCL_INLINE static inline __attribute__((always_inline))
 #else
@@ -180,7 +180,7 @@ int32_t co_incl_preset_offset(int32_t preset, int32_t m, uint8_t op, int32_t dif
  * Measured angles in resolution units, for a product that computes its
  * outputs at each read: divided once per sample and once per change of
  * 0x6000, never per read (a division is a helper call on the Cortex-M0:
- * with one per read, half of the ifm JD2's SYNC went to it, issue 11).
+ * with one per read, half of the ifm JD2's SYNC goes to it).
  * 0x6000 reaches the parameters through its hook, a restore and a load
  * alike, so a read compares the resolution rather than rely on every
  * writer telling it. The caller owns it and the angles it is given.
@@ -236,7 +236,7 @@ typedef struct co_incl {
     bool beyond[CO_INCL_AXES];  /* measured angle strictly beyond the limit */
     int32_t angle[CO_INCL_AXES]; /* filtered, saturated angle (mdeg) */
     /* Wrap mode: each axis' own continuous input to its filter (one value
-     * for both made the second axis follow the first's turns, issue 12). */
+     * for both makes the second axis follow the first's turns). */
     int32_t unwrapped[CO_INCL_AXES];
     co_filter_t f[CO_INCL_AXES];
     /* The slope outputs, computed once per sample rather than per read
@@ -280,8 +280,7 @@ _Static_assert(sizeof(co_incl_para_t) == 16u, "co_incl_para_t: four words, no pa
 
 /* *a equals *b. On a 32-bit core four word compares, not memcmp: there
  * memcmp is libc_min.c's byte loop, 135 Cortex-M0 instructions per slope
- * read; the words brought the DST TPDO from 605 to 391 instructions and the
- * expedited SDO read from 633 to 526 (issue 11), for 8 bytes of flash. */
+ * read (each TPDO and slope SDO read has one), for 8 bytes of flash. */
 static inline bool co_incl_para_same(const co_incl_para_t *a, const co_incl_para_t *b)
 {
 #if defined(__GNUC__) && UINTPTR_MAX <= 0xFFFFFFFFu

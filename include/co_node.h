@@ -111,7 +111,7 @@ typedef struct co_node_ops {
 
 /*
  * An optional service: linked into an image only when a product's config
- * lists it (STYLE rule 11: a feature is left out by not linking it).
+ * lists it (a feature is left out by not linking its file, not by #if).
  * The core (NMT, SDO, SYNC, heartbeat, TPDO, EMCY, store) is always there.
  */
 typedef struct co_service {
@@ -418,8 +418,8 @@ bool co_node_tx_drop(co_node_t *node);
 /* Send through the port, counting frames the board could not queue; nothing
  * is sent while the controller is bus-off (counted the same way). Inline,
  * the count out of line: the call and its frame cost x86-64 more than the
- * bus-off gate added (the SDO read and the TPDO were 2 instructions over
- * their figures before it). */
+ * bus-off gate adds (inline keeps the SDO read and the TPDO within their
+ * targets). */
 static inline bool co_node_send(co_node_t *node, const co_frame_t *f)
 {
     if (node->can_state != CO_CAN_BUSOFF && co_port_can_send(node->port, f)) {

@@ -37,15 +37,14 @@ bool co_port_can_bitrate(void *port, uint16_t kbps);
  * return false on a hardware failure (nothing is retried), and for any
  * byte beyond the board's EEPROM (nothing is read or written then).
  *
- * Decision (issue 12): the port has no size query. Until then it had
- * co_port_nvm_size(), which nothing called. Its check at start would
+ * Decision: the port has no size query. A check of it at start would
  * only say earlier what the range rule above already makes loud: a board
  * whose EEPROM is too small for a node's slots fails those reads, so the
  * store reports the class as CO_STORE_HW (co_store.h), the product shows
  * its data-set error (DST 0x4001 bit 6 and EMCY 1000h; P+F and JD EMCY
  * 6300h; the GSH-A has none), the Linux program logs the set it could not
- * read, and every save is refused with 0x06060000. The check would have cost the DST X730 image
- * flash it does not have to spare.
+ * read, and every save is refused with 0x06060000. The check would cost
+ * the DST X730 image flash it does not have to spare.
  */
 /* Copy len bytes of the EEPROM from addr into buf (the caller's, len
  * bytes). False: a hardware failure or a byte beyond the EEPROM; buf's

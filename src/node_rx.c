@@ -10,7 +10,7 @@
  * compares the list after each frame batch and poll (a few dozen
  * instructions) and reprograms its filter only when it changed. Its own
  * file, so that an MCU image that does not filter (every one today) does
- * not link it (STYLE rule 11).
+ * not link it (a feature is left out by not linking its file).
  */
 #include "co_node.h"
 

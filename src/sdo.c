@@ -249,8 +249,7 @@ CO_NOINLINE void co_sdo_receive(co_node_t *node, const co_frame_t *f)
     co_sdo_proto_fn seg = co_cfg(node)->sdo_segmented;
     /* Before the switch: a case of its own for download segments cost a
      * jump table (20 bytes on the Cortex-M0), the check inside the shared
-     * segment case 32; this one costs every request 2 instructions there
-     * (tools/bench, the expedited read: 321 -> 323; x86 281 -> 284). */
+     * segment case 32; this one costs every request 2 instructions there. */
     if (seg == NULL && sdo->state == SDO_DOWNLOAD && (d[0] >> 5) == CCS_DOWNLOAD_SEGMENT) {
         short_segment(node, d); /* a transfer download_initiate() began */
         return;

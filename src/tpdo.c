@@ -221,8 +221,7 @@ static uint32_t reverse_bytes(uint32_t v)
  * bytes are gathered in one 64-bit value and stored at the end. On a
  * 32-bit core it is built as two 32-bit words: there a 64-bit shift by a
  * variable count is a library call (__ashldi3 on the Cortex-M0, 24
- * instructions a mapped object; the two words took the DST TPDO from 314
- * to 292 instructions there). A 64-bit host keeps the single shift (the
+ * instructions a mapped object). A 64-bit host keeps the single shift (the
  * words cost x86-64 16 instructions a TPDO). */
 static inline void build_mapped(co_node_t *node, unsigned n, co_frame_t *f)
 {
@@ -289,8 +288,8 @@ _Static_assert(offsetof(co_frame_t, data) % 4u == 0u, "frame data word aligned")
 
 /* The 8 data bytes from s to d, both word aligned (a frame's data, last[]).
  * On a 32-bit core two word copies: there memcpy is libc_min.c's byte
- * loop, 53 Cortex-M0 instructions a TPDO sent on SYNC (JD2 SYNC with two
- * TPDOs 925 -> 830). A 64-bit host's compiler expands the memcpy itself. */
+ * loop, 53 Cortex-M0 instructions a TPDO sent on SYNC. A 64-bit host's
+ * compiler expands the memcpy itself. */
 static inline void copy_data(uint8_t *d, const uint8_t *s)
 {
 #if defined(__GNUC__) && UINTPTR_MAX <= 0xFFFFFFFFu

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from stack_depth import depth
 
-TARGET_FLASH, TARGET_RAM = 10 * 1024, 1024  # DST X730 on the Nucleo's Cortex-M0 (issue 4)
+TARGET_FLASH, TARGET_RAM = 10 * 1024, 1024  # DST X730 on the Nucleo's Cortex-M0
 TARGET_BOARD = "nucleo-f042k6"
 # RAM of the Cortex-M0 boards: every image's RAM and worst-case stack must fit.
 BOARD_RAM = {"nucleo-f042k6": 6 * 1024,  # STM32F042K6

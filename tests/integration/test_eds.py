@@ -50,8 +50,8 @@ def test_canopen_loads_the_eds(pid, tmp_path):
 @pytest.mark.parametrize("pid", ["gsh-a", "gsh-a-redundant"])
 def test_gsh_eds_event_timer_as_the_manual_asks(pid, tmp_path):
     """GSH-A manual: "In the EDS file this default value must be set to 0,
-    otherwise errors will be generated"; the device keeps 100 ms (spec C-14;
-    read live in test_gsh.py). The EDS says why, in a comment line."""
+    otherwise errors will be generated" (section 12, the 0x1800 table); the
+    device keeps 100 ms (read live in test_gsh.py). The EDS says why, in a comment line."""
     path = eds_of(pid, tmp_path)
     od = canopen.import_od(str(path), 0x13)
     assert od[0x1800][5].default == 0

@@ -13,7 +13,7 @@ from conftest import Sensor
 NODES = 10
 TPDO_MS = 10
 HB_MS = 100
-TOLERANCE = 0.10  # every interval within +-10 % of its period (issue 13, item 5)
+TOLERANCE = 0.10  # every interval within +-10 % of its period
 SECONDS = 3.0
 
 
@@ -55,7 +55,8 @@ def raw():
 def configure_gsh(raw, tmp_path, node_id):
     """A GSH-A (autostart, type 254) stored with node-ID node_id, a 10 ms
     event timer and a 100 ms heartbeat: set up alone at its factory
-    node-ID 0x13, saved, stopped (the manual's way, R-27..R-29)."""
+    node-ID 0x13, saved, stopped (the way of the GSH-A manual's section 13,
+    example 1)."""
     d = tmp_path / f"n{node_id}"
     d.mkdir()
     s = Sensor("gsh-a", d)
