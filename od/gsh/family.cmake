@@ -1,5 +1,5 @@
 # Gefran GSH-A draw-wire + tilt sensor, single and redundant (two nodes in
-# one device) (shared/specs/gefran-gsh-a.md).
+# one device), after the Gefran "CANopen GSH-A" manual (Cod. 80782).
 co_family(gsh
   HEADER gsh.h
   INSTANCE gsh_dev_t

@@ -1,6 +1,7 @@
 /*
- * gsh.c - behaviour of the Gefran GSH-A (shared/specs/gefran-gsh-a.md;
- * R-n rules, C-n contradictions of that spec).
+ * gsh.c - behaviour of the Gefran GSH-A, after its manual ("CANopen
+ * GSH-A", Cod. 80782). Where the manual is silent or contradicts itself,
+ * the choice is written down as a decision next to the code.
  */
 #include "gsh.h"
 
@@ -23,7 +24,9 @@ uint8_t gsh_pdo_checksum(const uint8_t d[7])
 co_res_t gsh_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
     if (v >= 1u && v <= 3u) {
-        return CO_E_VAL_LOW; /* 4..65535 ms (L404); 0 = off (C-14) */
+        /* 4..65535 ms (manual, section 11). Decision: 0 = off, since the
+         * manual wants 0 in the EDS and a tool may download it. */
+        return CO_E_VAL_LOW;
     }
     return co_tpdo_write_comm(n, e, v);
 }
@@ -70,19 +73,24 @@ static void gsh_reset(co_node_t *n, co_reset_t kind)
 {
     (void)kind;
     gsh_chan_t *c = chan_of(n);
-    c->counter = 0; /* 4.6: from 0 at every boot-up */
+    /* Decision: the counter starts from 0 at every boot-up (the manual
+     * only names byte 7 "Counter"). */
+    c->counter = 0;
     c->sent_counter = 0;
     c->sent_checksum = 0;
-    co_node_set_autostart(n, c->para.autostart == 1u); /* after every boot-up (C-22) */
+    /* Decision: auto-start after every boot-up, NMT resets included: the
+     * manual ties it to the boot-up (section 1), and every reset boots up. */
+    co_node_set_autostart(n, c->para.autostart == 1u);
 }
 
 static void gsh_tpdo_fill(co_node_t *n, unsigned pdo, co_frame_t *f)
 {
     (void)pdo;
     gsh_chan_t *c = chan_of(n);
-    /* Fixed 8-byte layout (R-39): position, angle and alarm word from the
-     * mapping, then the counter and the checksum, which only the frame
-     * knows (the mapped 0x2111/0x2112 give the last frame's). */
+    /* Fixed 8-byte layout (manual, section 11 'PDO communication'):
+     * position, angle and alarm word from the mapping, then the counter
+     * and the checksum, which only the frame knows (the mapped
+     * 0x2111/0x2112 give the last frame's). */
     f->data[6] = c->counter;
     f->data[7] = gsh_pdo_checksum(f->data);
     c->sent_counter = c->counter;
@@ -90,10 +98,10 @@ static void gsh_tpdo_fill(co_node_t *n, unsigned pdo, co_frame_t *f)
     c->counter++; /* built only to be sent: type 254 is fixed */
 }
 
-/* A corrupt stored set (C-38): factory defaults, as the spec recommends.
- * The GSH-A sends no EMCY at all (R-14, C-37: no EMCY object, 0x1001 is
- * always 0) and its manual describes no LED, so the node itself reports
- * nothing; the board logs it (the Linux program does). */
+/* Decision: a corrupt stored set gives the factory defaults (the manual
+ * does not say). The GSH-A sends no EMCY at all (its manual has no EMCY
+ * object, and 0x1001 is "Always 0") and describes no LED, so the node
+ * itself reports nothing; the board logs it (the Linux program does). */
 const co_node_ops_t gsh_ops = {
     .reset = gsh_reset,
     .tpdo_fill = gsh_tpdo_fill,
@@ -109,7 +117,8 @@ void gsh_create(const product_t *p, void *mem, void *const ports[], co_node_t *n
     for (unsigned i = 0; i < nchan; i++) {
         gsh_chan_t *c = &d->ch[i];
         c->incl_para.resolution = 100; /* 0x6800: 0.1 deg */
-        /* Channel 2 counts backwards: A2 = (3600 - A1) mod 3600 (R-41). */
+        /* Channel 2 counts backwards ("backward direction", manual section
+         * 11): A2 = (3600 - A1) mod 3600. */
         c->incl_para.op[0] = (uint8_t)(i == 0u ? 0u : CO_INCL_OP_INVERT);
         co_incl_init(&c->incl, &c->incl_para, 1, 0, true);
         c->incl.circular = true;
@@ -147,7 +156,8 @@ void gsh_sample(void *mem, const int32_t values[], uint32_t faults)
     int32_t angle[2] = {values[GSH_IN_ANGLE], 0};
     for (unsigned i = 0; i < d->nchan; i++) {
         gsh_chan_t *c = &d->ch[i];
-        /* Channel 2: "backward direction" = stroke - length (C-27, assumption). */
+        /* Decision: channel 2's "backward direction" is stroke - length;
+         * the manual defines it for the angle only. */
         c->position_mm = (uint16_t)(i == 0u ? len_mm : GSH_STROKE_MM - len_mm);
         c->alarms = alarms;
         co_incl_sample(&c->incl, angle);

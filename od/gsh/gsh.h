@@ -11,7 +11,8 @@
 #include "co_node.h"
 #include "product.h"
 
-/* Alarm word (PDO bytes 5-6, little-endian; manual L323-331). */
+/* Alarm word (PDO bytes 5-6, little-endian; manual, section 9 'Error
+ * handling', the alarm table). */
 #define GSH_ALARM_UNDER_EXTENSION 0x0002u
 #define GSH_ALARM_OVER_EXTENSION 0x0004u
 #define GSH_ALARM_FIELD_HIGH 0x0010u
@@ -26,7 +27,8 @@
 #define GSH_FAULT_EXTENSION_ELEMENT 0x01u
 #define GSH_FAULT_TILT_ELEMENT 0x02u
 
-/* Assumptions the manual leaves open (spec C-27, C-28), build parameters: */
+/* Decisions where the manual is silent (it gives no stroke for channel 2's
+ * "backward direction" and no alarm thresholds), as build parameters: */
 #define GSH_STROKE_MM 8000      /* measuring range; channel 2 = stroke - channel 1 */
 #define GSH_FIELD_LOW_PCT 50    /* magnet field below this: "too low" */
 #define GSH_FIELD_HIGH_PCT 150  /* above this: "too high" */
@@ -59,9 +61,10 @@ typedef struct gsh_dev {
 
 /*
  * PDO byte 8: the checksum over bytes 1..7 (d[0..6]). The manual does not
- * give the rule; the spec's recommended H2, (sum + 254) mod 255, is the
- * simplest that reproduces both of the manual's frames. Replace this one
- * function once a real capture decides (spec section 4.5).
+ * give the rule. Decision: (sum + 254) mod 255, the simplest rule that
+ * reproduces both of the manual's example frames (section 11); the plain
+ * byte sum misses one. Replace this one function once a capture of a real
+ * unit decides (a frame whose byte sum is below 256 or above 510 does).
  */
 uint8_t gsh_pdo_checksum(const uint8_t d[7]);
 

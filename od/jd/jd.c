@@ -88,8 +88,8 @@ CO_INCL_INLINE int32_t slope(jd_dev_t *d, const co_incl_meas_t *c, unsigned axis
     uint8_t op = wide ? p->op32[axis] : p->op16[axis];
     if ((op & CO_INCL_OP_SCALING) == 0u) {
         /* co_incl_output does not read the offsets then: not loaded
-         * either (gcc loads arguments first): the JD2 SYNC of tools/bench
-         * took 843 Cortex-M0 instructions with the loads, 799 without. */
+         * either (gcc loads arguments first, a twentieth of the JD2's
+         * SYNC on the Cortex-M0). */
         return co_incl_output(m, op, 0, 0, f);
     }
     if (wide) {
@@ -104,7 +104,7 @@ co_res_t jd_read_slope(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
 {
     jd_dev_t *d = dev_of(n);
     /* The angles first, while little is live across the rare remeasure
-     * (the JD2 SYNC of tools/bench: 851 -> 843 Cortex-M0 instructions). */
+     * (a few Cortex-M0 instructions less on each JD2 SYNC). */
     const co_incl_meas_t *c = meas(d);
     unsigned axis = (e->index & 0x00F0u) == 0x0020u ? 1u : 0u;
     bool wide = (e->index & 0x0100u) != 0u;
