@@ -1,9 +1,10 @@
 /*
  * dst.c - behaviour shared by the Danfoss DST inclinometers.
  *
- * Decisions where the manual is silent or contradicts itself follow
- * ../shared/specs/danfoss-dst-x730.md section 5 (C-n below), CiA 301/410
- * otherwise.
+ * After the DST X730 and DST X710 operating guides ("the manual": the two
+ * agree where this file cites them). Where the manual is silent or
+ * contradicts itself, the choice is written down as a decision next to
+ * the code; CiA 301/410 otherwise.
  */
 #include "dst.h"
 
@@ -36,7 +37,8 @@ co_res_t dst_write_emcy_cobid(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 co_res_t dst_write_tx_type(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
     /* 1..240 every n-th SYNC, 254 event timer. 252, 253, 255 are "not
-     * implemented" per the manual; 0 and 241..251 are not listed (C-18). */
+     * implemented" per the manual (section 12, 0x1800 sub 2).
+     * Decision: 0 and 241..251, which it does not list, are refused too. */
     if (!((v >= 1u && v <= 240u) || v == 254u)) {
         return CO_E_VAL;
     }
@@ -46,7 +48,8 @@ co_res_t dst_write_tx_type(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 co_res_t dst_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
     if (v >= 1u && v <= 3u) {
-        return CO_E_VAL; /* 0 = inactive, 4..65535 ms (C-17) */
+        /* 4..65535 ms (section 12); 0 = inactive (examples 12, 13) */
+        return CO_E_VAL;
     }
     return co_tpdo_write_comm(n, e, v);
 }
@@ -103,7 +106,8 @@ co_res_t dst_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 
 co_res_t dst_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
-    /* Immediate (manual L1018): the output equals the preset from now on. */
+    /* Immediate ("immediately corrects the measured value", manual,
+     * section 15, example 7): the output equals the preset from now on. */
     if (co_od_checking(n)) {
         return CO_OK;
     }
@@ -156,7 +160,8 @@ static void dst_reset(co_node_t *n, co_reset_t kind)
 
 static void dst_stored(co_node_t *n, uint32_t sig)
 {
-    /* The filter setting takes effect on "save" (manual L488). */
+    /* The filter setting takes effect on "save" (manual, section 12,
+     * 0x2001: "only accepted after a STORE command"). */
     if (sig == CO_SIG_SAVE) {
         apply_filter(dev_of(n));
     }
@@ -192,8 +197,10 @@ static uint32_t dst_poll(co_node_t *n, uint32_t now)
     if (d->errors == d->reported) {
         return CO_NEVER;
     }
-    /* EMCY layout from the manual's table (C-6): code, 0x1001 (always 0,
-     * C-14), 0x00, 0x4001, 0, 0, 0. Error reset: all zero (B-27). */
+    /* EMCY layout from the manual's table (section 9 'Error handling'),
+     * which the text's "only the 1st byte" does not contradict: code,
+     * 0x1001 ("Always ZERO"), 0x00, 0x4001, 0, 0, 0. Error reset: all zero
+     * (CiA 301; the manual does not say). */
     uint8_t msef[5] = {0x00, d->errors, 0, 0, 0};
     uint16_t code = d->errors != 0u ? CO_EMCY_GENERIC : CO_EMCY_NO_ERROR;
     co_nmt_state_t st = co_node_nmt_state(n);
@@ -204,7 +211,9 @@ static uint32_t dst_poll(co_node_t *n, uint32_t now)
     bool new_error = d->reported == 0u && d->errors != 0u;
     d->reported = d->errors;
     if (new_error) {
-        /* 0x4000: 0 pre-operational, 2 stopped, anything else no change (C-42). */
+        /* 0x4000: 0 pre-operational, 2 stopped, anything else no change.
+         * Decision: on any error appearing, the angle limit included (the
+         * manual's "serious device failure" is not defined). */
         if (d->para.err_behaviour == 0u && st == CO_NMT_OPERATIONAL) {
             co_nmt_enter(n, CO_NMT_PREOP);
         } else if (d->para.err_behaviour == 2u) {
@@ -216,7 +225,8 @@ static uint32_t dst_poll(co_node_t *n, uint32_t now)
 
 static void dst_leds(co_node_t *n, co_led_pattern_t *g, co_led_pattern_t *r)
 {
-    /* "Limit angles reached": red and green both on (manual L539). */
+    /* "Limit Angles reached": red and green both on (manual, section 13
+     * 'Status LED'). */
     if (co_incl_beyond(&dev_of(n)->incl)) {
         *g = CO_LED_ON;
         *r = CO_LED_ON;
@@ -230,7 +240,8 @@ const co_node_ops_t dst_ops = {
     .leds = dst_leds,
 };
 
-/* Green blinks 200/200 ms; "single flash" is 500 ms on / 500 ms off (C-38). */
+/* Green blinks 200/200 ms; "single flash" is 500 ms on / 500 ms off, as
+ * the manual's legend says (section 13), not CiA 303-3's 200/1000 ms. */
 const co_led_timing_t dst_led = {.flicker_ms = 50, .blink_ms = 200, .flash_ms = 500, .pause_ms = 500};
 
 void dst_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])

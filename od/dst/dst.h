@@ -86,7 +86,8 @@ extern const product_t dst_x730_xy10, dst_x730_xy15, dst_x730_xy20, dst_x730_xy3
 extern const product_t dst_x710_xy10, dst_x710_xy15, dst_x710_xy20, dst_x710_xy30,
     dst_x710_xy45, dst_x710_xy60, dst_x710_xy90, dst_x710_z360;
 
-/* The error limit of each variant; shared by both models (X710 C-8, X730 C-8). */
+/* The error limit of each variant: 110 % of the range, +-87 deg on the
+ * +-90 variant; shared by both models (section 9 of either manual). */
 #define DST_LIMIT_XY10 11000
 #define DST_LIMIT_XY15 16500
 #define DST_LIMIT_XY20 22000

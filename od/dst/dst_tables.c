@@ -2,12 +2,11 @@
  * dst_tables.c - the dictionaries of the Danfoss DST X730 ("top level") and
  * DST X710 ("entry level") inclination sensors: one list, DST_ENTRIES, with
  * the X710's differences from the X730 marked where they are.
- * Manuals: shared/seeds/000_70e80bfa514d57c1.txt (X730),
- * shared/seeds/001_5c118913644527d4.txt (X710); specs:
- * shared/specs/danfoss-dst-x730.md and danfoss-dst-x710.md (section 2 of
- * each is its table, section 6 of the X710's its differences from the X730;
- * C-n are the contradictions and the resolution taken). Behaviour is the
- * family's (dst.c).
+ * After the DST X730 and DST X710 operating guides: the table of each
+ * (section 12 'CANopen features summary') and its communication examples
+ * (section 15 of the X730's, 14 of the X710's). Where the manual
+ * contradicts itself, the line says which reading is taken. Behaviour is
+ * the family's (dst.c).
  *
  * The table must stay sorted by (index, sub-index).
  */
@@ -29,11 +28,11 @@
 #define X730_ONLY(model, ...) DST_ONLY_X730_##model(__VA_ARGS__)
 #define X710_ONLY(model, ...) DST_ONLY_X710_##model(__VA_ARGS__)
 
-/* The X730's dictionary; with model X710 the X710's (X710 spec section 6:
- * 0x100A, 0x1800 sub 3, no 0x5001; everything else identical). */
+/* The X730's dictionary; with model X710 the X710's (its table differs in
+ * 0x100A, 0x1800 sub 3 and has no 0x5001; everything else identical). */
 #define DST_ENTRIES(model) \
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = 0x0008019Au, CO_NAME("Device type")}, \
-    /* "Always ZERO", also inside the EMCY frame (C-14). */ \
+    /* "Always ZERO", also inside the EMCY frame (sections 9 and 12). */ \
     {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, .def = 0, CO_NAME("Error register")}, \
     /* Not in the manual, which lists SYNC transmission types (0x1800 sub \
      * 2: 1..240 "after n synch objects"): CiA 301's COB-ID SYNC, so that a \
@@ -43,14 +42,15 @@
     {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = 0x80, CO_NAME("COB-ID SYNC")}, \
     {.index = 0x1008, .sub = 0, CO_TYPE_STR("GIB"), .attr = CONST, CO_NAME("Manufacturer device name")}, \
     {.index = 0x1009, .sub = 0, CO_TYPE_STR("1.00"), .attr = CONST, CO_NAME("Manufacturer hardware version")}, \
-    /* X710: "1.10" (X710 spec 6.1 #1). */ \
+    /* X710: "1.10" (its table). */ \
     {.index = 0x100A, .sub = 0, CO_TYPE_STR(X730_ONLY(model, "1.24") X710_ONLY(model, "1.10")), .attr = CONST, CO_NAME("Manufacturer software version")}, \
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Store parameters")}, \
     /* The manual's table says wo and prints no read of it: CiA 301's rw, \
      * a read answers the storage capability, 1 = saves on command. */ \
     {.index = 0x1010, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_save), CO_NAME("Save all parameters")}, \
     {.index = 0x1011, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Restore default parameters")}, \
-    /* rw, reads 1 = "restores on command" (C-5, C-36). */ \
+    /* rw, reads 1 = "restores on command": the table's rw and CiA 301's, \
+     * where example 11 says wo (and names the object 1001h). */ \
     {.index = 0x1011, .sub = 1, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_load), CO_NAME("Restore all default parameters")}, \
     {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, CO_EXT(.write = dst_write_emcy_cobid), CO_NAME("COB-ID EMCY")}, \
     /* 0 or 20..65535 ms; 1..19 "NOT ACCEPTED". */ \
@@ -64,7 +64,8 @@
     {.index = 0x1200, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 2, CO_NAME("SDO server parameter")}, \
     {.index = 0x1200, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x600, CO_NAME("COB-ID client to server")}, \
     {.index = 0x1200, .sub = 2, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x580, CO_NAME("COB-ID server to client")}, \
-    /* Highest sub-index 5; sub 4 (reserved) does not exist (C-19). */ \
+    /* Highest sub-index 5 (the table gives none); sub 4 (reserved, CiA \
+     * 301) does not exist. */ \
     {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 5, CO_NAME("TPDO1 communication parameter")}, \
     /* 0x180 + node-ID as the manual prints it, with bit 30 set: no RTR \
      * (CiA 301). The manual says nothing of remote requests, and answering \
@@ -73,23 +74,25 @@
     {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = RO | CO_A_NODEID, .def = 0x40000180u, CO_NAME("COB-ID TPDO1")}, \
     {.index = 0x1800, .sub = 2, CO_TYPE_U8, .attr = RW, PARA(tx_type), .def = 254, CO_EXT(.write = dst_write_tx_type), CO_NAME("Transmission type")}, \
     /* X730: ro, 0, as Example 3 (its only source) prints it. X710: as its \
-     * main table, rw, default 4, 4..65535, unit 1 ms (X710 C-19; its \
-     * Example 3 says ro 0 too; dst_x710_cfg's inhibit_unit_us). */ \
+     * main table, rw, default 4, 4..65535, unit 1 ms (its Example 3 says \
+     * ro 0 too; dst_x710_cfg's inhibit_unit_us). */ \
     X730_ONLY(model, {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RO, .def = 0, CO_NAME("Inhibit time")},) \
     X710_ONLY(model, {.index = 0x1800, .sub = 3, CO_TYPE_U16, .attr = RW, PARA(inhibit_ms), .def = 4, CO_EXT(.min = 4, .max = 65535, .write = co_tpdo_write_comm), CO_NAME("Inhibit time")},) \
-    /* 0 = inactive, 4..65535 ms; default 100 = 0x64 (C-16, C-17). */ \
+    /* 0 = inactive (examples 12, 13), 4..65535 ms; default 100 = 0x64 \
+     * (the table's "0x65" is a misprint: example 3 says 0x64). */ \
     {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 100, CO_EXT(.write = dst_write_event), CO_NAME("Event timer")}, \
-    /* The manual's table prints 2 entries (4 bytes) for its 8-byte frame \
-     * (C-4); 3 here: sub 3 maps the "(0x00)" the manual's TPDO tables print \
+    /* The manual's table prints 2 entries (4 bytes) for its 8-byte frame; \
+     * 3 here: sub 3 maps the "(0x00)" the manual's TPDO tables print \
      * in bytes 5-8 (0x2100 below), so that the mapping covers every byte \
      * sent and a CiA 301 consumer that checks the length against it (EMCY \
      * 8220h) sees none. The bytes on the wire are the manual's. */ \
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 3, CO_NAME("TPDO1 mapping parameter")}, \
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x60100010u, CO_NAME("1st mapped object")}, \
-    /* The manual prints 0x60200020; 0x6020 is 16 bits (C-4). */ \
+    /* The manual prints 0x60200020; 0x6020 is 16 bits (bytes 3-4). */ \
     {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x60200010u, CO_NAME("2nd mapped object")}, \
     {.index = 0x1A00, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x21000020u, CO_NAME("3rd mapped object")}, \
-    /* 0 slow, 1 medium, 2 fast; active after "save". Default 0 (C-2). */ \
+    /* 0 slow, 1 medium, 2 fast; active after "save". Default 0 as the \
+     * table says (example 10 starts from 2). */ \
     {.index = 0x2001, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(filter), .def = 0, CO_EXT(.min = 0, .max = 2), CO_NAME("Filter setting")}, \
     {.index = 0x20F0, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(id[0]), .def = 0x7F, CO_EXT(.min = 1, .max = 127, .write = dst_write_id), CO_NAME("Node-ID setting copy 1")}, \
     {.index = 0x20F1, .sub = 0, CO_TYPE_U8, .attr = RW, VOL(id[1]), .def = 0x7F, CO_EXT(.min = 1, .max = 127, .write = dst_write_id), CO_NAME("Node-ID setting copy 2")}, \
@@ -106,12 +109,13 @@
     {.index = 0x4001, .sub = 0, CO_TYPE_U8, .attr = RO, CO_EXT(.read = dst_read_errors), CO_NAME("Error code")}, \
     {.index = 0x5000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(autostart), .def = 0, CO_EXT(.min = 0, .max = 1), CO_NAME("Automatic NMT start")}, \
     /* X730 only: the X710 has no 0x5001, its PDOs are always little-endian \
-     * (X710 spec 6.1 #3; dst.c reads the entry's presence). */ \
+     * (its manual; dst.c reads the entry's presence). */ \
     X730_ONLY(model, {.index = 0x5001, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(pdo_coding), .def = 1, CO_EXT(.min = 0, .max = 1, .write = dst_write_coding), CO_NAME("PDO coding")},) \
     /* 10, 50, 100, 500, 1000 (x 0.001 deg); needs scaling on both axes. */ \
     {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(incl.resolution), .def = 50, CO_EXT(.write = dst_write_resolution), CO_NAME("Resolution")}, \
     {.index = 0x6010, .sub = 0, CO_TYPE_I16, .attr = RO | CO_A_PDO, CO_EXT(.read = dst_read_slope), CO_NAME("Slope longitudinal")}, \
-    /* bit0 invert, bit1 scaling; default 0x02 (C-3). */ \
+    /* bit0 invert, bit1 scaling; default 0x02 (example 8; example 9 \
+     * changes the resolution from the factory state, which needs bit1). */ \
     {.index = 0x6011, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(incl.op[0]), .def = 0x02, CO_EXT(.min = 0, .max = 3), CO_NAME("Slope longitudinal operating parameter")}, \
     {.index = 0x6012, .sub = 0, CO_TYPE_I16, .attr = RW, PARA(incl.preset[0]), .def = 0, CO_EXT(.write = dst_write_preset), CO_NAME("Slope longitudinal preset value")}, \
     {.index = 0x6013, .sub = 0, CO_TYPE_I16, .attr = RO, PARA(incl.offset[0]), .def = 0, CO_NAME("Slope longitudinal offset")}, \
@@ -141,17 +145,17 @@ _Static_assert(sizeof(co_lss_para_t) <= CO_STORE_MAX_DATA, "LSS set must fit one
  * images fix one of these two symbols (od/dst/family.cmake). */
 #define DST_CFG(odp, ...)                                                                    \
     {.od = (odp), .ops = &dst_ops,                                                           \
-     /* No SDO block transfer: "only expedited transfer is used" (B-33). */                  \
+     /* No SDO block transfer: the manual's SDO section (10) has only expedited transfer. */ \
      .ram_size = {0, sizeof(dst_vol_t), sizeof(dst_para_t), sizeof(co_lss_para_t)},          \
      .default_node_id = 0x7F, .default_bitrate = 3 /* 250 kbit/s */,                        \
-     .kbps = product_kbps_cia, .tpdo_dlc = 8 /* the manual's frames are always 8 bytes (C-4) */, \
+     .kbps = product_kbps_cia, .tpdo_dlc = 8 /* the manual's frames are always 8 bytes */, \
      .store_write_limit = DST_WRITE_LIMIT, __VA_ARGS__}
 const co_node_cfg_t dst_x730_cfg = DST_CFG(&x730_od, .led = &dst_led);
 /* X710: the manual describes no LED (CiA 303-3 patterns); the inhibit time
- * in "unit 1 ms" as printed (X710 C-19). */
+ * in "unit 1 ms" as its table prints it. */
 const co_node_cfg_t dst_x710_cfg = DST_CFG(&x710_od, .led = NULL, .inhibit_unit_us = 1000);
 
-/* Error limits: 110 % of the range, but +-87 deg on the +-90 variant (C-8);
+/* Error limits: 110 % of the range, but +-87 deg on the +-90 variant (section 9);
  * the same on both models. */
 #define XY(cfgp, lim) {.cfg = (cfgp), .axes = 2, .wrap = false, .limit_mdeg = (lim)}
 #define Z360(cfgp) {.cfg = (cfgp), .axes = 1, .wrap = true, .limit_mdeg = 0}

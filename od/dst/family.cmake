@@ -1,5 +1,5 @@
 # Danfoss DST X730 (filtered) and DST X710 inclinometers, CiA 410
-# (shared/specs/danfoss-dst-x730.md, danfoss-dst-x710.md).
+# (after the DST X730 and DST X710 operating guides).
 co_family(dst
   HEADER dst.h
   INSTANCE dst_dev_t
