@@ -1,5 +1,5 @@
 # ifm JD1xxx (one axis) and JD2xxx (two axes) inclinometers
-# (shared/specs/ifm-jd.md).
+# (after their operating instructions).
 co_family(jd
   HEADER jd.h
   INSTANCE jd_dev_t

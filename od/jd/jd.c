@@ -1,11 +1,13 @@
 /*
- * jd.c - behaviour of the ifm JD1xxx / JD2xxx (shared/specs/ifm-jd.md).
+ * jd.c - behaviour of the ifm JD1xxx / JD2xxx, after their operating
+ * instructions ("the manual", cited by section). Where the manual is
+ * silent, the choice is written down as a decision next to the code.
  * Integer arithmetic only (the target MCUs have no FPU).
  * The CiA 410 arithmetic (slopes, presets, wrap, measured angles) is the
  * shared module's (co_incl.h); here is what the JD's objects and manual
- * add: a 16- and a 32-bit slope object per axis with one preset (R56),
- * the JD1's unsigned 16-bit preset, the ranges, the rescale of 0x6000
- * (R55), the moving average (R59), the fold at +-90 deg (R49).
+ * add: a 16- and a 32-bit slope object per axis with one preset, the
+ * JD1's unsigned 16-bit preset, the ranges, the rescale of 0x6000, the
+ * moving average (3100h), the fold at +-90 deg.
  */
 #include "jd.h"
 
@@ -46,15 +48,16 @@ static int32_t isin(int32_t mdeg)
 /* The angles in resolution units and one turn in them at the present
  * 0x6000 (co_incl_meas_t: divided once per sample and once per change of
  * 0x6000, never per read; with a division per read a SYNC with both JD2
- * TPDOs spent half its time in the division helper, issue 11). */
+ * TPDOs spends half its time in the division helper). */
 CO_INCL_INLINE const co_incl_meas_t *meas(jd_dev_t *d)
 {
     return co_incl_meas_at(&d->meas, d->raw, d->para.resolution);
 }
 
 /* How the slope objects hold their values (co_incl_fit_t): JD1 modulo a
- * turn, 0..N-1, its offsets in (-N/2, N/2] (R54, R56); JD2 saturated to
- * the object's type, never wrapped (R53). */
+ * turn, 0..N-1, its offsets in (-N/2, N/2] (decision: the manual does not
+ * say how the JD1 wraps); JD2 saturated to the object's type, never
+ * wrapped (an offset shifts the output window: manual, section 13.2). */
 CO_INCL_INLINE co_incl_fit_t fit(jd_dev_t *d, const co_incl_meas_t *c, bool wide)
 {
     co_incl_fit_t f = {.turn = d->axes == 1u ? c->turn : 0, .wide = wide, .centred = true};
@@ -62,8 +65,8 @@ CO_INCL_INLINE co_incl_fit_t fit(jd_dev_t *d, const co_incl_meas_t *c, bool wide
 }
 
 /* The largest differential offset, in resolution units: JD1 (-N/2, N/2]
- * (6114h: -17999..18000 at 0.01 deg, L1783-1791), JD2 +-90 deg (the
- * spec's recommendation; the manual gives none). Beyond: 0x06090030. */
+ * (6114h: -17999..18000 at 0.01 deg, manual section 9.46), JD2 +-90 deg
+ * (decision: the manual gives none). Beyond: 0x06090030. */
 static bool diff_ok(jd_dev_t *d, int32_t v)
 {
     if (d->axes == 1u) {
@@ -74,13 +77,14 @@ static bool diff_ok(jd_dev_t *d, int32_t v)
     return v >= -lim && v <= lim;
 }
 
-/* The slope of one axis, 16- or 32-bit object (R51, R53, R54, R56): each
+/* The slope of one axis, 16- or 32-bit object (the manual's position
+ * formula, sections 9.37 and 9.42; 6110h/6120h as 6010h/6020h): each
  * has its own operating parameter, offset and differential offset; c is
  * meas(d). */
 CO_INCL_INLINE int32_t slope(jd_dev_t *d, const co_incl_meas_t *c, unsigned axis, bool wide)
 {
     if (axis >= d->axes) {
-        return 0; /* JD1: 6020h / 6120h read 0 (L1671) */
+        return 0; /* JD1: 6020h / 6120h read 0 (manual, section 9.41) */
     }
     int32_t m = c->m[axis];
     co_incl_fit_t f = fit(d, c, wide);
@@ -114,7 +118,8 @@ co_res_t jd_read_slope(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
 
 co_res_t jd_read_preset(co_node_t *n, const co_od_entry_t *e, uint32_t *v)
 {
-    /* 0x2600/0x2601 and 0x6012/0x6022 show the one preset (L1121, L1141). */
+    /* 0x2600/0x2601 and 0x6012/0x6022 show the one preset (manual,
+     * sections 9.18 and 9.19). */
     unsigned axis = (e->index == 0x2601u || e->index == 0x6022u) ? 1u : 0u;
     *v = (uint32_t)dev_of(n)->para.preset[axis];
     return CO_OK;
@@ -134,13 +139,16 @@ co_res_t jd_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
             return CO_E_VAL;
         }
     } else if (p < -lim || p > lim) {
-        return CO_E_VAL; /* +-90 deg (C7, C8) */
+        /* +-90 deg: the JD2's range (the 6022h table's +-80 is taken for a
+         * misprint, and 6012h's lacks the 0.01 deg row) */
+        return CO_E_VAL;
     }
     if (co_od_checking(n)) {
         return CO_OK;
     }
     /* One preset, an offset per object: P - s*m with the object's own
-     * sign (R52, R56); the differential offset stays out of it. */
+     * sign (manual, sections 9.38 and 9.39.1); the differential offset
+     * stays out of it. */
     const co_incl_meas_t *c = meas(d);
     d->para.preset[axis] = p;
     d->para.off16[axis] =
@@ -183,7 +191,8 @@ co_res_t jd_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     jd_para_t *p = &dev_of(n)->para;
     int32_t old = (int32_t)p->resolution;
     int32_t now = (int32_t)v;
-    /* Every preset and offset follows into the new unit (R55). */
+    /* Every preset and offset follows into the new unit (the manual's
+     * "side effects" of a resolution change, section 9.37). */
     for (unsigned a = 0; a < 2u; a++) {
         p->preset[a] = rescale(p->preset[a], old, now);
         p->off16[a] = (int16_t)co_incl_saturate(rescale(p->off16[a], old, now), false);
@@ -197,7 +206,8 @@ co_res_t jd_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 
 co_res_t jd_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
-    /* 0x1800:05, 0x1801:05 and 0x2200 are one value (R20). */
+    /* 0x1800:05, 0x1801:05 and 0x2200 are one value (manual, sections
+     * 8.9.5, 8.9.6 and 9.16). */
     co_res_t r = co_od_store(n, e, v);
     co_tpdo_reconfig(n, 0);
     co_tpdo_reconfig(n, 1);
@@ -213,7 +223,7 @@ co_res_t jd_write_inhibit(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     uint32_t c = 0;
     (void)co_od_get(n, cob, &c);
     if ((c & 0x80000000u) == 0u) {
-        return CO_E_VAL; /* only while the PDO is invalid (R21) */
+        return CO_E_VAL; /* only while the PDO is invalid (manual, section 8.9.4) */
     }
     return co_tpdo_write_comm(n, e, v);
 }
@@ -226,7 +236,8 @@ co_res_t jd_write_save_reset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
     }
     co_res_t r = co_store_save(n, CO_CLS_PARA);
     if (r == CO_OK) {
-        co_node_request_reset(n, CO_RESET_NODE); /* after the confirmation (R38) */
+        /* after the confirmation (manual, section 9.17) */
+        co_node_request_reset(n, CO_RESET_NODE);
     }
     return r;
 }
@@ -250,15 +261,18 @@ static void jd_reset(co_node_t *n, co_reset_t kind)
 {
     jd_dev_t *d = dev_of(n);
     if (kind == CO_RESET_NODE && d->para.node_number <= 126u) {
-        co_node_set_id(n, (uint8_t)(d->para.node_number + 1u)); /* 3000h + 1 (R41) */
+        /* 3000h + 1 (manual, section 9.21) */
+        co_node_set_id(n, (uint8_t)(d->para.node_number + 1u));
     }
     if (kind == CO_RESET_NODE) {
         co_node_set_bitrate(n, d->para.bitrate); /* 3001h, read at power-on and reset node */
     }
-    co_node_set_autostart(n, d->para.autostart == 1u); /* 3005h, after every boot-up (C33) */
+    /* 3005h. Decision: after every boot-up, NMT resets included (the
+     * manual says "after power up"; every reset boots the same way). */
+    co_node_set_autostart(n, d->para.autostart == 1u);
 }
 
-/* CiA 305 bit-timing index to 0x3001 code (R46): 20k..1M are codes 0..7. */
+/* CiA 305 bit-timing index to 0x3001 code: 20k..1M are codes 0..7. */
 static const uint8_t lss_to_code[8] = {7, 6, 5, 4, 3, 0xFF, 1, 0};
 
 static uint8_t jd_lss_store(co_node_t *n, uint8_t id, uint8_t br)
@@ -270,13 +284,15 @@ static uint8_t jd_lss_store(co_node_t *n, uint8_t id, uint8_t br)
     if (br < 8u && lss_to_code[br] != 0xFFu) {
         d->para.bitrate = lss_to_code[br];
     }
-    /* 3000h/3001h are manufacturer parameters (R47). */
+    /* Decision: LSS "store" saves 3000h/3001h, the manufacturer
+     * parameters that hold the node-ID and bit rate. */
     return co_store_save_group(n, CO_CLS_PARA, 0x2000, 0x5FFF, false) == CO_OK ? 0u : 2u;
 }
 
 static void jd_leds(co_node_t *n, co_led_pattern_t *g, co_led_pattern_t *r)
 {
-    /* Green: on in pre-operational, flashing in operational (C20). */
+    /* Green: on in pre-operational, flashing in operational, as the
+     * manual's LED table says (section 7; CiA 303-3 has it the other way). */
     if (co_node_nmt_state(n) == CO_NMT_PREOP) {
         *g = CO_LED_ON;
     } else if (co_node_nmt_state(n) == CO_NMT_OPERATIONAL) {
@@ -287,17 +303,18 @@ static void jd_leds(co_node_t *n, co_led_pattern_t *g, co_led_pattern_t *r)
     } else if (co_emcy_active(n, CO_EMCY_LIFE_GUARD)) {
         *r = CO_LED_FLASH2; /* guard or heartbeat event */
     } else if (co_node_store_status(n, CO_CLS_PARA) == CO_STORE_CORRUPT) {
-        *r = CO_LED_BLINK; /* general configuration error (R11) */
+        *r = CO_LED_BLINK; /* "general configuration error" (manual, section 7) */
     }
     if (*r != CO_LED_OFF) {
-        *g = CO_LED_OFF; /* "only red is shown" (L376-378) */
+        *g = CO_LED_OFF; /* "only red is shown" (manual, section 7) */
     }
 }
 
 static uint32_t jd_poll(co_node_t *n, uint32_t now)
 {
     (void)now;
-    /* A broken stored set: defaults and the red LED blinking (R11), and
+    /* Decision: a broken stored set gives the defaults and the red LED
+     * blinking ("general configuration error", manual section 7), and
      * CiA 301's EMCY 6300h, so that a master learns it too. */
     co_store_report_emcy(n);
     return CO_NEVER;
@@ -306,7 +323,7 @@ static uint32_t jd_poll(co_node_t *n, uint32_t now)
 const co_node_ops_t jd_ops = {
     .reset = jd_reset,
     .poll = jd_poll,
-    .can_state = co_emcy_can_state, /* 8120h, 8140h (R34) */
+    .can_state = co_emcy_can_state, /* 8120h, 8140h (CiA 301; the manual lists no codes) */
     .lss_store = jd_lss_store,
     .leds = jd_leds,
 };
@@ -321,7 +338,8 @@ void jd_create(const product_t *p, void *mem, void *const ports[], co_node_t *no
     nodes[0] = &d->node;
 }
 
-/* Moving average over the last para.maf samples (R59), on continuous angles. */
+/* Moving average over the last para.maf samples (manual, section 9.25),
+ * on continuous angles. */
 static void maf(jd_dev_t *d, const int32_t in[2])
 {
     uint16_t len = d->para.maf <= JD_MAF_MAX ? d->para.maf : (uint16_t)JD_MAF_MAX;
@@ -360,7 +378,8 @@ void jd_sample(void *mem, const int32_t values[], uint32_t faults)
     for (unsigned a = 0; a < d->axes; a++) {
         int32_t t = co_incl_wrap180(values[a]);
         if (d->axes == 2u) {
-            /* +-90 deg, folded back beyond: the output of a gravity sensor (R49). */
+            /* +-90 deg, folded back beyond: the output of a gravity sensor
+             * (manual, section 13.2). */
             if (t > 90000) {
                 t = 180000 - t;
             } else if (t < -90000) {
@@ -421,7 +440,8 @@ void jd_sample(void *mem, const int32_t values[], uint32_t faults)
     }
     int32_t temp = values[d->axes]; /* the input after the angles: degC x 1000 */
     d->temp = (uint16_t)(int16_t)co_div_round(temp, 100);
-    /* Types 254/255: a PDO whenever its data changed (R18), within the inhibit time. */
+    /* Types 254/255: "Send PDO on event" (manual, section 8.9.3); the
+     * event is a change of its data (decision), within the inhibit time. */
     for (unsigned n = 0; n < 2u; n++) {
         if (co_tpdo_changed(&d->node, n)) {
             co_tpdo_event(&d->node, n); /* wakes the node */

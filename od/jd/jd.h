@@ -1,7 +1,7 @@
 /*
  * jd.h - ifm electronic JD1xxx (single axis, 0..360 deg) and JD2xxx (dual
  * axis, +-90 deg) dynamic inclination sensors. Behaviour in jd.c, the
- * dictionaries in jd_tables.c; shared/specs/ifm-jd.md (R-n, C-n).
+ * dictionaries in jd_tables.c.
  */
 #ifndef JD_H
 #define JD_H
@@ -26,7 +26,7 @@ typedef struct jd_para {
     uint32_t cob[2];          /* 0x1800/0x1801 sub 1 */
     uint8_t type[2];          /* sub 2 */
     uint16_t inhibit[2];      /* sub 3, 100 us */
-    uint16_t event_ms;        /* sub 5 of both, and 0x2200: one value (R20) */
+    uint16_t event_ms;        /* sub 5 of both, and 0x2200: one value (manual, 8.9.6) */
     uint8_t map_count[2];     /* 0x1A00/0x1A01 sub 0 */
     uint32_t map[2][2];       /* sub 1, 2 */
     /* manufacturer */
@@ -41,7 +41,7 @@ typedef struct jd_para {
     uint16_t resolution;      /* 0x6000 */
     uint8_t op16[2];          /* 0x6011 / 0x6021 */
     uint8_t op32[2];          /* 0x6111 / 0x6121 */
-    int32_t preset[2];        /* 0x6012 = 0x2600 = 0x6112 (hard-wired, L1121) */
+    int32_t preset[2];        /* 0x6012 = 0x2600 = 0x6112 (hard-wired, manual 9.18) */
     int16_t off16[2];         /* 0x6013 */
     int32_t off32[2];         /* 0x6113 */
     int16_t diff16[2];        /* 0x6014 */

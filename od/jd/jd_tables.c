@@ -1,7 +1,8 @@
 /*
  * jd_tables.c - the ifm JD2xxx (dual axis) and JD1xxx (single axis)
- * dictionaries (shared/specs/ifm-jd.md section 2). Values the manual does
- * not give are marked "(?)" as in the spec; sorted by (index, sub-index).
+ * dictionaries, after the object chapters of their operating instructions
+ * (sections 8.9 and 9, the overview of section 10). Values the manual does
+ * not give are marked "(?)"; sorted by (index, sub-index).
  */
 #include "jd.h"
 
@@ -30,7 +31,7 @@
 #define JD_COMM(devtype, devname)                                                                            \
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CONST, .def = (devtype), CO_NAME("Device type")},       \
     {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = RO, CO_EXT(.read = co_emcy_read_register), CO_NAME("Error register")}, \
-    /* Depth 1: only sub 1 is documented (C41). */ \
+    /* Depth 1: only sub 1 is documented (manual, section 9.3). */ \
     {.index = 0x1003, .sub = 0, CO_TYPE_U8, .attr = RW, CO_EXT(.write = co_emcy_write_hist, .read = co_emcy_read_hist), CO_NAME("Pre-defined error field")}, \
     {.index = 0x1003, .sub = 1, CO_TYPE_U32, .attr = RO, CO_EXT(.read = co_emcy_read_hist), CO_NAME("Most recent error")}, \
     {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = RW, PARA(sync_cobid), .def = 0x80, CO_EXT(.write = co_sync_write_cobid), CO_NAME("COB-ID SYNC")}, \
@@ -49,7 +50,8 @@
     {.index = 0x1011, .sub = 2, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_load), CO_NAME("Restore communication parameters")}, \
     {.index = 0x1011, .sub = 3, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_load), CO_NAME("Restore application parameters")}, \
     {.index = 0x1011, .sub = 4, CO_TYPE_U32, .attr = RW, .def = 1, CO_EXT(.write = co_store_write_group_load), CO_NAME("Restore manufacturer parameters")}, \
-    /* UNSIGNED32, rw, 0x80 + node-ID (C2). */ \
+    /* UNSIGNED32, rw, 0x80 + node-ID (CiA 301; the manual's overview says \
+     * read-only and its section prints the node-1 value 0x81). */ \
     {.index = 0x1014, .sub = 0, CO_TYPE_U32, .attr = RW | CO_A_NODEID, PARA(emcy_cobid), .def = 0x80, CO_EXT(.write = co_emcy_write_cobid), CO_NAME("COB-ID EMCY")}, \
     {.index = 0x1016, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("Consumer heartbeat time")}, \
     {.index = 0x1016, .sub = 1, CO_TYPE_U32, .attr = RW, PARA(hb_consumer), .def = 0, CO_EXT(.write = co_hbc_write_time), CO_NAME("Consumer heartbeat time 1")}, \
@@ -62,14 +64,16 @@
 
 /* 0x2200 .. 0x3411 (2601h on JD2 only). */
 #define JD_MFR_HEAD \
-    /* The cyclic timer is the event timer (R20). */ \
+    /* The cyclic timer is the event timer (manual, sections 8.9.6, 9.16). */ \
     {.index = 0x2200, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 10, CO_EXT(.write = jd_write_event), CO_NAME("Cyclic time")}, \
     {.index = 0x2300, .sub = 0, CO_TYPE_U32, .attr = WO, CO_EXT(.write = jd_write_save_reset), CO_NAME("Save parameters with reset")}, \
     {.index = 0x2600, .sub = 0, CO_TYPE_I16, .attr = RW, CO_EXT(.write = jd_write_preset, .read = jd_read_preset), CO_NAME("Preset X-axis")}
 #define JD_MFR_TAIL \
     /* Fast boot-up: stored; the simulated boot is immediate either way. */ \
     {.index = 0x2700, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(fast_boot), .def = 0, CO_EXT(.min = 0, .max = 1), CO_NAME("Fast boot-up")}, \
-    /* Node-ID - 1 (C1, R41); active after save and reset. */ \
+    /* Node-ID - 1 (manual, section 9.21); default 0x09: "ifm standard \
+     * node number is 10" (the table's 0 would be node 1); active after \
+     * save and reset. */ \
     {.index = 0x3000, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(node_number), .def = 0x09, CO_EXT(.min = 0, .max = 0x7E), CO_NAME("Node number")}, \
     /* 0..7 = 20, 50, 100, 125, 250, 500, 800, 1000 kbit/s. */ \
     {.index = 0x3001, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(bitrate), .def = 0x03, CO_EXT(.min = 0, .max = 7), CO_NAME("Baud rate")}, \
@@ -84,7 +88,8 @@
     {.index = 0x3404, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, CO_EXT(.read = jd_read_sensor), CO_NAME("Acceleration Y axis 16")}, \
     {.index = 0x3405, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, CO_EXT(.read = jd_read_sensor), CO_NAME("Acceleration Z axis 16")}, \
     {.index = 0x3411, .sub = 0, CO_TYPE_U16, .attr = RO | PDO, CO_EXT(.read = jd_read_sensor), CO_NAME("Temperature gyro")}, \
-    /* 10, 100, 1000 (x 0.001 deg); a change rescales presets and offsets (R55). */ \
+    /* 10, 100, 1000 (x 0.001 deg); a change rescales presets and offsets \
+     * (manual, section 9.37). */ \
     {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(resolution), .def = 10, CO_EXT(.write = jd_write_resolution), CO_NAME("Resolution")}
 
 /* One axis of 16-bit slope objects at base (0x6010 / 0x6020). */
@@ -104,7 +109,7 @@
 static const co_od_entry_t jd2_entries[] = {
     JD_COMM(0x0002019Au, "JD2xxx"),
     JD_TPDO(0, 0x180, 0),
-    JD_TPDO(1, 0x280, 1), /* TPDO2 inhibit default 1, as printed (C10) */
+    JD_TPDO(1, 0x280, 1), /* TPDO2 inhibit default 1, as printed (manual, 8.9.2) */
     JD_MAP(0, 2, 0x60200010u),
     JD_MAP(1, 2, 0x60200010u),
     JD_MFR_HEAD,
@@ -124,9 +129,10 @@ static const co_od_entry_t jd1_entries[] = {
     JD_MAP(1, 1, 0x60200010u),
     JD_MFR_HEAD,
     JD_MFR_TAIL,
-    /* Z, 0..N-1 as UNSIGNED16 (R50, R54). */
+    /* Z, 0..N-1 as UNSIGNED16 (0..360 deg clockwise, manual section 8.2). */
     JD_AXIS16(0x6010, 0, CO_TYPE_U16, "long"),
-    /* "6020h always returns 0" (L1671); 6021h-6024h absent (?). */
+    /* 6020h "will output 0 for a sensor with one axis" (manual, section
+     * 9.41); 6021h-6024h absent (?). */
     {.index = 0x6020, .sub = 0, CO_TYPE_I16, .attr = RO | PDO, CO_EXT(.read = jd_read_slope), CO_NAME("Slope lateral16")},
     JD_AXIS32(0x6110, 0, "long"),
     {.index = 0x6120, .sub = 0, CO_TYPE_I32, .attr = RO | PDO, CO_EXT(.read = jd_read_slope), CO_NAME("Slope lateral32")},
@@ -137,17 +143,18 @@ static const co_od_t jd1_od = {.entries = jd1_entries, .count = sizeof(jd1_entri
 
 _Static_assert(sizeof(jd_para_t) <= CO_STORE_MAX_DATA, "PARA set must fit one store slot");
 
-/* CiA 305 bit-timing indices 0-4, 6, 7 (not 5 = reserved, not 8 = 10k) (R46). */
+/* CiA 305 bit-timing indices 0-4, 6, 7 (not 5 = reserved, not 8 = 10k):
+ * the rates 3001h has. */
 #define JD_LSS_BITRATES 0x00DFu
 static const co_service_t *const jd_services[] = {&co_lss_service, &co_guard_service,
                                                   &co_hbc_service, &co_rtr_service, NULL};
 
 #define JD_CFG(odp)                                                                   \
-    {.od = (odp), .ops = &jd_ops, .led = NULL /* CiA 303-3 timing (R65) */,            \
+    {.od = (odp), .ops = &jd_ops, .led = NULL /* CiA 303-3 timing: the manual has none */, \
      .services = jd_services,                                                           \
      .sdo_segmented = co_sdo_segmented, .sdo_block = co_sdo_block,                      \
      .ram_size = {0, 0, sizeof(jd_para_t), 0}, .default_node_id = 10,                   \
-     .id_index = 0x3000, .id_offset = 1 /* 3000h = node-ID - 1 (R41) */,                \
+     .id_index = 0x3000, .id_offset = 1 /* 3000h = node-ID - 1 (manual, 9.21) */,       \
      .default_bitrate = 3, .tpdo_dlc = 0, .lss = true, .lss_bitrates = JD_LSS_BITRATES,     \
      .kbps = product_kbps_ifm}
 const co_node_cfg_t jd2_cfg = JD_CFG(&jd2_od);
