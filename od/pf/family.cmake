@@ -1,5 +1,5 @@
 # Pepperl+Fuchs INX360D (one axis) and INY360D (two axes) inclinometers
-# (shared/specs/pf-inx-iny.md).
+# (after the INX360D/INY360D-F99-B16-V15 manual).
 co_family(pf
   HEADER pf.h
   INSTANCE pf_dev_t

@@ -1,9 +1,10 @@
 /*
  * pf.c - behaviour of the Pepperl+Fuchs INX360D / INY360D.
  *
- * The manual (shared/seeds/004_ce24af47702850aa.txt) lacks its object
- * chapter; shared/specs/pf-inx-iny.md reconstructs it. R-n, C-n and G-n
- * below are that spec's rules, contradictions and gaps.
+ * After the INX360D/INY360D-F99-B16-V15 manual ("the manual", cited by
+ * section). Its object chapter (section 8) is missing from the edition at
+ * hand, so the dictionary is inferred from the other chapters; where the
+ * manual is silent the choice is written down as a decision.
  */
 #include "pf.h"
 
@@ -16,7 +17,8 @@ static pf_dev_t *dev_of(co_node_t *n)
 
 co_res_t pf_write_bitrate(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
-    /* 01h 125k, 02h 250k, 04h 500k, 08h 1M; others "not adopted" (R47). */
+    /* 01h 125k, 02h 250k, 04h 500k, 08h 1M; others "not adopted" (manual,
+     * section 6.3). */
     if (v != PF_BR_125K && v != PF_BR_250K && v != PF_BR_500K && v != PF_BR_1M) {
         return CO_E_VAL;
     }
@@ -27,12 +29,13 @@ co_res_t pf_write_resolution(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
     (void)n;
     (void)e;
-    return v == 100u ? CO_OK : CO_E_VAL; /* fixed 0.1 deg (L760) */
+    return v == 100u ? CO_OK : CO_E_VAL; /* fixed 0.1 deg (manual, section 7.3) */
 }
 
 co_res_t pf_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 {
-    /* Zero point: the output equals the preset at once when scaling is on (R56). */
+    /* Zero point: the output equals the preset at once when scaling is on
+     * (manual, section 7.3.2). */
     if (co_od_checking(n)) {
         return CO_OK;
     }
@@ -52,7 +55,8 @@ static uint32_t pf_poll(co_node_t *n, uint32_t now)
     if (co_node_nmt_state(n) == CO_NMT_INIT || co_node_nmt_state(n) == CO_NMT_STOPPED) {
         return CO_NEVER; /* no EMCY in stopped: errors are raised when allowed */
     }
-    /* Error register bits as the manual's example (C12) and R35. */
+    /* Error register bits as the manual's only EMCY example (section
+     * 7.2.1: 11h for 5010h); CiA 301's for the others. */
     (void)co_emcy_error(n, PF_EMCY_RANGE_X, CO_ER_COMM, (d->faults & PF_FAULT_RANGE_X) != 0u, NULL);
     if (d->incl.axes > 1u) {
         (void)co_emcy_error(n, PF_EMCY_RANGE_Y, CO_ER_COMM,
@@ -60,13 +64,13 @@ static uint32_t pf_poll(co_node_t *n, uint32_t now)
     }
     (void)co_emcy_error(n, CO_EMCY_VOLTAGE_LOW, CO_ER_VOLTAGE,
                         (d->faults & PF_FAULT_UNDERVOLTAGE) != 0u, NULL);
-    co_store_report_emcy(n); /* 6300h: a corrupt stored set (R52) */
+    co_store_report_emcy(n); /* 6300h: a corrupt stored set (decision, CiA 301) */
     return CO_NEVER;
 }
 
 static void pf_leds(co_node_t *n, co_led_pattern_t *run, co_led_pattern_t *err)
 {
-    /* run (yellow) follows the NMT state; err per the manual's table (L212-227):
+    /* run (yellow) follows the NMT state; err per the manual's table (section 5.3):
      * bus-off / undervoltage on, EEPROM error 2x flash, warning 1x flash. */
     pf_dev_t *d = dev_of(n);
     bool undervoltage = (d->faults & PF_FAULT_UNDERVOLTAGE) != 0u;
@@ -81,7 +85,8 @@ static void pf_leds(co_node_t *n, co_led_pattern_t *run, co_led_pattern_t *err)
 }
 
 /* A stored set that failed its checksum stays reported (6300h) until a
- * good store (R52): the poll re-evaluates the error table every time. */
+ * good store (decision; the manual gives no reaction to it): the poll
+ * re-evaluates the error table every time. */
 const co_node_ops_t pf_ops = {
     .poll = pf_poll,
     .leds = pf_leds,
@@ -94,7 +99,7 @@ void pf_create(const product_t *p, void *mem, void *const ports[], co_node_t *no
     memset(d, 0, sizeof(*d));
     co_incl_init(&d->incl, &d->para.incl, v->axes, 0, true);
     d->incl.circular = true;
-    d->incl.shift = 0; /* no filter (R61): one sample, one calculation */
+    d->incl.shift = 0; /* no filter (the manual has none): one sample, one calculation */
     void *const ram[CO_CLS_COUNT] = {NULL, NULL, &d->para, &d->lss};
     co_node_init(&d->node, v->cfg, ports[0], d, ram, 0);
     nodes[0] = &d->node;
@@ -106,6 +111,7 @@ void pf_sample(void *mem, const int32_t values[], uint32_t faults)
     d->faults = faults;
     co_incl_sample(&d->incl, values);
     co_node_wake(&d->node); /* faults may have changed: pf_poll looks */
-    /* Type 254/255: a PDO "after each calculation" (R26), within the inhibit time. */
+    /* Type 254/255: a PDO "after each calculation" (manual, section
+     * 7.1.1), within the inhibit time. */
     co_tpdo_event(&d->node, 0);
 }

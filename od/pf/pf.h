@@ -15,17 +15,19 @@
 #define PF_FAULT_RANGE_Y 0x02u
 #define PF_FAULT_UNDERVOLTAGE 0x04u
 
-/* EMCY codes of the manual's table (L662-668). */
+/* EMCY codes of the manual's table (section 7.2.1 'Error messages'). */
 #define PF_EMCY_RANGE_X 0x5010u
 #define PF_EMCY_RANGE_Y 0x5020u
 
-/* P+F bit-rate codes of 0x2001 (not CiA 305's, C7). */
+/* P+F bit-rate codes of 0x2001 (manual, section 6.3; not CiA 305's). */
 #define PF_BR_125K 0x01u
 #define PF_BR_250K 0x02u
 #define PF_BR_500K 0x04u
 #define PF_BR_1M 0x08u
 
-/* Stored (class PARA): every SDO write is stored at once (G2). */
+/* Stored (class PARA). Decision: every SDO write is stored at once, since
+ * the manual's node-ID and bit-rate changes survive a power cycle with no
+ * save command (section 6.2). */
 typedef struct pf_para {
     uint32_t sync_cobid;   /* 0x1005 */
     uint32_t emcy_cobid;   /* 0x1014 */
