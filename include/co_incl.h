@@ -106,10 +106,10 @@ static inline int32_t co_incl_saturate(int64_t v, bool wide)
  *   turn > 0: circular, modulo one turn (turn = 360 deg in resolution
  *             units): outputs 0..turn-1, whatever the offsets hold;
  *             centred: offsets made by a preset lie in (-turn/2, turn/2]
- *             (a signed object, ifm JD1 R54), else in [0, turn) (P+F,
+ *             (a signed object, ifm JD1), else in [0, turn) (P+F,
  *             Gefran);
  *   turn = 0: linear, the exact sum saturated to INTEGER32 (wide) or
- *             INTEGER16, never wrapped (CiA 410, ifm R53).
+ *             INTEGER16, never wrapped (CiA 410, ifm JD2).
  */
 typedef struct co_incl_fit {
     int32_t turn;

@@ -8,7 +8,7 @@
  * Declared next to the product's dictionary:
  *
  *     static const product_eds_override_t x_eds[] = {
- *         {.index = 0x1800, .sub = 5, .value = 0, .reason = "manual L529: ..."},
+ *         {.index = 0x1800, .sub = 5, .value = 0, .reason = "manual, section 12: ..."},
  *         {.index = 0}, // ends the list
  *     };
  *     const product_t x = {..., PRODUCT_EDS_OVERRIDES(x_eds)};

@@ -237,7 +237,7 @@ void co_incl_set_preset(co_incl_t *incl, unsigned axis, int16_t preset)
     co_incl_fit_t fit = fit_of(incl);
     int32_t sm = signed_measure(incl, axis);
     co_incl_para_t *p = incl->p;
-    /* Circular (P+F R56, Gefran): the output reads the preset, the
+    /* Circular (P+F, Gefran): the output reads the preset, the
      * differential offset taken in; linear (DST, CiA 410): preset - s*m,
      * the output reads preset + differential offset. */
     int32_t diff = fit.turn > 0 ? p->diff[axis] : 0;

@@ -19,7 +19,7 @@ void co_sync_reconfig(co_node_t *node)
 co_res_t co_sync_write_cobid(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
     /* 11-bit IDs only; bit 30 (this node generates SYNC) refused: no
-     * product produces SYNC (the specs: 0x06090030); bit 31 means nothing
+     * product produces SYNC (0x06090030, value out of range); bit 31 means nothing
      * to a consumer; never a restricted CAN-ID (co_node_receive relies on
      * it for SDO frames). */
     co_res_t c = co_cobid_check(value, false, false);

@@ -1,8 +1,9 @@
 /*
  * skeleton.c - the template family's behaviour and dictionary (skeleton.h).
  *
- * A real family cites its manual and spec on every line that follows one
- * (R-n: the spec's rules; [301]: a CiA default the manual does not give).
+ * A real family cites its manual (title and section or table) on every
+ * line that follows it, marks a CiA default the manual does not give
+ * ([301]) and writes "Decision: ... because ..." where the manual is silent.
  * Here the choices are CiA 301 / CiA 410 defaults throughout.
  */
 #include "skeleton.h"
