@@ -291,11 +291,12 @@ static bool cmd_can(serial_link_t *s, tokens_t *t, serial_put_fn put)
         }
     }
     int32_t hold_ms = 0;
-    bool ok = k >= 0 && next_token(t) == NULL &&
-              (arg == NULL || (states[k].state == CO_CAN_BUSOFF &&
-                               parse_milli(arg, (int32_t)HOLD_MAX_S, &hold_ms) && hold_ms >= 0));
-    if (!ok) {
-        return fail(put, "usage: can bus-off [SECONDS, 0..60] | can passive|warning|active", "", "");
+    bool hold = k >= 0 && states[k].state == CO_CAN_BUSOFF && arg != NULL;
+    if (hold && (!parse_milli(arg, (int32_t)HOLD_MAX_S, &hold_ms) || hold_ms < 0)) {
+        return fail(put, "'", arg, "': not a number of seconds within 0..60");
+    }
+    if (k < 0 || next_token(t) != NULL || (arg != NULL && !hold)) {
+        return fail(put, "usage: can bus-off [SECONDS] | can passive | can warning | can active", "", "");
     }
     s->can_state = states[k].state;
     s->busoff_pending = states[k].state == CO_CAN_BUSOFF;
@@ -307,11 +308,10 @@ static bool cmd_can(serial_link_t *s, tokens_t *t, serial_put_fn put)
  * as the Linux program answers it but without its "nmt=" word: the line
  * sees the inputs, not the node (its NMT state is on the bus, in the
  * heartbeat). Words after it: answered "error" instead. */
-static void cmd_get(const serial_link_t *s, tokens_t *t, serial_put_fn put)
+static bool cmd_get(serial_link_t *s, tokens_t *t, serial_put_fn put)
 {
     if (next_token(t) != NULL) {
-        (void)fail(put, "get takes nothing after it", "", "");
-        return;
+        return fail(put, "get takes nothing after it", "", "");
     }
     put_str(put, "ok");
     for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && s->prod->inputs[i].name != NULL; i++) {
@@ -328,23 +328,49 @@ static void cmd_get(const serial_link_t *s, tokens_t *t, serial_put_fn put)
         put((char)('0' + m % 10u));
     }
     put('\r');
+    return false; /* answered already: no "ok" after it */
 }
 
-/* The Linux program's commands this image does not have, each answered
+/* The line language's verbs this image serves: each answers its line
+ * itself when it fails (or, get, when it succeeds) and returns whether
+ * "ok" is still to be sent. */
+static const struct {
+    const char *name;
+    bool (*run)(serial_link_t *s, tokens_t *t, serial_put_fn put);
+} verbs[] = {{"set", cmd_set}, {"fault", cmd_fault}, {"can", cmd_can}, {"get", cmd_get}};
+
+/* The Linux program's verbs this image does not have, each answered
  * "error: 'WORD' is not on this target (...)" rather than "unknown
  * command": ramp, sine and noise are motion generators of the simulation
  * that would need a clock and per-input state in the image (a master
  * scripts the same motion as a series of `set` lines); replay reads a
  * file, and the image has no file system; quit: the image runs until QEMU
  * ends (tools/emu, SIGTERM). */
-static bool not_here(const char *cmd)
+static const char *const absent[] = {"ramp", "sine", "noise", "replay", "quit"};
+
+const char *serial_link_verb(unsigned i)
 {
-    static const char *const words[] = {"ramp", "sine", "noise", "replay", "quit"};
-    bool found = false;
-    for (unsigned i = 0; i < sizeof(words) / sizeof(words[0]); i++) {
-        found = found || equal(cmd, words[i]);
+    return i < sizeof(verbs) / sizeof(verbs[0]) ? verbs[i].name : NULL;
+}
+
+const char *serial_link_absent_verb(unsigned i)
+{
+    return i < sizeof(absent) / sizeof(absent[0]) ? absent[i] : NULL;
+}
+
+/* "error: " a, cmd, b, then the verbs served: " (set, fault, can, get)". */
+static void fail_verbs(serial_put_fn put, const char *a, const char *cmd, const char *b)
+{
+    put_str(put, "error: ");
+    put_str(put, a);
+    put_str(put, cmd);
+    put_str(put, b);
+    put_str(put, " (");
+    for (unsigned i = 0; i < sizeof(verbs) / sizeof(verbs[0]); i++) {
+        put_str(put, i > 0u ? ", " : "");
+        put_str(put, verbs[i].name);
     }
-    return found;
+    put_str(put, ")\r");
 }
 
 /* One complete input line, NUL-terminated in s->line. */
@@ -352,26 +378,25 @@ static void input_line(serial_link_t *s, serial_put_fn put)
 {
     tokens_t t = {.at = s->line};
     char *cmd = next_token(&t);
-    bool ok;
     if (cmd == NULL) {
         return; /* blank: nothing to answer */
     }
-    if (equal(cmd, "set")) {
-        ok = cmd_set(s, &t, put);
-    } else if (equal(cmd, "fault")) {
-        ok = cmd_fault(s, &t, put);
-    } else if (equal(cmd, "can")) {
-        ok = cmd_can(s, &t, put);
-    } else if (equal(cmd, "get")) {
-        cmd_get(s, &t, put);
-        return; /* answered: "ok ..." or "error: ..." */
-    } else if (not_here(cmd)) {
-        ok = fail(put, "'", cmd, "' is not on this target (set, fault, can, get)");
-    } else {
-        ok = fail(put, "unknown command '", cmd, "' (set, fault, can, get)");
+    for (unsigned i = 0; i < sizeof(verbs) / sizeof(verbs[0]); i++) {
+        if (equal(cmd, verbs[i].name)) {
+            if (verbs[i].run(s, &t, put)) {
+                put_str(put, "ok\r");
+            }
+            return;
+        }
     }
-    if (ok) {
-        put_str(put, "ok\r");
+    bool here = true;
+    for (unsigned i = 0; i < sizeof(absent) / sizeof(absent[0]); i++) {
+        here = here && !equal(cmd, absent[i]);
+    }
+    if (here) {
+        fail_verbs(put, "unknown command '", cmd, "'");
+    } else {
+        fail_verbs(put, "'", cmd, "' is not on this target");
     }
 }
 

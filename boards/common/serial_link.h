@@ -14,9 +14,12 @@
  *                                    (thousandths; no "nmt=": the line
  *                                    does not see the node)
  *
- * ramp, sine, noise, replay and quit, which the Linux program also takes,
- * are answered "error: 'WORD' is not on this target (...)" (why: see
- * not_here() in serial_link.c).
+ * This is the Linux program's line language (boards/linux/cmd.h) less
+ * what an image cannot carry: ramp, sine, noise, replay and quit are
+ * answered "error: 'WORD' is not on this target (set, fault, can, get)"
+ * (why: serial_link.c, absent[]); selectors are not taken (an image is one
+ * product); `get` has no "nmt=" word. The answers of the verbs it has are
+ * the program's.
  *
  * Each input line is answered on the line with "ok" or "error: <cause>"
  * (python-can's slcan ignores lines that are not frames; an answer holds
@@ -77,6 +80,13 @@ void serial_link_sample(serial_link_t *s, const product_t *p, int32_t values[],
  * frame line, which is then in *f. An input line is applied and answered
  * through put(). */
 bool serial_link_rx(serial_link_t *s, char c, co_frame_t *f, serial_put_fn put);
+
+/* The line language's verbs this line serves, by index (NULL past the
+ * last), and those of the Linux program's it answers "not on this
+ * target" (above). Every verb of the Linux program is in one of the two
+ * lists (a unit test checks it against the program's table). */
+const char *serial_link_verb(unsigned i);
+const char *serial_link_absent_verb(unsigned i);
 
 /* Send one frame as an SLCAN line ("t1FF81122...\r", "r1FF0\r"). */
 void serial_link_tx(const co_frame_t *f, serial_put_fn put);

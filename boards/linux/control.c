@@ -108,7 +108,7 @@ int ctl_open(ctl_t *c, const char *spec, char *err, size_t errlen)
 /* One answer line; a client that cannot take it at once is dropped. */
 static bool reply(ctl_client_t *k, const char *text)
 {
-    char out[CTL_REPLY_MAX + 2u];
+    char out[CMD_REPLY_MAX + 2u];
     int n = snprintf(out, sizeof(out), "%s\n", text);
     size_t len = n <= 0 ? 1u : (size_t)n >= sizeof(out) ? sizeof(out) - 1u : (size_t)n;
     out[len - 1u] = '\n'; /* cut short or not, one line */
@@ -138,13 +138,13 @@ static void drop(ctl_client_t *k)
 {
     close(k->fd);
     k->fd = -1;
-    k->len = 0;
+    k->lines = (cmd_lines_t){0};
 }
 
 /* Append one answer line to client k's buffer (room was checked). */
 static void queue_reply(ctl_client_t *k, const char *text)
 {
-    size_t n = strnlen(text, CTL_REPLY_MAX);
+    size_t n = strnlen(text, CMD_REPLY_MAX);
     memcpy(k->out + k->olen, text, n);
     k->olen += n;
     k->out[k->olen++] = '\n';
@@ -153,22 +153,15 @@ static void queue_reply(ctl_client_t *k, const char *text)
 /* A complete line of client k: answered into its buffer. */
 static void line_done(ctl_client_t *k, ctl_line_fn fn, void *ctx)
 {
-    char out[CTL_REPLY_MAX + 1u];
-    if (k->overflow) {
-        snprintf(out, sizeof(out), "error: line longer than %u characters", CTL_LINE_MAX);
-    } else if (k->nul) {
-        snprintf(out, sizeof(out), "error: line holds a NUL byte");
+    char out[CMD_REPLY_MAX + 1u];
+    char err[64];
+    const char *line = cmd_lines_take(&k->lines, err, sizeof(err));
+    if (line == NULL) {
+        snprintf(out, sizeof(out), "error: %s", err);
     } else {
-        k->line[k->len] = '\0';
-        if (k->len > 0u && k->line[k->len - 1u] == '\r') {
-            k->line[k->len - 1u] = '\0';
-        }
         out[0] = '\0';
-        fn(ctx, k->line, out, sizeof(out));
+        fn(ctx, line, out, sizeof(out));
     }
-    k->len = 0;
-    k->overflow = false;
-    k->nul = false;
     queue_reply(k, out);
 }
 
@@ -192,22 +185,15 @@ static bool flush_out(ctl_client_t *k)
 /* Room for one more answer. */
 static bool out_room(const ctl_client_t *k)
 {
-    return CTL_OUT - k->olen >= CTL_REPLY_MAX + 1u;
+    return CTL_OUT - k->olen >= CMD_REPLY_MAX + 1u;
 }
 
 /* Look at the read bytes while their answers fit. */
 static void take_input(ctl_client_t *cl, ctl_line_fn fn, void *ctx)
 {
     while (cl->ipos < cl->ilen && out_room(cl)) {
-        char ch = cl->in[cl->ipos++];
-        if (ch == '\n') {
+        if (cmd_lines_put(&cl->lines, cl->in[cl->ipos++])) {
             line_done(cl, fn, ctx);
-        } else if (ch == '\0') {
-            cl->nul = true;
-        } else if (cl->len < CTL_LINE_MAX) {
-            cl->line[cl->len++] = ch;
-        } else {
-            cl->overflow = true;
         }
     }
 }

@@ -2,8 +2,8 @@
  * control.h - the control socket (--control unix:PATH | tcp:PORT): clients
  * send the standard-input line language, one command a line, and get one
  * answer line for each ("ok ..." or "error: <cause>"). This module owns
- * the sockets and the line assembly; the program answers each line
- * (ctl_line_fn). Everything runs in the program's one thread; nothing
+ * the sockets and each client's buffers; lines are assembled as on every
+ * channel (cmd.h, cmd_lines_t) and answered by the program (ctl_line_fn). Everything runs in the program's one thread; nothing
  * blocks: answers the kernel cannot take at once wait in the client's
  * buffer, and while it is full the client's further lines wait unread
  * (in the kernel), so a client that sends faster than it reads is slowed
@@ -16,15 +16,13 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "cmd.h"
+
 /* Clients at once; one more is accepted and told so, then closed. */
 #define CTL_CLIENTS 16u
-/* Longest line accepted, without its newline (the stdin limit). */
-#define CTL_LINE_MAX 255u
-/* Longest answer line, without its newline. */
-#define CTL_REPLY_MAX 511u
 /* Answers waiting for the kernel, per client: lines are taken while one
  * more answer fits. */
-#define CTL_OUT ((size_t)8 * (CTL_REPLY_MAX + 1u))
+#define CTL_OUT ((size_t)8 * (CMD_REPLY_MAX + 1u))
 /* Bytes read from a client in one call. */
 #define CTL_IN 512u
 
@@ -34,10 +32,7 @@ typedef void (*ctl_line_fn)(void *ctx, const char *line, char *reply, size_t len
 
 typedef struct ctl_client {
     int fd; /* -1: free */
-    char line[CTL_LINE_MAX + 1u];
-    size_t len;
-    bool overflow; /* longer than CTL_LINE_MAX: answered with an error at its end */
-    bool nul;      /* held a NUL byte: answered with an error at its end */
+    cmd_lines_t lines; /* the line being assembled (cmd.h) */
     char in[CTL_IN]; /* read, not looked at yet (the answers' buffer was full) */
     size_t ipos, ilen;
     char out[CTL_OUT]; /* answers the kernel has not taken yet */

@@ -7,7 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "port.h"
+#include "log.h"
 
 #if defined(HAVE_GPIOD) && HAVE_GPIOD
 #include <gpiod.h>

@@ -1,5 +1,7 @@
 """The command line of canopen-sensor (no CAN needed)."""
 import os
+import re
+from pathlib import Path
 import subprocess
 
 import pytest
@@ -70,9 +72,30 @@ def test_help():
     assert r.returncode == 0
     for word in ("--product", "--iface", "--nvm", "--log", "--list-products", "--led-chip",
                  "--eds", "--on-eof quit|run", "--json", "set NAME=VALUE", "fault NAME on|off",
-                 "can bus-off [SECONDS]", "can passive|warning|active", "quit", "SIGHUP",
+                 "can bus-off [SECONDS] | passive | warning | active", "quit", "SIGHUP",
                  "Exit status"):
         assert word in r.stdout
+
+
+def help_verbs():
+    """The verbs --help lists (the program's table), in its order."""
+    lines = run("--help").stdout.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("Commands,"))
+    rows = lines[start + 1:lines.index("", start)]
+    return [line.split()[0] for line in rows if line.startswith("  ") and not line.startswith("   ")]
+
+
+def test_verbs_agree_with_the_python_package_and_the_readme():
+    """One language: the verbs of the program's table (--help), the Python
+    package's list (a SimBus method each) and the README's command table are
+    the same, in the same order."""
+    from canopen_sensor_sim import VERBS, SimBus
+    assert help_verbs() == list(VERBS)
+    for verb in VERBS:
+        assert callable(getattr(SimBus, verb, None)), verb
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    table = [m.group(1) for m in re.finditer(r"^\| `([a-z]+)[ `]", readme, re.M)]
+    assert list(dict.fromkeys(table)) == list(VERBS)
 
 
 def test_help_lists_every_products_inputs_and_faults():

@@ -1,6 +1,6 @@
 /*
- * test_linux_board.c - the Linux board's simulator commands, standard
- * input lines, EEPROM file and simulated CAN controller.
+ * test_linux_board.c - the Linux program's ports: the EEPROM file, the log's
+ * rate limit, the simulated CAN controller and the shared transmit queue.
  */
 #include <fcntl.h>
 #include <linux/can.h>
@@ -12,8 +12,7 @@
 #include "co_port.h"
 #include "dst.h"
 #include "jd.h"
-#include "port.h"
-#include "sim.h"
+#include "can_port.h"
 
 #include "harness.h"
 
@@ -44,161 +43,6 @@ static void log_stop(void)
     lp_log_open(NULL);
     fclose(log_f);
     log_f = NULL;
-}
-
-static void test_sim_commands(void)
-{
-    sim_t s;
-    sim_init(&s, &dst_x730_xy30);
-    char err[200];
-    CHECK(sim_command(&s, "set x=12.345 y=-0.5", err, sizeof(err)));
-    CHECK_EQ(s.values[0], 12345);
-    CHECK_EQ(s.values[1], -500);
-    CHECK(sim_command(&s, "set y=3", err, sizeof(err)));
-    CHECK_EQ(s.values[0], 12345);
-    CHECK_EQ(s.values[1], 3000);
-    /* Rejected lines change nothing, not even the part that was fine. */
-    CHECK(!sim_command(&s, "set x=1 y=banana", err, sizeof(err)));
-    CHECK(strstr(err, "banana") != NULL);
-    CHECK(!sim_command(&s, "set z=1", err, sizeof(err)));
-    CHECK(strstr(err, "x=<deg> y=<deg>") != NULL);
-    CHECK(!sim_command(&s, "set x=1e9", err, sizeof(err)));
-    CHECK(!sim_command(&s, "set x=nan", err, sizeof(err)));
-    CHECK(!sim_command(&s, "set x=", err, sizeof(err)));
-    CHECK(!sim_command(&s, "set", err, sizeof(err)));
-    CHECK(!sim_command(&s, "tilt 4", err, sizeof(err)));
-    CHECK(!sim_command(&s, "fault sensor maybe", err, sizeof(err)));
-    CHECK(!sim_command(&s, "fault motor on", err, sizeof(err)));
-    CHECK(strstr(err, "usage: fault sensor on|off") != NULL);
-    CHECK_EQ(s.values[0], 12345);
-    CHECK_EQ(s.values[1], 3000);
-    CHECK(s.faults == 0u && !s.quit);
-    CHECK(sim_command(&s, "fault sensor on", err, sizeof(err)) && s.faults == 1u);
-    CHECK(sim_command(&s, "fault sensor off", err, sizeof(err)) && s.faults == 0u);
-    CHECK(sim_command(&s, "", err, sizeof(err)));
-    CHECK(sim_command(&s, "# comment", err, sizeof(err)));
-    CHECK(!s.get_request);
-    CHECK(sim_command(&s, "get", err, sizeof(err)) && s.get_request); /* the board answers */
-    s.get_request = false;
-    CHECK(!sim_command(&s, "get x", err, sizeof(err)) && !s.get_request);
-    CHECK(strstr(err, "get takes nothing after it") != NULL);
-    CHECK(sim_command(&s, "quit", err, sizeof(err)) && s.quit);
-    sim_t z;
-    sim_init(&z, &dst_x730_z360);
-    CHECK(sim_command(&z, "set z=-179.99", err, sizeof(err)));
-    CHECK_EQ(z.values[0], -179990);
-    CHECK(!sim_command(&z, "set x=1", err, sizeof(err)));
-}
-
-/* The JD has no simulated faults: say so, not "usage: fault  on|off". */
-static void test_sim_no_faults(void)
-{
-    sim_t s;
-    sim_init(&s, &jd1xxx);
-    char err[200];
-    CHECK(!sim_command(&s, "fault sensor on", err, sizeof(err)));
-    CHECK(strcmp(err, "jd1xxx has no simulated faults") == 0);
-    char d[256];
-    sim_describe(&jd1xxx, d, sizeof(d));
-    CHECK(strncmp(d, "set z=<deg> ", 12) == 0 && strstr(d, "; no faults") != NULL);
-    sim_describe(&dst_x730_xy30, d, sizeof(d));
-    CHECK(strcmp(d, "set x=<deg> y=<deg>; fault sensor") == 0);
-}
-
-static void test_sim_can_commands(void)
-{
-    sim_t s;
-    sim_init(&s, &jd2xxx);
-    char err[200];
-    CHECK(sim_command(&s, "can bus-off", err, sizeof(err)));
-    CHECK(s.can_request && s.can_state == CO_CAN_BUSOFF && s.can_hold_ms == 0u);
-    s.can_request = false;
-    CHECK(sim_command(&s, "can bus-off 1.5", err, sizeof(err)));
-    CHECK(s.can_request && s.can_state == CO_CAN_BUSOFF && s.can_hold_ms == 1500u);
-    s.can_request = false;
-    CHECK(sim_command(&s, "can passive", err, sizeof(err)) && s.can_state == CO_CAN_PASSIVE);
-    CHECK(sim_command(&s, "can warning", err, sizeof(err)) && s.can_state == CO_CAN_WARNING);
-    CHECK(sim_command(&s, "can active", err, sizeof(err)) && s.can_state == CO_CAN_ACTIVE);
-    s.can_request = false;
-    CHECK(!sim_command(&s, "can", err, sizeof(err)));
-    CHECK(strstr(err, "usage: can bus-off [SECONDS]") != NULL);
-    CHECK(!sim_command(&s, "can off", err, sizeof(err)));
-    CHECK(!sim_command(&s, "can bus-off -1", err, sizeof(err)));
-    CHECK(!sim_command(&s, "can bus-off 1800.5", err, sizeof(err)));
-    CHECK(sim_command(&s, "can bus-off 1800", err, sizeof(err)) && s.can_hold_ms == 1800000u);
-    s.can_request = false;
-    CHECK(!sim_command(&s, "can bus-off 1 2", err, sizeof(err)));
-    CHECK(!sim_command(&s, "can passive 3", err, sizeof(err)));
-    CHECK(!s.can_request);
-}
-
-/* What sim_feed reported, for the checks. */
-typedef struct lines {
-    unsigned applied, rejected;
-    char last[300];
-    char last_err[300];
-} lines_t;
-
-static void record(void *ctx, const char *line, const char *error)
-{
-    lines_t *l = ctx;
-    if (error == NULL) {
-        l->applied++;
-        snprintf(l->last, sizeof(l->last), "%s", line);
-    } else {
-        l->rejected++;
-        snprintf(l->last_err, sizeof(l->last_err), "%s", error);
-    }
-}
-
-static void test_stdin_lines(void)
-{
-    sim_t s;
-    sim_init(&s, &dst_x730_xy30);
-    lines_t l = {0};
-    /* A line in pieces, CR LF, a comment and an empty line. */
-    sim_feed(&s, "set x=", 6, record, &l);
-    CHECK_EQ(l.applied, 0);
-    sim_feed(&s, "4 y=2\r\n# note\n\n", 16, record, &l);
-    CHECK_EQ(l.applied, 1);
-    CHECK_EQ(s.values[0], 4000);
-    CHECK_EQ(s.values[1], 2000);
-    /* A NUL byte: the whole line is rejected, not applied up to the NUL. */
-    static const char nul[] = "set x=11\0garbage y=99\n";
-    sim_feed(&s, nul, sizeof(nul) - 1u, record, &l);
-    CHECK_EQ(l.rejected, 1);
-    CHECK(strstr(l.last_err, "NUL") != NULL);
-    CHECK_EQ(s.values[0], 4000);
-    CHECK_EQ(s.values[1], 2000);
-    /* Too long: rejected whole, and the next line is fine again. */
-    char big[600];
-    memset(big, ' ', sizeof(big));
-    memcpy(big, "set x=7", 7);
-    big[sizeof(big) - 1u] = '\n';
-    sim_feed(&s, big, sizeof(big), record, &l);
-    CHECK_EQ(l.rejected, 2);
-    CHECK(strstr(l.last_err, "line too long") != NULL);
-    CHECK_EQ(s.values[0], 4000);
-    sim_feed(&s, "set x=5\n", 8, record, &l);
-    CHECK_EQ(s.values[0], 5000);
-    CHECK_EQ(l.applied, 2);
-    /* The last line without a newline counts once the input ends. */
-    sim_feed(&s, "set y=-8", 8, record, &l);
-    CHECK_EQ(s.values[1], 2000);
-    sim_feed_end(&s, record, &l);
-    CHECK_EQ(s.values[1], -8000);
-    CHECK_EQ(l.applied, 3);
-    CHECK(strcmp(l.last, "set y=-8") == 0);
-    sim_feed_end(&s, record, &l); /* nothing left: nothing happens */
-    CHECK_EQ(l.applied, 3);
-    CHECK_EQ(l.rejected, 2);
-    /* A line of exactly the longest length is accepted. */
-    char edge[SIM_LINE_MAX + 1u];
-    memset(edge, ' ', sizeof(edge));
-    memcpy(edge, "set x=9", 7);
-    edge[SIM_LINE_MAX] = '\n';
-    sim_feed(&s, edge, sizeof(edge), record, &l);
-    CHECK_EQ(s.values[0], 9000);
 }
 
 static void write_file(const char *path, const void *data, size_t len)
@@ -665,10 +509,6 @@ static void test_tx_flush(void)
 
 int main(void)
 {
-    RUN(test_sim_commands);
-    RUN(test_sim_no_faults);
-    RUN(test_sim_can_commands);
-    RUN(test_stdin_lines);
     RUN(test_eeprom_file);
     RUN(test_eeprom_not_a_file);
     RUN(test_eeprom_link_to_nothing);

@@ -1,13 +1,18 @@
 /*
  * test_linux_sim.c - the Linux program's simulated motion: ramp, sine,
  * noise, replay, how they compose, their limits and their determinism
- * (boards/linux/sim.c, language in sim.h).
+ * (boards/linux/sim.c), driven by the line language (cmd.h) as the
+ * program serves it.
  */
 #include <math.h>
 #include <stdlib.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <string.h>
+
+#include "app.h"
+#include "cmd.h"
 #include "dst.h"
 #include "gsh.h"
 #include "sim.h"
@@ -21,6 +26,36 @@
 static uint32_t at(uint64_t us)
 {
     return (uint32_t)(T0 + us);
+}
+
+/*
+ * One line of the language applied to sim s, as the program serves it: s
+ * is the one instance of an app of its product (no sockets), the line is
+ * served by cmd_line() and s gets the instance's inputs back. Blank lines
+ * and comments change nothing (standard input skips them). false with
+ * the cause in err for an error answer.
+ */
+static bool sim_command(sim_t *s, const char *line, char *err, size_t errlen)
+{
+    static app_t app;
+    static const char *const ifn[PRODUCT_MAX_NODES] = {"vcan0", "vcan0"};
+    size_t i = strspn(line, " \t\r");
+    if (line[i] == '\0' || line[i] == '#') {
+        return true;
+    }
+    memset(&app, 0, sizeof(app));
+    CHECK(app_add(&app, s->prod, ifn, 0, 1) == 0);
+    app.inst[0].sim = *s;
+    char reply[CMD_REPLY_MAX + 1u];
+    cmd_line(&app, CMD_STDIN, line, 0, reply, sizeof(reply));
+    *s = app.inst[0].sim;
+    if (strncmp(reply, "error: ", 7) == 0) {
+        size_t n = strnlen(reply + 7, errlen - 1u);
+        memcpy(err, reply + 7, n);
+        err[n] = '\0';
+        return false;
+    }
+    return true;
 }
 
 static bool cmd(sim_t *s, const char *line)
@@ -554,66 +589,6 @@ static void test_replay_limits_bom_and_where(void)
     remove_files(dir, path, sizeof(path));
 }
 
-static void report(void *ctx, const char *line, const char *error);
-
-/* sim_t.route: a line it takes is reported with its error; one it leaves
- * goes to sim_command as before. */
-static bool route_at(void *ctx, const char *line, char *err, unsigned errlen)
-{
-    unsigned *taken = ctx;
-    if (line[0] != '@') {
-        return false;
-    }
-    (*taken)++;
-    snprintf(err, errlen, "%s", strcmp(line, "@bad") == 0 ? "no such node" : "");
-    return true;
-}
-
-static void test_route(void)
-{
-    sim_t s;
-    start(&s);
-    unsigned taken = 0;
-    s.route = route_at;
-    s.route_ctx = &taken;
-    char last[200] = "";
-    static const char in[] = "@1 set x=5\n@bad\nset x=3\n";
-    sim_feed(&s, in, 11, report, last);
-    CHECK(strcmp(last, "@1 set x=5|ok") == 0);
-    sim_feed(&s, in + 11, 5, report, last);
-    CHECK(strcmp(last, "@bad|no such node") == 0);
-    sim_feed(&s, in + 16, sizeof(in) - 17u, report, last);
-    CHECK(strcmp(last, "set x=3|ok") == 0);
-    CHECK_EQ(taken, 2u);
-    CHECK_EQ(s.values[0], 3000); /* the routed set did not reach this sim */
-}
-
-/* Standard input lines: motion commands applied and answered like set. */
-static void report(void *ctx, const char *line, const char *error)
-{
-    char *last = ctx;
-    snprintf(last, 200, "%s|%s", line, error != NULL ? error : "ok");
-}
-
-static void test_motion_lines(void)
-{
-    sim_t s;
-    start(&s);
-    char last[200] = "";
-    static const char in[] = "ramp x=30 in 5s\n";
-    sim_feed(&s, in, sizeof(in) - 1u, report, last);
-    CHECK(strcmp(last, "ramp x=30 in 5s|ok") == 0);
-    static const char bad[] = "sine x amp=5 period=2 s\n";
-    sim_feed(&s, bad, sizeof(bad) - 1u, report, last);
-    CHECK(strstr(last, "sine x amp=5 period=2 s|") == last);
-    CHECK(strstr(last, "usage: sine") != NULL);
-    static const char unknown[] = "wobble x\n";
-    sim_feed(&s, unknown, sizeof(unknown) - 1u, report, last);
-    CHECK(strstr(last, "(set, ramp, sine, noise, replay, fault, can, get, quit)") != NULL);
-    sim_step(&s, at(2500000));
-    CHECK_EQ(s.values[0], 15000);
-}
-
 /* A step right after the first: the clock may start anywhere, and the
  * simulated time runs on across the board clock's wrap. */
 static void test_clock(void)
@@ -673,8 +648,6 @@ int main(void)
     RUN(test_replay);
     RUN(test_replay_bad_files);
     RUN(test_replay_limits_bom_and_where);
-    RUN(test_route);
-    RUN(test_motion_lines);
     RUN(test_clock);
     return h_finish();
 }

@@ -27,7 +27,12 @@ import subprocess
 import tempfile
 import time
 
-__all__ = ["ControlClient", "SimBus", "SimError", "find_program"]
+__all__ = ["ControlClient", "SimBus", "SimError", "VERBS", "find_program"]
+
+# The line language's verbs, in the program's order (its table,
+# boards/linux/cmd.c): each is a SimBus method of the same name.
+# tests/integration/test_cli.py checks this list against the program's.
+VERBS = ("set", "ramp", "sine", "noise", "replay", "fault", "can", "get", "quit")
 
 
 class SimError(RuntimeError):
@@ -277,6 +282,20 @@ class SimBus:
 
     def replay(self, node, path):
         self.command(f"replay {path}", node)
+
+    def can(self, node, state, seconds=None):
+        """The node's simulated CAN controller: ``bus-off`` (the bus unusable
+        ``seconds``, then back after 128 x 11 bits), ``passive``, ``warning``
+        or ``active``; node "@all" for every node."""
+        hold = "" if seconds is None else f" {seconds}"
+        self.command(f"can {state}{hold}", node)
+
+    def quit(self):
+        """Stop the program by its own command (stop() signals it instead);
+        returns the exit status."""
+        if self._client is not None:
+            self._client.command("quit")
+        return self.stop()
 
     def get(self, node):
         """The node's true inputs and NMT state: ``{"x": 12.5, "nmt": "operational"}``
