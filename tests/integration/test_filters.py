@@ -1,4 +1,4 @@
-"""Kernel receive filters (CAN_RAW_FILTER, boards/linux/port.c): each
+"""Kernel receive filters (CAN_RAW_FILTER, boards/linux/can_port.c): each
 canopen-sensor socket takes only the CAN-IDs its node consumes, so that
 ten separate processes on one bus at a 10 ms TPDO keep their timing, and
 the filter follows a new SYNC COB-ID or node-ID at once."""

@@ -578,7 +578,7 @@ s.bind(("vcan0",))
 others = [base + k for base in (0x080, 0x180, 0x280, 0x380, 0x480, 0x580, 0x700)
           for k in range(1, 128, 7) if k != node]
 # Every other frame on the node's SYNC COB-ID (0x080) with 8 bytes: its
-# kernel filter lets them through (port.c), the stack takes them as a SYNC
+# kernel filter lets them through (can_port.c), the stack takes them as a SYNC
 # with more than one data byte and does nothing; the others' frames stop
 # at the filter.
 ids = [i for o in others for i in (o, 0x080)]
