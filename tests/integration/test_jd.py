@@ -117,7 +117,7 @@ def test_guarding_and_heartbeat_consumer(sensor_factory, network, bus):
 def test_tpdo2_remap_and_change_of_state(sensor_factory, network, bus):
     sensor = sensor_factory("jd2xxx")
     node = boot(sensor, network, bus)
-    # The manual's example B (corrected as the spec says): gyro X + accel X.
+    # The manual's example B (its misprinted frames corrected): gyro X + accel X.
     node.tpdo.read()
     tpdo2 = node.tpdo[2]
     tpdo2.clear()

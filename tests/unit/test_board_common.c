@@ -691,7 +691,7 @@ static void test_main_loop_two_nodes(void)
 }
 
 /* Each frame is served to its end before the next: the JD2xxx's "save
- * with reset" (2300h) confirms, then resets the node (JD manual R38), and
+ * with reset" (2300h) confirms, then resets the node (JD manual, 9.17), and
  * an SDO request right behind it in the same pass is answered by the
  * node after its reset, behind the boot-up. */
 static void test_main_loop_reset_between_frames(void)

@@ -1,13 +1,16 @@
 /*
  * test_dst_manual.c - every CAN exchange of the DST X730 and DST X710
- * manuals, as listed in shared/specs/danfoss-dst-x730.md and
- * danfoss-dst-x710.md section 4 (N, H, P, E vectors), and the specs'
- * derived vectors (D, X). Node-ID 0x7F as in the manuals. The two manuals
+ * operating guides, and derived checks. Labels: N and H are the manual's
+ * NMT and heartbeat frames, P its TPDO examples (section 11) in the order
+ * printed, E<n>.<k> frame k of its communication example n (section 15 of
+ * the X730's, 14 of the X710's); D (both models) and X (X710) are checks
+ * derived here, not printed in the manual. Node-ID 0x7F as in the
+ * manuals. The two manuals
  * show the same frames for the shared examples, so those tests run once per
  * model; each model's own vectors follow.
  *
  * Where a manual's bytes are wrong the corrected bytes are tested and the
- * line says so (C-n: the spec's contradiction number, the same in both).
+ * line says so, and why.
  */
 #include "dst.h"
 #include "harness.h"
@@ -126,7 +129,7 @@ static void test_tpdo_p1_to_p6(void)
     EXPECT_TPDO("94 11 00 00 00 00 00 00"); /* P2 */
     d->truth[0] = -45000;
     h_advance(d, 3000000);
-    /* P3: the manual prints 6B EE (its "value - 65535" rule, C-1); INTEGER16
+    /* P3: the manual prints 6B EE (its "value - 65535" rule, one off); INTEGER16
      * two's complement of -4500 is 6C EE. */
     EXPECT_TPDO("6C EE 00 00 00 00 00 00");
     d->truth[0] = 0;
@@ -137,7 +140,7 @@ static void test_tpdo_p1_to_p6(void)
     EXPECT_TPDO("00 00 94 11 00 00 00 00"); /* P5 */
     d->truth[1] = -45000;
     h_advance(d, 3000000);
-    EXPECT_TPDO("00 00 6C EE 00 00 00 00"); /* P6: manual 6B EE, corrected (C-1) */
+    EXPECT_TPDO("00 00 6C EE 00 00 00 00"); /* P6: manual 6B EE, corrected as P3 */
 }
 
 static void test_tpdo_p7_to_p10_z360(void)
@@ -146,11 +149,11 @@ static void test_tpdo_p7_to_p10_z360(void)
     set_res_001();
     d->truth[0] = -180000;
     operational_settled();
-    /* P7: manual AF B9 (C-1); -18000 is B0 B9. */
+    /* P7: manual AF B9 (one off, as P3); -18000 is B0 B9. */
     EXPECT_TPDO("B0 B9 00 00 00 00 00 00");
     d->truth[0] = -90000;
     h_advance(d, 3000000);
-    EXPECT_TPDO("D8 DC 00 00 00 00 00 00"); /* P8: manual D7 DC, corrected (C-1) */
+    EXPECT_TPDO("D8 DC 00 00 00 00 00 00"); /* P8: manual D7 DC, corrected as P3 */
     d->truth[0] = 0;
     h_advance(d, 3000000);
     EXPECT_TPDO("00 00 00 00 00 00 00 00"); /* P9 */
@@ -172,7 +175,7 @@ static void test_e1_bitrate(void)
     SDO(d, "2F F3 20 00 02 00 00 00", "60 F3 20 00 00 00 00 00"); /* E1.3/E1.4 */
     dst_dev_t *x = (dst_dev_t *)h_inst(d);
     CHECK_EQ(x->lss.bitrate, 2);
-    h_power_cycle(d); /* no "save" needed (B-50) */
+    h_power_cycle(d); /* no "save" needed (example 1 has none) */
     EXPECT(d, 0x77F, "00");
     x = (dst_dev_t *)h_inst(d);
     CHECK_EQ(x->lss.bitrate, 2);
@@ -185,13 +188,13 @@ static void test_e2_node_id(void)
     boot(M->xy30);
     SDO(d, "2F F0 20 00 06 00 00 00", "60 F0 20 00 00 00 00 00"); /* E2.1/E2.2 */
     SDO(d, "2F F1 20 00 06 00 00 00", "60 F1 20 00 00 00 00 00"); /* E2.3/E2.4 */
-    CHECK_EQ(d->node->node_id, 0x7F); /* old ID until reset (B-44) */
+    CHECK_EQ(d->node->node_id, 0x7F); /* old ID until reset (example 2) */
     h_power_cycle(d);
     EXPECT(d, 0x706, "00"); /* boot-up on the new ID */
     CHECK_EQ(d->node->node_id, 6);
     h_drain(d);
     h_rx(d, 0x606, "40 00 12 01 00 00 00 00");
-    EXPECT(d, 0x586, "43 00 12 01 06 06 00 00"); /* SDO COB-ID follows (B-45) */
+    EXPECT(d, 0x586, "43 00 12 01 06 06 00 00"); /* SDO COB-ID follows (CiA 301) */
     h_rx(d, 0x606, "40 14 10 00 00 00 00 00");
     EXPECT(d, 0x586, "43 14 10 00 86 00 00 00"); /* EMCY COB-ID follows */
     h_rx(d, 0x606, "40 00 18 01 00 00 00 00");
@@ -230,7 +233,7 @@ static void test_e4_autostart(void)
     CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
     h_advance(d, 1);
     EXPECT(d, 0x1FF, "00 00 00 00 00 00 00 00"); /* TPDO without NMT start */
-    SDO(d, "2F 00 50 00 02 00 00 00", "80 00 50 00 31 00 09 06"); /* B-12: > 1 */
+    SDO(d, "2F 00 50 00 02 00 00 00", "80 00 50 00 31 00 09 06"); /* "Max. = 1" */
 }
 
 static void test_e5_e6_preset_xy(void)
@@ -243,7 +246,7 @@ static void test_e5_e6_preset_xy(void)
     EXPECT_TPDO("D2 04 0C FE 00 00 00 00");
     SDO(d, "2B 12 60 00 00 00 00 00", "60 12 60 00 00 00 00 00"); /* E5.1/E5.2 */
     EXPECT_TPDO("00 00 0C FE 00 00 00 00");                      /* immediate */
-    /* E6.1: the manual prints CMD 28h (C-11); 2B is the 2-byte download. */
+    /* E6.1: the manual prints CMD 28h, no SDO command; 2B is the 2-byte download. */
     SDO(d, "2B 22 60 00 00 00 00 00", "60 22 60 00 00 00 00 00");
     EXPECT_TPDO("00 00 00 00 00 00 00 00");
     SAVE();
@@ -282,7 +285,7 @@ static void test_e9_resolution(void)
     EXPECT_TPDO("C8 00 00 00 00 00 00 00"); /* 10 deg at 0.05 = 200 (D18 style) */
     SDO(d, "2B 14 60 00 05 00 00 00", "60 14 60 00 00 00 00 00");
     SDO(d, "2B 00 60 00 0A 00 00 00", "60 00 60 00 00 00 00 00"); /* E9.1/E9.2 */
-    CHECK_EQ(h_read(d, 0x6014, 0), 0); /* offsets cleared (B-71) */
+    CHECK_EQ(h_read(d, 0x6014, 0), 0); /* offsets cleared */
     SAVE();
     EXPECT_TPDO("E8 03 00 00 00 00 00 00"); /* 1000 at 0.01 */
     h_power_cycle(d);
@@ -294,7 +297,7 @@ static void test_e10_filter_after_save(void)
     boot(M->xy30);
     dst_dev_t *x = (dst_dev_t *)h_inst(d);
     SDO(d, "2F 01 20 00 02 00 00 00", "60 01 20 00 00 00 00 00");
-    CHECK_EQ(x->filter_active, 0); /* not yet: only after STORE (B-81) */
+    CHECK_EQ(x->filter_active, 0); /* not yet: "only accepted after a STORE command" */
     CHECK_EQ(h_read(d, 0x2001, 0), 2);
     SAVE();
     CHECK_EQ(x->filter_active, 2);
@@ -328,7 +331,7 @@ static void test_e11_restore_defaults(void)
     h_rx(d, 0x606, "40 00 18 05 00 00 00 00");
     EXPECT(d, 0x586, "4B 00 18 05 14 00 00 00"); /* RAM unchanged until reset */
     h_rx(d, 0x000, "81 06");
-    EXPECT(d, 0x77F, "00"); /* PARA and LSS-PARA back to defaults (C-5) */
+    EXPECT(d, 0x77F, "00"); /* PARA and LSS-PARA back to defaults (table, example 11) */
     CHECK_EQ(h_read(d, 0x1800, 5), 100);
     CHECK_EQ(h_read(d, 0x1011, 1), 1);
     SDO(d, "23 11 10 01 6C 6F 61 65", "80 11 10 01 20 00 00 08"); /* wrong signature */
@@ -353,7 +356,7 @@ static void test_e13_sync(void)
     h_rx(d, 0x000, "01 7F");
     h_drain(d);
     h_advance(d, 500000);
-    EXPECT_NONE(d); /* no event-timer PDO in synchronous mode (B-61) */
+    EXPECT_NONE(d); /* no event-timer PDO in synchronous mode (CiA 301) */
     h_rx(d, 0x080, "");
     EXPECT(d, 0x1FF, "00 00 00 00 00 00 00 00");
     h_rx(d, 0x080, "");
@@ -399,7 +402,7 @@ static void test_derived_reads(void)
     SDO(d, "40 08 10 00 00 00 00 00", "47 08 10 00 47 49 42 00"); /* D6 */
     SDO(d, "40 09 10 00 00 00 00 00", "43 09 10 00 31 2E 30 30");
     SDO(d, "40 00 60 00 00 00 00 00", "4B 00 60 00 32 00 00 00"); /* D8 */
-    SDO(d, "40 00 1A 02 00 00 00 00", "43 00 1A 02 10 00 20 60"); /* D9, C-4 */
+    SDO(d, "40 00 1A 02 00 00 00 00", "43 00 1A 02 10 00 20 60"); /* D9: 16 bits, not the printed 0x20 */
     /* 3 entries where the manual prints 2: bytes 5-8 mapped as 2100h, 0. */
     SDO(d, "40 00 1A 00 00 00 00 00", "4F 00 1A 00 03 00 00 00");
     SDO(d, "40 00 1A 03 00 00 00 00", "43 00 1A 03 20 00 00 21");
@@ -409,7 +412,7 @@ static void test_derived_reads(void)
     SDO(d, "40 00 12 02 00 00 00 00", "43 00 12 02 FF 05 00 00");
     SDO(d, "40 00 18 00 00 00 00 00", "4F 00 18 00 05 00 00 00");
     SDO(d, "40 00 18 05 00 00 00 00", "4B 00 18 05 64 00 00 00");
-    SDO(d, "40 11 60 00 00 00 00 00", "4F 11 60 00 02 00 00 00"); /* C-3 */
+    SDO(d, "40 11 60 00 00 00 00 00", "4F 11 60 00 02 00 00 00"); /* default 0x02 (example 8) */
 }
 
 static void test_derived_rejections(void)
@@ -422,13 +425,13 @@ static void test_derived_rejections(void)
     SDO(d, "2B 00 18 05 03 00 00 00", "80 00 18 05 30 00 09 06"); /* D12 */
     SDO(d, "2B 00 18 05 04 00 00 00", "60 00 18 05 00 00 00 00");
     SDO(d, "2F 00 18 02 FF 00 00 00", "80 00 18 02 30 00 09 06"); /* D13 */
-    SDO(d, "2F 00 18 02 00 00 00 00", "80 00 18 02 30 00 09 06"); /* C-18 */
+    SDO(d, "2F 00 18 02 00 00 00 00", "80 00 18 02 30 00 09 06"); /* type 0: not listed */
     SDO(d, "2F 00 18 02 F1 00 00 00", "80 00 18 02 30 00 09 06");
     SDO(d, "2F 00 18 02 FC 00 00 00", "80 00 18 02 30 00 09 06");
     SDO(d, "2F 00 18 02 FD 00 00 00", "80 00 18 02 30 00 09 06");
     SDO(d, "2F 00 18 02 F0 00 00 00", "60 00 18 02 00 00 00 00");
-    /* D14/D15: the spec suggests 0x06090030 for every range error; CiA 301
-     * has the more precise "value too low" / "too high", used here. */
+    /* D14/D15: 0x06090030 would do for every range error; CiA 301 has the
+     * more precise "value too low" / "too high", used here. */
     SDO(d, "2F F0 20 00 00 00 00 00", "80 F0 20 00 32 00 09 06"); /* D14 */
     SDO(d, "2F F0 20 00 80 00 00 00", "80 F0 20 00 31 00 09 06");
     SDO(d, "2F F2 20 00 08 00 00 00", "80 F2 20 00 31 00 09 06"); /* D15 */
@@ -436,25 +439,25 @@ static void test_derived_rejections(void)
     SDO(d, "2F 11 60 00 00 00 00 00", "60 11 60 00 00 00 00 00"); /* D17 */
     SDO(d, "2B 00 60 00 64 00 00 00", "80 00 60 00 22 00 00 08");
     SDO(d, "2F 11 60 00 04 00 00 00", "80 11 60 00 31 00 09 06"); /* > 3 */
-    /* D25 (the spec's, not the manual's) read it as wo: CiA 301's rw, the
-     * storage capability 1 = saves on command. */
+    /* The manual's table says wo, but prints no read of it: CiA 301's rw,
+     * the storage capability 1 = saves on command. */
     SDO(d, "40 10 10 01 00 00 00 00", "43 10 10 01 01 00 00 00");
     SDO(d, "23 10 10 01 00 00 00 00", "80 10 10 01 20 00 00 08"); /* D26 */
-    SDO(d, "2B 10 10 01 73 61 00 00", "80 10 10 01 13 00 07 06"); /* B-54 length */
+    SDO(d, "2B 10 10 01 73 61 00 00", "80 10 10 01 13 00 07 06"); /* length (CiA 301) */
     SDO(d, "23 00 10 00 00 00 00 00", "80 00 10 00 02 00 01 06"); /* ro */
     SDO(d, "2B 10 60 00 00 00 00 00", "80 10 60 00 02 00 01 06"); /* slope ro */
     SDO(d, "2F 01 40 00 00 00 00 00", "80 01 40 00 02 00 01 06");
-    SDO(d, "23 00 1A 02 10 00 20 60", "80 00 1A 02 02 00 01 06"); /* B-69 */
-    SDO(d, "40 00 18 04 00 00 00 00", "80 00 18 04 11 00 09 06"); /* C-19 */
+    SDO(d, "23 00 1A 02 10 00 20 60", "80 00 1A 02 02 00 01 06"); /* static mapping */
+    SDO(d, "40 00 18 04 00 00 00 00", "80 00 18 04 11 00 09 06"); /* sub 4 reserved */
     SDO(d, "40 01 10 01 00 00 00 00", "80 01 10 01 11 00 09 06"); /* "1001h sub 1" */
     SDO(d, "40 06 21 06 00 00 00 00", "80 06 21 06 00 00 02 06"); /* "2106h sub 6" */
     SDO(d, "40 05 10 00 00 00 00 00", "43 05 10 00 80 00 00 00"); /* COB-ID SYNC (CiA 301) */
     SDO(d, "40 06 10 00 00 00 00 00", "80 06 10 00 00 00 02 06");
     SDO(d, "2F 00 40 00 FF 00 00 00", "60 00 40 00 00 00 00 00"); /* 0x4000 0..255 */
     SDO(d, "23 14 10 00 FF 00 00 40", "80 14 10 00 30 00 09 06"); /* bit 30 */
-    SDO(d, "22 01 20 00 01 00 00 00", "60 01 20 00 00 00 00 00"); /* B-39 */
+    SDO(d, "22 01 20 00 01 00 00 00", "60 01 20 00 00 00 00 00"); /* 22h (CiA 301) */
     SDO(d, "2B 01 20 00 01 00 00 00", "80 01 20 00 12 00 07 06"); /* length high */
-    /* B-33, B-36: the manuals use expedited transfer only. A segmented
+    /* The manuals use expedited transfer only (section 10). A segmented
      * download is taken too (CiA 301, test_segmented_download); a segment
      * out of turn, upload segments and block transfer are unsupported
      * command specifiers, and change nothing. */
@@ -695,7 +698,7 @@ static void test_derived_limits_and_emcy(void)
     CHECK(emcy);
     EXPECT_TPDO("4C 04 00 00 00 00 00 00"); /* D22: stops at +11.00 */
     CHECK_EQ(h_read(d, 0x4001, 0), 0x01);
-    CHECK_EQ(h_read(d, 0x1001, 0), 0x00); /* C-14 */
+    CHECK_EQ(h_read(d, 0x1001, 0), 0x00); /* "Always ZERO" */
     bool g;
     bool r;
     uint32_t nx;
@@ -712,7 +715,7 @@ static void test_derived_limits_and_emcy(void)
     }
     CHECK(emcy);
     CHECK_EQ(h_read(d, 0x4001, 0), 0x00);
-    /* Negative side, the +-90 variant stops at -87 (C-8). */
+    /* Negative side, the +-90 variant stops at -87 (section 9). */
     boot(M->xy90);
     set_res_001();
     d->truth[1] = -89000;
@@ -738,7 +741,8 @@ static void test_error_behaviour(void)
     EXPECT(d, 0xFF, "00 10 00 00 01 00 00 00");
 }
 
-/* C-42: 0x4000 acts on a transition of 0x4001 from 0 to an error; an
+/* 0x4000 acts on a transition of 0x4001 from 0 to an error (a decision:
+ * the manual's "serious device failure" is not defined); an
  * error added to one already reported is reported (EMCY with the new
  * 0x4001) without a second state change. */
 static void test_error_behaviour_on_the_first_error_only(void)
@@ -835,7 +839,7 @@ static void test_pdo_coding_default_after_reset(void)
 
 /* Status LED (operating guide section 13): green blinking is 200 ms on,
  * 200 ms off (pre-operational), the single flash 500 ms on, 500 ms off
- * (stopped, C-38). */
+ * (stopped), as the manual's legend says. */
 static void test_x730_led_timing(void)
 {
     boot(&dst_x730_xy30);
@@ -865,7 +869,7 @@ static void test_x710_own_vectors(void)
     SDO(d, "40 0A 10 00 00 00 00 00", "43 0A 10 00 31 2E 31 30"); /* X1 */
     SDO(d, "40 01 50 00 00 00 00 00", "80 01 50 00 00 00 02 06"); /* X2: no 0x5001 */
     SDO(d, "40 00 18 03 00 00 00 00", "4B 00 18 03 04 00 00 00"); /* X3 */
-    /* X4: the spec suggests 0x06090030; below a plain minimum is "too low". */
+    /* X4: below a plain minimum is "too low" (rather than 0x06090030). */
     SDO(d, "2B 00 18 03 02 00 00 00", "80 00 18 03 32 00 09 06");
     /* Always little-endian (no D19). */
     boot(&dst_x710_xy90);
@@ -877,7 +881,7 @@ static void test_x710_own_vectors(void)
 
 static void test_x710_inhibit_time(void)
 {
-    /* Inhibit time in 1 ms (C-19): event timer 4 ms, inhibit 10 ms. */
+    /* Inhibit time in 1 ms (the X710's table): event timer 4 ms, inhibit 10 ms. */
     boot(&dst_x710_xy30);
     SDO(d, "2B 00 18 05 04 00 00 00", "60 00 18 05 00 00 00 00");
     SDO(d, "2B 00 18 03 0A 00 00 00", "60 00 18 03 00 00 00 00");

@@ -58,7 +58,7 @@ static void test_every_product_applies_its_overrides(void)
 }
 
 /* GSH-A manual: "In the EDS file this default value must be set to 0,
- * otherwise errors will be generated" (spec C-14); the device keeps 100. */
+ * otherwise errors will be generated" (section 12); the device keeps 100. */
 static void test_gsh_event_timer(void)
 {
     const product_t *gsh[] = {&gsh_a, &gsh_a_redundant};

@@ -1,13 +1,13 @@
 /*
- * test_gsh_manual.c - every frame of the Gefran GSH-A manual
- * (shared/specs/gefran-gsh-a.md section 5.1) and the derived vectors of
- * section 5.2, on the single (node 0x13) and redundant (0x13 + 0x14)
- * versions.
+ * test_gsh_manual.c - every frame of the Gefran GSH-A manual and checks
+ * derived from its object table, on the single (node 0x13) and redundant
+ * (0x13 + 0x14) versions. Labels: P-1 and P-2 are the manual's PDO
+ * examples (section 11), E<n>-<k> frame k of its communication example n
+ * (section 13); D-n are checks derived here, not printed in the manual.
  *
- * Abort codes: where the spec suggests 0x06090030 for a value beyond a
- * plain limit, this firmware answers CiA 301's "too high" (0x06090031);
- * where it allows 0x06070010 "or 0x06070012" for a too long write, the
- * latter. Lines that differ from the spec say so.
+ * Abort codes: for a value beyond a plain limit this firmware answers
+ * CiA 301's "too high" (0x06090031) rather than the general 0x06090030;
+ * for a too long write 0x06070012 rather than 0x06070010.
  */
 #include "gsh.h"
 #include "harness.h"
@@ -55,7 +55,8 @@ static void test_checksum_against_both_frames(void)
     static const uint8_t b[7] = {0x26, 0x1F, 0xE6, 0x0D, 0x00, 0x00, 0x04};
     CHECK_EQ(gsh_pdo_checksum(a), 0x59); /* P-1, 193h */
     CHECK_EQ(gsh_pdo_checksum(b), 0x3C); /* P-2, 194h */
-    /* The spec's worked H2 values (section 4.5). */
+    /* Sums below 256 and above 510, where (sum + 254) mod 255 differs
+     * from the plain byte sum. */
     static const uint8_t zero[7] = {0};
     static const uint8_t s511[7] = {0xFF, 0x00, 0xFF, 0x00, 0x00, 0x00, 0x01};
     CHECK_EQ(gsh_pdo_checksum(zero), 0xFE);
@@ -68,13 +69,14 @@ static void test_p1_p2_pdo_frames(void)
     h_boot(d, &gsh_a_redundant, false);
     d->truth[GSH_IN_LENGTH] = 52000;
     d->truth[GSH_IN_ANGLE] = 3400;
-    /* Factory auto-start: boot-up, then PDOs every 100 ms, at once. */
+    /* Factory auto-start: boot-up, then PDOs every 100 ms, at once (0x5000 = 1). */
     CHECK_EQ(d->nodes[0]->nmt.state, CO_NMT_OPERATIONAL);
     CHECK_EQ(d->nodes[1]->nmt.state, CO_NMT_OPERATIONAL);
     h_advance(d, 450000);
     expect_pdo_number(0x193, 4, "34 00 22 00 00 00 04 59", __LINE__);
     /* P-2: channel 2 (backwards) shows 7974 mm and 355.8 deg. The two printed
-     * frames are not one moment of one device (C-27), so P-2 gets its own. */
+     * frames are not one moment of one device (52 + 7974 mm is not the
+     * 3.4 deg frame's complement), so P-2 gets its own. */
     h_boot(d, &gsh_a_redundant, false);
     d->truth[GSH_IN_LENGTH] = (GSH_STROKE_MM - 7974) * 1000;
     d->truth[GSH_IN_ANGLE] = 4200; /* 360 - 355.8 */
@@ -115,7 +117,7 @@ static void test_e1_node_id(void)
     h_drain(d);
     SDO(d, "2F 01 30 00 06 00 00 00", "60 01 30 00 00 00 00 00"); /* E1-1/E1-2 */
     CHECK_EQ(d->node->node_id, 0x13);
-    /* E1-3: the manual sends to 67Fh (C-01); a node 0x13 must not answer there. */
+    /* E1-3: the manual sends to 67Fh (a misprint for 613h); a node 0x13 must not answer there. */
     h_drain(d);
     h_rx(d, 0x67F, "23 10 10 01 73 61 76 65");
     EXPECT_NONE(d);
@@ -126,13 +128,14 @@ static void test_e1_node_id(void)
     const co_frame_t *f = h_next(d);
     CHECK(f != NULL && f->id == 0x186); /* auto-start: the TPDO on the new ID */
     SDO(d, "40 00 12 01 00 00 00 00", "43 00 12 01 06 06 00 00");
-    /* NMT reset communication also applies a saved node-ID (C-24). */
+    /* NMT reset communication also applies a saved node-ID (a decision:
+     * the manual says "sensor reset"). */
     SDO(d, "2F 01 30 00 13 00 00 00", "60 01 30 00 00 00 00 00");
     SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
     h_drain(d);
     h_rx(d, 0x000, "82 06");
     EXPECT_ID(d, 0x713, "00");
-    /* Without a save a reset restores the old ID. */
+    /* Without a save a reset restores the old ID (example 1 saves first). */
     SDO(d, "2F 01 30 00 07 00 00 00", "60 01 30 00 00 00 00 00");
     h_rx(d, 0x000, "81 13");
     EXPECT_ID(d, 0x713, "00");
@@ -158,7 +161,7 @@ static void test_e3_autostart_off(void)
 {
     boot(&gsh_a);
     SDO(d, "2F 00 50 00 00 00 00 00", "60 00 50 00 00 00 00 00"); /* E3-1/E3-2 */
-    CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);               /* */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);               /* unchanged by 0x5000 */
     SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00"); /* E3-3/E3-4 */
     h_power_cycle(d);
     EXPECT_ID(d, 0x713, "00");
@@ -170,9 +173,9 @@ static void test_e3_autostart_off(void)
     CHECK(f != NULL && f->id == 0x193);
 }
 
-/* 4.6: the PDO counter starts from 0 at every boot-up, also after a
+/* The PDO counter starts from 0 at every boot-up (a decision), also after a
  * reset; until the first PDO after it, 0x2111 and 0x2112 (the last PDO's
- * counter and checksum) read 0. Auto-start off (0x5000, C-22), so that the
+ * counter and checksum) read 0. Auto-start off (0x5000), so that the
  * node waits in pre-operational after the reset communication. */
 static void test_counter_from_zero_after_reset(void)
 {
@@ -215,7 +218,7 @@ static void test_nmt_and_stopped(void)
     EXPECT_ID(d, 0x713, "00");
     h_rx(d, 0x000, "82 14"); /* NMT-5 */
     EXPECT_ID(d, 0x714, "00");
-    /* No node guarding. */
+    /* No node guarding (the manual claims the heartbeat only). */
     co_frame_t rtr = {.id = 0x713, .rtr = true, .dlc = 1};
     h_drain(d);
     h_rx_frame(d, &rtr);
@@ -260,7 +263,7 @@ static void test_derived_reads_d1_to_d29(void)
     SDO(d, "40 11 68 00 00 00 00 00", "4F 11 68 00 00 00 00 00"); /* D-26 */
     SDO(d, "40 FF 6F 00 00 00 00 00", "43 FF 6F 00 9A 01 02 00"); /* D-27 */
     /* D-28 with 0x6004 UNSIGNED16, as the PDO text and the mapping length
-     * say (gsh_a.c): 2 bytes, where the spec's vector has 4. */
+     * say (gsh_a.c): 2 bytes, not the table's Unsigned32. */
     SDO(d, "40 04 60 00 00 00 00 00", "4B 04 60 00 34 00 00 00");
     SDO(d, "40 10 68 00 00 00 00 00", "4B 10 68 00 22 00 00 00"); /* D-29 */
 }
@@ -269,23 +272,23 @@ static void test_derived_aborts_d30_to_d39(void)
 {
     boot(&gsh_a);
     SDO(d, "23 00 10 00 00 00 00 00", "80 00 10 00 02 00 01 06"); /* D-30 */
-    /* D-31 (the spec's) read it as wo: CiA 301's rw, 1 = saves on command. */
+    /* The manual's table says wo, but prints no read: CiA 301's rw, 1 = saves on command. */
     SDO(d, "40 10 10 01 00 00 00 00", "43 10 10 01 01 00 00 00");
     SDO(d, "23 10 10 01 00 00 00 00", "80 10 10 01 20 00 00 08"); /* D-32 */
     SDO(d, "40 00 20 00 00 00 00 00", "80 00 20 00 00 00 02 06"); /* D-33 */
     SDO(d, "40 18 10 05 00 00 00 00", "80 18 10 05 11 00 09 06"); /* D-34 */
-    SDO(d, "2B 01 30 00 06 00 00 00", "80 01 30 00 12 00 07 06"); /* D-35 (spec: 10 or 12) */
-    SDO(d, "2F 01 30 00 80 00 00 00", "80 01 30 00 31 00 09 06"); /* D-36 (spec: 30) */
-    SDO(d, "2F 00 30 00 08 00 00 00", "80 00 30 00 31 00 09 06"); /* D-37 (spec: 30) */
+    SDO(d, "2B 01 30 00 06 00 00 00", "80 01 30 00 12 00 07 06"); /* D-35 */
+    SDO(d, "2F 01 30 00 80 00 00 00", "80 01 30 00 31 00 09 06"); /* D-36 */
+    SDO(d, "2F 00 30 00 08 00 00 00", "80 00 30 00 31 00 09 06"); /* D-37 */
     SDO(d, "2B 00 18 05 03 00 00 00", "80 00 18 05 32 00 09 06"); /* D-38 */
-    SDO(d, "2B 00 18 05 01 00 00 00", "80 00 18 05 32 00 09 06"); /* 1..3 (L404) */
+    SDO(d, "2B 00 18 05 01 00 00 00", "80 00 18 05 32 00 09 06"); /* 1..3 (section 11) */
     SDO(d, "2B 00 18 05 04 00 00 00", "60 00 18 05 00 00 00 00"); /* 4 ms is the least */
     SDO(d, "23 00 18 01 93 02 00 00", "80 00 18 01 02 00 01 06"); /* D-39 */
-    SDO(d, "40 11 10 01 00 00 00 00", "80 11 10 01 00 00 02 06"); /* no 0x1011 (C-09) */
-    SDO(d, "40 14 10 00 00 00 00 00", "80 14 10 00 00 00 02 06"); /* no EMCY */
-    SDO(d, "2F 00 18 02 01 00 00 00", "80 00 18 02 02 00 01 06"); /* type fixed (C-11) */
-    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* 0 = off (C-14) */
-    SDO(d, "40 10 10 02 00 00 00 00", "43 10 10 02 01 00 00 00"); /* sub 2..4 (C-07) */
+    SDO(d, "40 11 10 01 00 00 00 00", "80 11 10 01 00 00 02 06"); /* no 0x1011 in the manual */
+    SDO(d, "40 14 10 00 00 00 00 00", "80 14 10 00 00 00 02 06"); /* no EMCY in the manual */
+    SDO(d, "2F 00 18 02 01 00 00 00", "80 00 18 02 02 00 01 06"); /* type fixed: ro */
+    SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* 0 = off (the EDS default) */
+    SDO(d, "40 10 10 02 00 00 00 00", "43 10 10 02 01 00 00 00"); /* sub 2..4 (sub 0 = 4) */
 }
 
 static void test_alarms_counter_checksum(void)
@@ -345,7 +348,7 @@ static void test_alarms_counter_checksum(void)
         CHECK_EQ(h_read(d, 0x2111, 0), counter);
         CHECK_EQ(h_read(d, 0x2112, 0), sum);
     }
-    CHECK_EQ(h_read(d, 0x1001, 0), 0); /* always 0 */
+    CHECK_EQ(h_read(d, 0x1001, 0), 0); /* "Always 0" */
 }
 
 /* The magnet field is judged in whole percent, rounded: 150.499 % and
@@ -402,7 +405,7 @@ static void test_redundant_channels_are_independent(void)
     h_drain(d);
     h_rx(d, 0x614, "40 00 18 05 00 00 00 00");
     EXPECT_ID(d, 0x594, "4B 00 18 05 64 00 00 00"); /* ch 2 still 100 ms */
-    /* Each channel's 0x3001 reads its own node-ID, 0x13 and 0x14. */
+    /* Each channel's 0x3001 reads its own node-ID, 0x13 and 0x14 (section 6). */
     h_rx(d, 0x613, "40 01 30 00 00 00 00 00");
     EXPECT_ID(d, 0x593, "4F 01 30 00 13 00 00 00");
     h_rx(d, 0x614, "40 01 30 00 00 00 00 00");
@@ -422,7 +425,7 @@ static void test_redundant_channels_are_independent(void)
 }
 
 /* A node-ID set that fails its check at power-on (node-ID 0) gives the
- * channel its own default back: 0x14 on channel 2 (0x3001, R-27). Only
+ * channel its own default back: 0x14 on channel 2 (0x3001). Only
  * where the fake EEPROM holds the second node's area (not the qemu build's
  * 1 KB). */
 static void test_channel2_node_id_default_after_a_bad_set(void)
@@ -444,7 +447,7 @@ static void test_channel2_node_id_default_after_a_bad_set(void)
 
 static void test_group_save(void)
 {
-    /* 0x1010 sub 2 stores the communication group only (C-07). */
+    /* 0x1010 sub 2 stores the communication group only (CiA 301). */
     boot(&gsh_a);
     SDO(d, "2B 00 18 05 F4 01 00 00", "60 00 18 05 00 00 00 00"); /* comm: 500 ms */
     SDO(d, "2F 00 50 00 00 00 00 00", "60 00 50 00 00 00 00 00"); /* mfr */
@@ -461,9 +464,9 @@ static void test_group_save(void)
     CHECK_EQ(h_read(d, 0x1800, 5), 500);
 }
 
-/* The write-cycle count (the 100 000 limit's, L308) survives a restart
- * whole: a save writes the parameters and the LSS record (C-21), and the
- * count read back at start takes the LSS record's too (tools/mutate's
+/* The write-cycle count (the 100 000 limit's, section 7) survives a restart
+ * whole: a save writes the parameters and the LSS record (example 1 saves
+ * 0x3001), and the count read back at start takes the LSS record's too (tools/mutate's
  * survivor: co_store_init's class loop stopping before the LSS class). */
 static void test_write_count_across_restart(void)
 {

@@ -1,6 +1,6 @@
 /*
  * test_hardening.c - the defects a coverage-guided fuzzer and a hostile
- * user found in the stack (issue "Hardening", section 1), one regression
+ * user found in the stack, one regression
  * test each, on the products where they were found: COB-ID rules, signed
  * overflows of the ifm JD, stored sets with a valid CRC but values an SDO
  * write would refuse, NVM that is neither erased nor a record, the angle
@@ -128,13 +128,13 @@ static void test_jd_differential_offset_range(void)
     SDO(d, "2B 14 60 00 D7 DC 00 00", "80 14 60 00 30 00 09 06");
     SDO(d, "23 14 61 00 28 23 00 00", "60 14 61 00 00 00 00 00");
     SDO(d, "23 24 61 00 D8 DC FF FF", "60 24 61 00 00 00 00 00");
-    /* The rescale on a resolution change (R55): 9000 at 0.01 deg is 90 at 1 deg. */
+    /* The rescale on a resolution change: 9000 at 0.01 deg is 90 at 1 deg. */
     SDO(d, "2B 00 60 00 E8 03 00 00", "60 00 60 00 00 00 00 00");
     SDO(d, "40 14 61 00 00 00 00 00", "43 14 61 00 5A 00 00 00");
     SDO(d, "40 24 61 00 00 00 00 00", "43 24 61 00 A6 FF FF FF");
     SDO(d, "2B 00 60 00 0A 00 00 00", "60 00 60 00 00 00 00 00");
     SDO(d, "40 14 61 00 00 00 00 00", "43 14 61 00 28 23 00 00");
-    boot(&jd1xxx); /* (-N/2, N/2]: -17999..18000 at 0.01 deg (L1783-1791) */
+    boot(&jd1xxx); /* (-N/2, N/2]: -17999..18000 at 0.01 deg (JD manual, 9.46) */
     SDO(d, "23 14 61 00 50 46 00 00", "60 14 61 00 00 00 00 00");
     SDO(d, "23 14 61 00 51 46 00 00", "80 14 61 00 30 00 09 06");
     SDO(d, "23 14 61 00 B1 B9 FF FF", "60 14 61 00 00 00 00 00");
@@ -237,7 +237,7 @@ static void test_stored_values_pass_sdo_validation(void)
     co_led_pattern_t g;
     co_led_pattern_t r;
     co_node_led_patterns(d->node, &g, &r);
-    CHECK(r == CO_LED_BLINK); /* R11 */
+    CHECK(r == CO_LED_BLINK); /* "general configuration error" */
 
     /* P+F: a bit-rate code the product does not have. */
     boot(&pf_inx360d);
@@ -261,7 +261,7 @@ static void test_stored_values_pass_sdo_validation(void)
     EXPECT(d, 0x713, "00");
     h_advance(d, 1000);
     for (const co_frame_t *f = h_next(d); f != NULL; f = h_next(d)) {
-        CHECK(f->id != 0x093); /* the GSH-A sends no EMCY at all: the board logs it */
+        CHECK(f->id != 0x093); /* the GSH-A sends no EMCY at all: the board logs it */
     }
     CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
     CHECK_EQ(d->node->store.status[CO_CLS_LSS], CO_STORE_CORRUPT);

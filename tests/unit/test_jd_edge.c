@@ -1,12 +1,11 @@
 /*
  * test_jd_edge.c - the ifm JD1xxx / JD2xxx beyond the manual's example
- * frames (shared/specs/ifm-jd.md, R-rules): the JD1 preset through 2600h
- * as an unsigned bit pattern and its offset normalised into (-N/2, N/2]
- * (R52, R54), the lateral axis' presets with inversion (R51, R52), the
- * 16-bit slope clamped to its type and the 32-bit one not (R53, R56), the
- * fold of negative angles (R49), the temperature (R62), the moving average
- * across 0/360 deg on the JD1 (R59, R54), the LED (R65, R11, C20) and LSS
- * "store" through 3000h/3001h (R46, R47). Node 10 (0x70A, SDO 0x60A).
+ * frames: the JD1 preset through 2600h as an unsigned bit pattern and its
+ * offset normalised into (-N/2, N/2], the lateral axis' presets with
+ * inversion, the 16-bit slope clamped to its type and the 32-bit one not,
+ * the fold of negative angles, the temperature, the moving average across
+ * 0/360 deg on the JD1, the LED and LSS "store" through 3000h/3001h.
+ * Node 10 (0x70A, SDO 0x60A).
  */
 #include "jd.h"
 #include "harness.h"
@@ -46,13 +45,13 @@ static void test_jd1_preset_and_wrap(void)
     SDO(d, "23 12 61 00 00 00 00 00", "60 12 61 00 00 00 00 00"); /* 0 */
     SDO(d, "40 13 60 00 00 00 00 00", "4B 13 60 00 F0 D8 00 00"); /* -10000 */
     SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 00 00 00 00");
-    /* 6020h and 6120h read 0 on the JD1 (L1671). */
+    /* 6020h and 6120h read 0 on the JD1 (manual, section 9.41). */
     SDO(d, "40 20 60 00 00 00 00 00", "4B 20 60 00 00 00 00 00");
     SDO(d, "40 20 61 00 00 00 00 00", "43 20 61 00 00 00 00 00");
 }
 
 /* JD2 lateral axis: 2601h, 6022h and 6122h set the one preset; the offset
- * of an inverted axis is P + r (R52: P - r x multiplier). */
+ * of an inverted axis is P + r (the manual's P - r x multiplier). */
 static void test_jd2_lateral_preset_inverted(void)
 {
     boot(&jd2xxx);
@@ -79,7 +78,7 @@ static void test_jd2_lateral_preset_inverted(void)
     SDO(d, "40 22 61 00 00 00 00 00", "43 22 61 00 2C 01 00 00");
 }
 
-/* R52: a preset sets the offset once, at the angle of that moment; a
+/* A preset sets the offset once, at the angle of that moment; a
  * saved offset comes back at power-on as it was, whatever the angle is
  * then (the preset is not taken again). */
 static void test_jd2_preset_offset_survives_power_cycle(void)
@@ -105,7 +104,7 @@ static int32_t div_round(int32_t v, int32_t k)
     return v >= 0 ? (v + k / 2) / k : -((-v + k / 2) / k);
 }
 
-/* R55: a new resolution carries every preset, offset and differential
+/* A new resolution carries every preset, offset and differential
  * offset into the new unit, on both axes, 16- and 32-bit objects: rounded
  * into a coarser unit, multiplied into a finer one. */
 static void test_jd2_resolution_rescales_everything(void)
@@ -153,7 +152,7 @@ static void test_jd2_resolution_rescales_everything(void)
     }
 }
 
-/* R20: the cyclic time (2200h = 1800h/1801h sub 5) applies at once to
+/* The cyclic time (2200h = 1800h/1801h sub 5) applies at once to
  * both TPDOs, also while operational. */
 static void test_jd2_cyclic_time_while_operational(void)
 {
@@ -175,7 +174,7 @@ static void test_jd2_cyclic_time_while_operational(void)
     CHECK(n2 >= 9u && n2 <= 11u);
 }
 
-/* R61: the gyro rates 3400h..3402h in 0.1 deg/s, +-500 deg/s at most, from
+/* The gyro rates 3400h..3402h in 0.1 deg/s, +-500 deg/s at most, from
  * the angle's change over the 5 ms sample period, the short way round:
  * the JD2's X and Y turn about its X and Y axes, the JD1's Z about Z. */
 static void test_gyro_rates(void)
@@ -213,7 +212,7 @@ static void test_gyro_rates(void)
     }
 }
 
-/* R41, R42: 3000h = node-ID - 1, 0x7E the last (node 127); read with 3001h
+/* 3000h = node-ID - 1, 0x7E the last (node 127); read with 3001h
  * at power-on and reset node after a save: a reset communication keeps
  * the running node-ID and bit rate. */
 static void test_node_number_at_reset_node_only(void)
@@ -231,7 +230,7 @@ static void test_node_number_at_reset_node_only(void)
     CHECK_EQ(d->port.kbps, 500);
 }
 
-/* R2, R64, C33: 3005h = 1 starts the node on its own right after every
+/* 3005h = 1 starts the node on its own right after every
  * boot-up (power-on after a save, and a reset communication); 0 leaves it
  * pre-operational. */
 static void test_autostart(void)
@@ -250,7 +249,7 @@ static void test_autostart(void)
     CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
 }
 
-/* R46: CiA 305 bit-timing indices (0 = 1000 ... 4 = 125, 6 = 50, 7 = 20
+/* CiA 305 bit-timing indices (0 = 1000 ... 4 = 125, 6 = 50, 7 = 20
  * kbit/s) stored by LSS as the 3001h codes (0 = 20 ... 7 = 1000 kbit/s). */
 static void test_lss_bit_timing_codes(void)
 {
@@ -271,7 +270,7 @@ static void test_lss_bit_timing_codes(void)
     }
 }
 
-/* R47: LSS "store" writes the node-ID (1 and 127, the ends, as 3000h 00h
+/* LSS "store" writes the node-ID (1 and 127, the ends, as 3000h 00h
  * and 7Eh) and the manufacturer parameters (2000h-5FFFh) only: an
  * application parameter changed meanwhile (6000h) is not saved with them. */
 static void test_lss_store_node_id_ends(void)
@@ -296,7 +295,7 @@ static void test_lss_store_node_id_ends(void)
     EXPECT(d, 0x5FF, "4B 00 60 00 0A 00 00 00"); /* 0.01 deg: not stored by LSS */
 }
 
-/* R59: 3100h = N averages the last N samples (fewer while the window
+/* 3100h = N averages the last N samples (fewer while the window
  * fills); a new N starts a new window. */
 static void test_moving_average_window(void)
 {
@@ -325,7 +324,7 @@ static void test_moving_average_window(void)
     }
 }
 
-/* R59 with R54 on the JD1: two samples average the short way round,
+/* The moving average on the JD1: two samples average the short way round,
  * from the second sample of a new window on (359 and 1 deg: 0; 1 and 359:
  * 0; 10 and 160: 85); exactly half a turn apart either midpoint is as
  * near, and the device takes the one between the two readings as 0..360
@@ -357,7 +356,7 @@ static void test_jd1_average_of_two(void)
     }
 }
 
-/* R59 with R54: the JD1 turning one way for many turns under the longest
+/* The moving average with the JD1 turning one way for many turns under the longest
  * average (250 samples): the output keeps following in 0..360 deg, the
  * mean of the last 250 angles (the averaged values stay within a turn, so
  * nothing grows with the turns). 1 deg a sample, 10 000 samples. */
@@ -381,7 +380,7 @@ static void test_jd1_longest_average_many_turns(void)
     CHECK_EQ(bad, 0);
 }
 
-/* R49: beyond +-90 deg the JD2 folds back exactly: 100.006 deg is 79.994
+/* Beyond +-90 deg the JD2 folds back exactly: 100.006 deg is 79.994
  * (79.99 at 0.01 deg), 100.005 is 79.995 (80.00), and the same negative. */
 static void test_jd2_fold_is_exact(void)
 {
@@ -404,7 +403,7 @@ static void test_jd2_fold_is_exact(void)
     CHECK_EQ((int16_t)h_read(d, 0x6020, 0), -4500);
 }
 
-/* R18: transmission type 254 without an event timer sends a TPDO when its
+/* Transmission type 254 without an event timer sends a TPDO when its
  * data changed, both TPDOs, and nothing while the data stay the same. */
 static void test_change_of_state_both_tpdos(void)
 {
@@ -428,7 +427,7 @@ static void test_change_of_state_both_tpdos(void)
     CHECK(n2 >= 1u);
 }
 
-/* The TPDOs' factory settings (spec section 2, C10): COB-IDs 180h and
+/* The TPDOs' factory settings (manual, sections 8.9.1 and 8.9.2): COB-IDs 180h and
  * 280h + node-ID, TPDO1 inhibit 0,
  * TPDO2 inhibit 1 as printed; JD2 maps both slopes into each TPDO, the JD1
  * its one slope (the second entry names 6020h, unused). */
@@ -460,9 +459,9 @@ static void test_tpdo_defaults(void)
     }
 }
 
-/* R53: the 16-bit slope is clamped to INTEGER16 only; R56: the 32-bit one
+/* The 16-bit slope is clamped to INTEGER16 only; the 32-bit one
  * carries the same sum unclamped. A differential offset beyond +-90 deg is
- * refused (spec 6014h/6114h, 0x06090030), so only a stored offset reaches
+ * refused (6014h/6114h, 0x06090030), so only a stored offset reaches
  * the clamp: written into the product's RAM here. */
 static void test_jd2_slope_limits(void)
 {
@@ -485,7 +484,7 @@ static void test_jd2_slope_limits(void)
     SDO(d, "40 10 61 00 00 00 00 00", "43 10 61 00 58 98 00 00"); /* 39000 */
 }
 
-/* R49: beyond -90 deg the output folds back too; angles wrap first. */
+/* Beyond -90 deg the output folds back too; angles wrap first. */
 static void test_jd2_negative_fold(void)
 {
     boot(&jd2xxx);
@@ -494,7 +493,7 @@ static void test_jd2_negative_fold(void)
     SDO(d, "40 20 60 00 00 00 00 00", "4B 20 60 00 D0 07 00 00"); /* -200 = 160: 20.00 */
 }
 
-/* R62: 3411h, 0.1 degC, negative as two's complement. */
+/* 3411h, 0.1 degC, negative as two's complement. */
 static void test_temperature(void)
 {
     boot(&jd2xxx);
@@ -506,7 +505,7 @@ static void test_temperature(void)
     SDO(d, "40 11 34 00 00 00 00 00", "4B 11 34 00 CE FF 00 00"); /* -5.0 */
 }
 
-/* R59 with R54: the JD1's moving average crosses 0/360 deg the short way,
+/* The JD1's moving average crosses 0/360 deg the short way,
  * in both directions: every output on the way is within the window of the
  * inputs averaged (359..1 deg), never a value across the circle. */
 static void test_jd1_moving_average_across_zero(void)
@@ -533,9 +532,10 @@ static void test_jd1_moving_average_across_zero(void)
     CHECK_EQ(bad, 0);
 }
 
-/* R65/C20: green on in pre-operational, flashing in operational; red wins
+/* Green on in pre-operational, flashing in operational (the manual's LED
+ * table, section 7); red wins
  * (single flash: warning level, double: guard event, flashes: corrupt
- * stored parameters, R11) and then green is off. */
+ * stored parameters) and then green is off. */
 static void test_leds(void)
 {
     boot(&jd2xxx);
@@ -597,7 +597,7 @@ static void test_lss_activate_bit_timing(void)
     CHECK_EQ(d->port.bitrate_calls, calls + 2u);
 }
 
-/* LSS "store" writes 3000h/3001h (R47): an unconfigured node-ID (0xFF)
+/* LSS "store" writes 3000h/3001h: an unconfigured node-ID (0xFF)
  * and no bit timing leave them as they are; an EEPROM that refuses the
  * write answers error 2. */
 static void test_lss_store_edges(void)

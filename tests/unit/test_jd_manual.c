@@ -1,9 +1,14 @@
 /*
- * test_jd_manual.c - the frames of the ifm JD1xxx/JD2xxx manual
- * (shared/specs/ifm-jd.md section 4.1: N, BU, A-E, T) and the derived
- * frames of section 4.2 (D-...), on node 10. Every manual write uses 22h
- * (size not indicated) with 4 data bytes, also to 1- and 2-byte objects
- * (R28). Corrected frames (C3, C5, C19) say so on their line.
+ * test_jd_manual.c - the frames of the ifm JD1xxx/JD2xxx manual and the
+ * replies and follow-ups derived from them, on node 10. Labels: N are its
+ * NMT frames (section 6.1), BU the boot-up; A to E its worked examples in
+ * the order printed (A: a TPDO every 100 ms, B: gyro and acceleration on
+ * TPDO2, C: node number 50, D: bit rate and 2300h, E: preset), each step
+ * numbered; T single frames of its object sections; D-... the frames
+ * derived here. Every manual write uses 22h (size not indicated) with 4
+ * data bytes, also to 1- and 2-byte objects: the object's length counts.
+ * Frames the manual misprints are tested corrected and say so on their
+ * line.
  */
 #include "jd.h"
 #include "harness.h"
@@ -37,7 +42,7 @@ static void test_nmt_frames(void)
     h_drain(d);
     h_rx(d, 0x000, "82 00"); /* N7 */
     EXPECT(d, 0x70A, "00");
-    h_rx(d, 0x000, "81 0A"); /* N8, as CiA 301 codes reset node (C19) */
+    h_rx(d, 0x000, "81 0A"); /* N8, as CiA 301 codes reset node (the manual prints 82h) */
     EXPECT(d, 0x70A, "00");
 }
 
@@ -77,8 +82,8 @@ static void test_b_tpdo2_mapping_example(void)
 {
     boot(&jd2xxx);
     SDO(d, "22 01 18 01 00 00 00 80", "60 01 18 01 00 00 00 00"); /* B1, D-B1 */
-    SDO(d, "22 01 1A 00 00 00 00 80", "60 01 1A 00 00 00 00 00"); /* B2 as printed (R28) */
-    /* B3 as printed writes sub 0 with 0x10 entries (C5): entry 3 names no
+    SDO(d, "22 01 1A 00 00 00 00 80", "60 01 1A 00 00 00 00 00"); /* B2 as printed: its stray 80 is beyond the 1-byte object */
+    /* B3 as printed writes sub 0 (meant: sub 1) with 0x10 entries: entry 3 names no
      * object (the mapping has two), CiA 301's 0x06020000. */
     SDO(d, "22 01 1A 00 10 00 00 34", "80 01 1A 00 00 00 02 06");
     SDO(d, "22 01 1A 01 10 00 00 34", "60 01 1A 01 00 00 00 00"); /* B3 corrected, D-B3 */
@@ -105,7 +110,7 @@ static void test_c_node_number_example(void)
 {
     boot(&jd2xxx);
     SDO(d, "40 00 30 00 00 00 00 00", "4F 00 30 00 09 00 00 00"); /* D-S5 */
-    /* C1 corrected: 31h for node 50 (C3); the printed 09 keeps node 10. */
+    /* C1 corrected: 31h for node 50, as the text says; the printed 09 keeps node 10. */
     SDO(d, "22 00 30 00 31 00 00 00", "60 00 30 00 00 00 00 00"); /* D-C1 */
     SDO(d, "22 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00"); /* C2 */
     h_drain(d);
@@ -124,7 +129,8 @@ static void test_d_bitrate_save_with_reset(void)
     SDO(d, "22 01 30 00 05 00 00 00", "60 01 30 00 00 00 00 00"); /* D1 */
     h_drain(d);
     CHECK_EQ(d->port.kbps, 125); /* a new code waits for the reset */
-    /* D2 with the code of L1113 (C9); confirmation first, then the reset. */
+    /* D2 with the code of section 9.17 (55AAAA55h; the example prints
+     * "Article type" in its middle bytes); confirmation first, then the reset. */
     h_rx(d, 0x60A, "22 00 23 00 55 AA AA 55");
     EXPECT(d, 0x58A, "60 00 23 00 00 00 00 00"); /* D-D2 */
     h_advance(d, 1);
@@ -161,7 +167,7 @@ static void test_t1_inhibit_only_while_invalid(void)
     SDO(d, "22 00 18 03 E8 03 00 00", "60 00 18 03 00 00 00 00");
     SDO(d, "22 00 18 01 8A 01 00 00", "60 00 18 01 00 00 00 00");
     SDO(d, "40 00 18 03 00 00 00 00", "4B 00 18 03 E8 03 00 00");
-    SDO(d, "40 01 18 03 00 00 00 00", "4B 01 18 03 01 00 00 00"); /* TPDO2 default 1 (C10) */
+    SDO(d, "40 01 18 03 00 00 00 00", "4B 01 18 03 01 00 00 00"); /* TPDO2 default 1, as printed (8.9.2) */
     /* Valid is bit 31 clear, whatever the CAN-ID: an odd one too. */
     SDO(d, "22 00 18 01 A1 01 00 80", "60 00 18 01 00 00 00 00");
     SDO(d, "22 00 18 01 A1 01 00 00", "60 00 18 01 00 00 00 00");
@@ -240,7 +246,7 @@ static void test_heartbeat_consumer(void)
     CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
     h_drain(d);
     h_advance(d, 60000);
-    EXPECT_ID(d, 0x08A, "30 81 11 00 00 00 00 00"); /* heartbeat event (R13) */
+    EXPECT_ID(d, 0x08A, "30 81 11 00 00 00 00 00"); /* heartbeat event (manual, section 9.13) */
     CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
     h_rx(d, 0x705, "05");
     EXPECT_ID(d, 0x08A, "00 00 00 00 00 00 00 00");
@@ -285,7 +291,7 @@ static void test_moving_average(void)
     CHECK_EQ(h_read(d, 0x6010, 0), 1000);
 }
 
-/* ---- LSS (R44-R47, D-S9..D-S11) --------------------------------------- */
+/* ---- LSS (manual, section 6.3; D-S9..D-S11) ---------------------------- */
 
 static void lss(const char *req, const char *resp, int line)
 {
@@ -432,7 +438,7 @@ static void test_can_error_emcy(void)
     boot(&jd2xxx);
     h_drain(d);
     co_node_set_can_state(d->node, CO_CAN_PASSIVE);
-    EXPECT(d, 0x08A, "20 81 11 00 00 00 00 00"); /* R34: 8120h */
+    EXPECT(d, 0x08A, "20 81 11 00 00 00 00 00"); /* CiA 301's 8120h */
     SDO(d, "2B 17 10 00 64 00 00 00", "60 17 10 00 00 00 00 00"); /* heartbeat 100 ms */
     h_drain(d);
     co_node_set_can_state(d->node, CO_CAN_BUSOFF);

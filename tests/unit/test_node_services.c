@@ -125,7 +125,7 @@ static const co_node_cfg_t n_cfg = {
 };
 
 /* The test dictionary where reset communication applies the stored
- * node-ID too (as the Gefran GSH's manual C-24 asks). */
+ * node-ID too (the Gefran GSH-A's "sensor reset", read as any reset). */
 static const co_node_cfg_t n_comm_id_cfg = {
     .od = &n_od,
     .ops = &n_ops,

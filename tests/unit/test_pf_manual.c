@@ -1,13 +1,12 @@
 /*
  * test_pf_manual.c - every frame example of the P+F INX360D/INY360D manual
- * (shared/specs/pf-inx-iny.md section 4.1, V-vectors) and the spec's
- * derived sequences (section 4.2, D-vectors). Default node-ID 1; the
- * manual's examples use nodes 9, 5 and 1, reached through 0x2000.
+ * (V1.., in the order printed) and sequences derived from them here (D1..).
+ * Default node-ID 1; the manual's examples use nodes 9, 5 and 1, reached
+ * through 0x2000.
  *
- * Abort codes: the spec suggests 0x06090030 for every rejected value; a
- * value beyond a plain minimum or maximum gets CiA 301's more precise
- * "too low" (0x06090032) / "too high" (0x06090031) here, as for every
- * product of this firmware. Lines that differ from the spec say so.
+ * Abort codes: a value beyond a plain minimum or maximum gets CiA 301's
+ * precise "too low" (0x06090032) / "too high" (0x06090031), as for every
+ * product of this firmware; other rejected values 0x06090030.
  */
 #include "pf.h"
 #include "harness.h"
@@ -46,7 +45,7 @@ static void test_v1_to_v7_boot_and_nmt(void)
 {
     boot(&pf_iny360d);
     renumber(9);
-    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP); /* R3: never operational by itself */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP); /* never operational by itself (6.1) */
     h_power_cycle(d);
     EXPECT(d, 0x709, "00"); /* V1 */
     h_rx(d, 0x000, "01 09"); /* V4 */
@@ -70,18 +69,18 @@ static void test_v8_node_id_and_d1_to_d5(void)
 {
     boot(&pf_inx360d);
     SDO(d, "2F 00 20 00 0F 00 00 00", "60 00 20 00 00 00 00 00"); /* V8, D1 */
-    SDO(d, "40 00 20 00 00 00 00 00", "4F 00 20 00 0F 00 00 00"); /* pending value (G15) */
-    h_rx(d, 0x000, "82 01"); /* reset communication keeps the old ID (C8) */
+    SDO(d, "40 00 20 00 00 00 00 00", "4F 00 20 00 0F 00 00 00"); /* the stored, pending value */
+    h_rx(d, 0x000, "82 01"); /* reset communication keeps the old ID (6.2: "Reset sensor") */
     EXPECT(d, 0x701, "00");
     h_rx(d, 0x000, "81 01"); /* D2 */
     EXPECT(d, 0x70F, "00");  /* D3 */
     SDO(d, "40 00 10 00 00 00 00 00", "43 00 10 00 9A 01 00 00");
-    /* D4: 0x80 not adopted (spec: 0x06090030; here "too high"). */
+    /* D4: 0x80 not adopted ("too high"). */
     SDO(d, "2F 00 20 00 80 00 00 00", "80 00 20 00 31 00 09 06");
     SDO(d, "2F 00 20 00 00 00 00 00", "80 00 20 00 32 00 09 06");
     SDO(d, "40 00 20 00 00 00 00 00", "4F 00 20 00 0F 00 00 00"); /* unchanged */
     h_power_cycle(d);
-    EXPECT(d, 0x70F, "00"); /* survived without a save command (L298) */
+    EXPECT(d, 0x70F, "00"); /* survived without a save command (6.2) */
     renumber(1);
     SDO(d, "40 00 20 00 00 00 00 00", "4F 00 20 00 01 00 00 00"); /* D5 */
 }
@@ -149,7 +148,7 @@ static void test_v14_inhibit_ff_each_calculation(void)
         n++;
     }
     CHECK(n >= 19 && n <= 21);
-    /* V14: inhibit 2710h = 1 s (writable while valid, C11). */
+    /* V14: inhibit 2710h = 1 s (written while valid, as the manual does). */
     SDO(d, "2B 00 18 03 10 27 00 00", "60 00 18 03 00 00 00 00");
     h_drain(d);
     h_advance(d, 3000000);
@@ -181,7 +180,7 @@ static void test_v17_emcy_and_d27(void)
     h_advance(d, 10000);
     EXPECT(d, 0x089, "00 00 00 00 00 00 00 00"); /* D27: once, when the last clears */
     EXPECT_NONE(d);
-    /* Undervoltage: 3100h, register 05h; run off, err on (L227). */
+    /* Undervoltage: 3100h, register 05h; run off, err on (5.3). */
     d->fault = PF_FAULT_UNDERVOLTAGE;
     h_advance(d, 10000);
     EXPECT(d, 0x089, "00 31 05 00 00 00 00 00");
@@ -207,7 +206,7 @@ static void test_v17_emcy_and_d27(void)
 static void test_v18_heartbeat_d21(void)
 {
     boot(&pf_inx360d);
-    /* A 4-byte write to the 16-bit object: length too high (C5). */
+    /* A 4-byte write to the 16-bit object (CiA 301; the manual says 32-bit): length too high. */
     SDO(d, "23 17 10 00 E8 03 00 00", "80 17 10 00 12 00 07 06");
     SDO(d, "2B 17 10 00 E8 03 00 00", "60 17 10 00 00 00 00 00"); /* D21 */
     h_drain(d);
@@ -243,7 +242,7 @@ static void test_v19_v20_guarding_d22_d24(void)
     h_rx_frame(d, &rtr);
     h_drain(d);
     h_advance(d, 310000);
-    EXPECT(d, 0x081, "30 81 11 00 00 00 00 00"); /* 8130h (C4) */
+    EXPECT(d, 0x081, "30 81 11 00 00 00 00 00"); /* CiA 301's 8130h, where the manual prints 3081h */
     CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
     h_rx_frame(d, &rtr);
     EXPECT(d, 0x701, "FF"); /* next guard answer: pre-operational */
@@ -259,12 +258,13 @@ static void test_v21_to_v24_zero_point_d12_to_d18(void)
     SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 00 00 00 00"); /* D14 */
     SDO(d, "2B 14 60 00 38 FF 00 00", "60 14 60 00 00 00 00 00"); /* V24: -20.0 */
     SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 48 0D 00 00"); /* D15: 340.0 */
-    /* D16: reversed, scaling off: 3600 - 1317 = 2283; 0 stays 0 (C14). */
+    /* D16: reversed, scaling off: 3600 - 1317 = 2283; 0 stays 0 (not the
+     * manual's 360 - x = 360.0, outside its 0..359.9). */
     SDO(d, "2F 11 60 00 01 00 00 00", "60 11 60 00 00 00 00 00"); /* V22 */
     SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 EB 08 00 00");
     settle(0, 0);
     SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 00 00 00 00");
-    /* D17 / D18 (spec: 0x06090030; here "too high"). */
+    /* D17 / D18 ("too high"). */
     SDO(d, "2B 12 60 00 10 0E 00 00", "80 12 60 00 31 00 09 06");
     SDO(d, "2F 11 60 00 04 00 00 00", "80 11 60 00 31 00 09 06");
     SDO(d, "2B 10 60 00 00 00 00 00", "80 10 60 00 02 00 01 06"); /* D19 */
@@ -275,8 +275,8 @@ static void test_v21_to_v24_zero_point_d12_to_d18(void)
     SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 00 00 00 00");
 }
 
-/* An aborted write changes nothing. The P+F stores every write at once
- * (G2); when that save fails (the EEPROM refuses the write) the write is
+/* An aborted write changes nothing. The P+F stores every write at once;
+ * when that save fails (the EEPROM refuses the write) the write is
  * answered 06060000h, and the value, what its hook moved with it (the
  * preset's offset) and what it set going (the heartbeat's timer) stay as
  * they were. */
@@ -309,8 +309,8 @@ static void test_failed_autosave_changes_nothing(void)
     CHECK_EQ(h_read(d, 0x6012, 0), 0);
 }
 
-/* R56: the zero point sets the offset once, at the position of that
- * moment; stored at once (G2), the offset comes back at power-on as it
+/* The zero point sets the offset once, at the position of that
+ * moment (7.3.2); stored at once, the offset comes back at power-on as it
  * was, the sensor elsewhere by then (the preset is not taken again). */
 static void test_zero_point_kept_across_power_cycle(void)
 {
@@ -326,7 +326,7 @@ static void test_zero_point_kept_across_power_cycle(void)
     SDO(d, "40 13 60 00 00 00 00 00", "4B 13 60 00 EB 08 00 00"); /* 2283, as set */
 }
 
-/* R56 on the INY's Y axis: 6022h is the lateral zero point (6020h reads
+/* The zero point on the INY's Y axis: 6022h is the lateral zero point (6020h reads
  * it at once, scaling on), the X axis untouched. */
 static void test_lateral_zero_point(void)
 {
@@ -385,21 +385,21 @@ static void test_d25_stopped_and_d26_store(void)
     h_rx(d, 0x601, "40 00 20 00 00 00 00 00");
     EXPECT_NONE(d); /* D25 */
     h_rx(d, 0x000, "80 01");
-    /* Autonomous store (G2): written values survive a power cycle unsaved. */
+    /* Autonomous store: written values survive a power cycle unsaved. */
     SDO(d, "2B 14 60 00 38 FF 00 00", "60 14 60 00 00 00 00 00");
     SDO(d, "2F 00 20 00 07 00 00 00", "60 00 20 00 00 00 00 00");
     SDO(d, "40 10 10 01 00 00 00 00", "43 10 10 01 03 00 00 00");
     h_power_cycle(d);
     EXPECT(d, 0x707, "00");
     SDO(d, "40 14 60 00 00 00 00 00", "4B 14 60 00 38 FF 00 00");
-    /* D26: save and load; load keeps node-ID and bit rate (R51). */
+    /* D26: save and load; load keeps node-ID and bit rate (a decision). */
     SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
     SDO(d, "23 11 10 01 6C 6F 61 64", "60 11 10 01 00 00 00 00");
     SDO(d, "40 14 60 00 00 00 00 00", "4B 14 60 00 38 FF 00 00"); /* RAM until reset */
     h_rx(d, 0x000, "81 07");
     EXPECT(d, 0x707, "00");
     SDO(d, "40 14 60 00 00 00 00 00", "4B 14 60 00 00 00 00 00");
-    SDO(d, "40 00 18 02 00 00 00 00", "4F 00 18 02 01 00 00 00"); /* type 1 (G1) */
+    SDO(d, "40 00 18 02 00 00 00 00", "4F 00 18 02 01 00 00 00"); /* type 1 (CiA 410's default) */
 }
 
 static void test_eeprom_checksum_6300(void)
@@ -412,7 +412,7 @@ static void test_eeprom_checksum_6300(void)
     h_power_cycle(d);
     EXPECT(d, 0x701, "00");
     h_advance(d, 1000);
-    EXPECT(d, 0x081, "00 63 01 00 00 00 00 00"); /* R52 */
+    EXPECT(d, 0x081, "00 63 01 00 00 00 00 00"); /* 6300h: the stored set is bad */
     co_led_pattern_t run;
     co_led_pattern_t err;
     co_node_led_patterns(d->node, &run, &err);
@@ -426,7 +426,7 @@ static void test_dynamic_mapping_and_cobid(void)
 {
     boot(&pf_iny360d);
     settle(10000, 20000);
-    /* Mapping only while invalid; COB-ID only while invalid (G3, G12). */
+    /* Mapping only while invalid; COB-ID only while invalid (CiA 301). */
     SDO(d, "2F 00 1A 00 01 00 00 00", "80 00 1A 00 00 00 01 06");
     SDO(d, "23 00 18 01 81 02 00 00", "80 00 18 01 30 00 09 06");
     SDO(d, "23 00 18 01 81 01 00 80", "60 00 18 01 00 00 00 00");

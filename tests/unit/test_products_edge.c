@@ -1,13 +1,13 @@
 /*
  * test_products_edge.c - the product registry and the DST and P+F
  * behaviour the manuals' example frames leave out: product_find() and the
- * bit-rate code tables; on the DST X730 (specs/danfoss-dst-x730.md) the
- * values it accepts and refuses (heartbeat 0, transmission types C-18,
+ * bit-rate code tables; on the DST X730 the
+ * values it accepts and refuses (heartbeat 0, transmission types,
  * resolutions, EMCY COB-ID), the node-ID pair written only when it
- * changes (B-44), big-endian PDOs after a reset (0x5001 = 0), an error
+ * changes, big-endian PDOs after a reset (0x5001 = 0), an error
  * raised while stopped reported once allowed again, the error behaviour
  * 0x4000 = 0 in pre-operational, an EEPROM that cannot be read (0x4001
- * bit 6); on the P+F (specs/pf-inx-iny.md) the fixed resolution (L760),
+ * bit 6); on the P+F the fixed resolution (0.1 deg),
  * the error LED and 6300h for stored sets that cannot be used. For every
  * product: each TPDO's mapping names objects of the mapped length and
  * covers exactly the bytes the frame has (CiA 301: a consumer checks the
@@ -84,9 +84,9 @@ static void test_dst_values(void)
     SDO(d, "2B 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00"); /* 0: off */
     SDO(d, "2B 17 10 00 13 00 00 00", "80 17 10 00 30 00 09 06"); /* 1-19 refused */
     SDO(d, "2B 17 10 00 01 00 00 00", "80 17 10 00 30 00 09 06"); /* from 1 on (object 1017h) */
-    /* Event timer: 0 off, 4..65535 ms; 1..3 refused from 1 on (C-17). */
+    /* Event timer: 0 off, 4..65535 ms; 1..3 refused from 1 on (section 12, examples 12, 13). */
     SDO(d, "2B 00 18 05 01 00 00 00", "80 00 18 05 30 00 09 06");
-    /* C-18: 1..240 and 254 only. */
+    /* Transmission types 1..240 and 254 only (section 12, 0x1800 sub 2). */
     SDO(d, "2F 00 18 02 FF 00 00 00", "80 00 18 02 30 00 09 06");
     SDO(d, "2F 00 18 02 FC 00 00 00", "80 00 18 02 30 00 09 06");
     SDO(d, "2F 00 18 02 F1 00 00 00", "80 00 18 02 30 00 09 06");
@@ -222,7 +222,7 @@ static void test_dst_big_endian_after_reset(void)
 
 /* No EMCY in stopped: an error raised there is reported when EMCY is
  * allowed again. With 0x4000 = 0 a new error in pre-operational keeps the
- * state (only operational drops to pre-operational, C-42). */
+ * state (only operational drops to pre-operational). */
 static void test_dst_error_while_stopped(void)
 {
     boot_dst();
@@ -261,7 +261,7 @@ static void boot_pf(const product_t *p)
     EXPECT(d, 0x701, "00");
 }
 
-/* L760: the resolution is fixed at 0.1 deg. */
+/* The resolution is fixed at 0.1 deg (P+F manual, section 7.3). */
 static void test_pf_resolution_fixed(void)
 {
     boot_pf(&pf_inx360d);
@@ -270,7 +270,7 @@ static void test_pf_resolution_fixed(void)
     SDO(d, "40 00 60 00 00 00 00 00", "4B 00 60 00 64 00 00 00");
 }
 
-/* The err LED (L212-227): bus-off on (run off), Y out of range 1x flash. */
+/* The err LED (P+F manual, section 5.3): bus-off on (run off), Y out of range 1x flash. */
 static void test_pf_leds(void)
 {
     boot_pf(&pf_iny360d);
@@ -286,7 +286,7 @@ static void test_pf_leds(void)
     CHECK(run == CO_LED_BLINK && err == CO_LED_FLASH1);
 }
 
-/* 6300h (R52) for a stored set that cannot be used: unreadable EEPROM,
+/* 6300h (CiA 301) for a stored set that cannot be used: unreadable EEPROM,
  * or a node-ID / bit-rate record that fails its check; err LED 2x flash. */
 static void test_pf_stored_set_unusable(void)
 {

@@ -445,8 +445,8 @@ static void test_incl_axis_bounds(void)
 
 /* Two axes, circular outputs (0..359.9 deg), the filter on: each axis keeps
  * its own continuous angle. With one value shared by both, the second axis
- * was unwrapped against the first one's input (170 / -100 deg in gave
- * 171.4 / 79.3 deg out; issue 12). */
+ * would be unwrapped against the first one's input (170 / -100 deg in
+ * would give 171.4 / 79.3 deg out). */
 static void test_incl_two_axes_circular(void)
 {
     co_incl_para_t p = {.resolution = 100, .op = {CO_INCL_OP_SCALING, CO_INCL_OP_SCALING}};
@@ -494,7 +494,7 @@ static void test_led_patterns(void)
     CHECK(co_led_level(CO_LED_FLASH2, t, 450000, &next));
     CHECK(!co_led_level(CO_LED_FLASH2, t, 700000, &next) && next == 900000);
     CHECK(co_led_level(CO_LED_FLICKER, t, 10000, &next) && next == 40000);
-    /* The DST's single flash: 500 ms on, 500 ms off (C-38). */
+    /* The DST's single flash: 500 ms on, 500 ms off (its manual's legend). */
     CHECK(co_led_level(CO_LED_FLASH1, &dst_led, 499000, &next) && next == 1000);
     CHECK(!co_led_level(CO_LED_FLASH1, &dst_led, 500000, &next) && next == 500000);
     /* Node state to pattern. */

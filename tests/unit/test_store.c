@@ -169,7 +169,7 @@ static void test_write_limit(void)
     SAVE_OK(); /* the 100,000th */
     h_advance(d, 1000);
     EXPECT(d, 0xFF, "00 10 00 00 20 00 00 00"); /* bit 5: flash limit reached */
-    SDO(d, "23 10 10 01 73 61 76 65", "80 10 10 01 20 00 00 08"); /* refused (C-41) */
+    SDO(d, "23 10 10 01 73 61 76 65", "80 10 10 01 20 00 00 08"); /* refused at the limit (a decision) */
     SDO(d, "2F F0 20 00 05 00 00 00", "60 F0 20 00 00 00 00 00");
     SDO(d, "2F F1 20 00 05 00 00 00", "80 F1 20 00 20 00 00 08");
     h_power_cycle(d);

@@ -370,8 +370,8 @@ static void test_read_fault_in_group_save(void)
             CHECK(ok);
             break;
         }
-        /* The code of a failed save is the subject of issue 9 section 2; what
-         * matters here is the abort and that a whole stored set survived. */
+        /* Not the abort code of a failed save: what matters here is the
+         * abort and that a whole stored set survived. */
         CHECK(!ok);
         refused++;
         set_all(100, 200, 0x11223344u, 300);
