@@ -79,13 +79,7 @@ void app_sync_can_state(app_t *a, unsigned node)
 
 void app_sim_can(app_t *a, unsigned node, co_can_state_t s, uint32_t hold_ms, uint32_t now)
 {
-    uint32_t kbps = a->ports[node].kbps;
-    if (kbps == 0u) {
-        kbps = 125u; /* a code the product does not define: the usual default */
-    }
-    /* 128 x 11 recessive bits at the node's bit rate, rounded up */
-    uint32_t recovery_us = (LP_BUSOFF_RECOVERY_BITS * 1000u + kbps - 1u) / kbps;
-    lp_sim_can(&a->ports[node], s, now, hold_ms * 1000u, recovery_us);
+    lp_sim_can_command(&a->ports[node], s, now, hold_ms);
     app_sync_can_state(a, node);
 }
 

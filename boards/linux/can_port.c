@@ -221,6 +221,17 @@ void lp_sim_can(lp_port_t *p, co_can_state_t s, uint32_t now, uint32_t hold_us,
     }
 }
 
+void lp_sim_can_command(lp_port_t *p, co_can_state_t s, uint32_t now, uint32_t hold_ms)
+{
+    uint32_t kbps = p->kbps;
+    if (kbps == 0u) {
+        kbps = 125u; /* a code the product does not define: the usual default */
+    }
+    /* 128 x 11 recessive bits at the node's bit rate, rounded up */
+    uint32_t recovery_us = (LP_BUSOFF_RECOVERY_BITS * 1000u + kbps - 1u) / kbps;
+    lp_sim_can(p, s, now, hold_ms * 1000u, recovery_us);
+}
+
 static void report_drops(lp_port_t *p, uint32_t now)
 {
     if (p->rx_unlogged != 0u && lp_rate_allow(&p->rx_rate, now, 1u)) {

@@ -137,6 +137,11 @@ co_can_state_t lp_can_state(const lp_port_t *p);
 void lp_sim_can(lp_port_t *p, co_can_state_t s, uint32_t now, uint32_t hold_us,
                 uint32_t recovery_us);
 
+/* A `can` command (cmd.h) on this port at time now: lp_sim_can with the
+ * recovery of 128 x 11 bits at the node's bit rate (125 kbit/s when its
+ * code means none), a bus-off's hold given in milliseconds. */
+void lp_sim_can_command(lp_port_t *p, co_can_state_t s, uint32_t now, uint32_t hold_ms);
+
 /* Log the dropped frames not logged yet, whatever the rate (at exit). */
 void lp_report_drops(lp_port_t *p);
 
