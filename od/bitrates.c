@@ -9,6 +9,23 @@ const uint16_t product_kbps_pf[16] = {[1] = 125, [2] = 250, [4] = 500, [8] = 100
 
 uint16_t product_kbps(const product_t *p, uint8_t code)
 {
-    return (p->kbps != NULL && code < 16u) ? p->kbps[code] : 0u;
+    const uint16_t *table = p->cfg != NULL ? p->cfg->kbps : NULL;
+    return (table != NULL && code < 16u) ? table[code] : 0u;
+}
+
+uint8_t product_eds_bitrates(const product_t *p)
+{
+    /* The rates of the PRODUCT_BR_* bits, bit 0 first (CiA 306 BaudRate_x). */
+    static const uint16_t eds_kbps[8] = {10, 20, 50, 125, 250, 500, 800, 1000};
+    uint8_t bits = 0;
+    for (uint8_t code = 0; code < 16u; code++) {
+        uint16_t kbps = product_kbps(p, code);
+        for (unsigned i = 0; i < 8u; i++) {
+            if (kbps == eds_kbps[i]) {
+                bits |= (uint8_t)(1u << i);
+            }
+        }
+    }
+    return bits;
 }
 

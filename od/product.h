@@ -73,12 +73,11 @@ struct product {
      */
     void (*sample)(void *mem, const int32_t values[], uint32_t faults);
     const void *variant;     /* product-specific constants */
-    /* For the EDS (CiA 306), from the same tables the firmware runs: */
+    /* For the EDS (CiA 306), from the same tables the firmware runs: the
+     * bit rates and LSS support are the config's (product_kbps(),
+     * product_eds_bitrates(), product_lss()), written there only. */
     const co_node_cfg_t *cfg;    /* node 0's configuration and dictionary */
     const char *vendor;          /* vendor name */
-    uint8_t bitrates;            /* supported bit rates, PRODUCT_BR_* bits */
-    const uint16_t *kbps;        /* kbit/s of each bit-rate code (0: unused), 16 codes */
-    bool lss;                    /* LSS slave (CiA 305) */
 #ifndef CO_OD_NO_NAMES
     /* EDS values the manual wants other than the device's (product_eds.h),
      * ended by index 0; NULL: none. Not in MCU images (they print no EDS). */
@@ -101,8 +100,20 @@ extern const uint16_t product_kbps_cia[16];  /* 0 = 1000 ... 7 = 20: DST, GSH-A 
 extern const uint16_t product_kbps_ifm[16];  /* 0 = 20 ... 7 = 1000: ifm JD (3001h) */
 extern const uint16_t product_kbps_pf[16];   /* 1 = 125, 2 = 250, 4 = 500, 8 = 1000: P+F */
 
-/* kbit/s of code for product p, 0 if the code means nothing. */
+/* kbit/s of code for product p (its config's table, co_node_cfg_t.kbps),
+ * 0 if the code means nothing or p has no config or table. */
 uint16_t product_kbps(const product_t *p, uint8_t code);
+
+/* The PRODUCT_BR_* bits of the rates p's codes give (product_kbps()): the
+ * bit rates its EDS declares. A rate CiA 306 has no key for (100 kbit/s)
+ * is left out; 0 without a config or table. */
+uint8_t product_eds_bitrates(const product_t *p);
+
+/* Whether p's node 0 is an LSS slave (CiA 305): its config's lss. */
+static inline bool product_lss(const product_t *p)
+{
+    return p->cfg != NULL && p->cfg->lss;
+}
 
 /* Every product, in --list-products order; NULL-terminated. */
 extern const product_t *const product_list[];

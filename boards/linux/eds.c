@@ -159,14 +159,15 @@ int eds_write(FILE *f, const product_t *p)
             ident != NULL ? (unsigned long)ident->def : 0ul,
             rev != NULL ? (unsigned long)rev->def : 0ul, p->id);
     static const unsigned rates[8] = {10, 20, 50, 125, 250, 500, 800, 1000};
+    unsigned bitrates = product_eds_bitrates(p);
     for (unsigned i = 0; i < 8u; i++) {
-        fprintf(f, "BaudRate_%u=%d\n", rates[i], (p->bitrates >> i) & 1u);
+        fprintf(f, "BaudRate_%u=%d\n", rates[i], (bitrates >> i) & 1u);
     }
     fprintf(f,
             "SimpleBootUpMaster=0\nSimpleBootUpSlave=1\nGranularity=%d\n"
             "DynamicChannelsSupported=0\nGroupMessaging=0\nNrOfRXPDO=0\nNrOfTXPDO=%u\n"
             "LSS_Supported=%d\nCompactPDO=0\n\n",
-            dynamic ? 8 : 0, tpdos, p->lss ? 1 : 0);
+            dynamic ? 8 : 0, tpdos, product_lss(p) ? 1 : 0);
     fprintf(f, "[DummyUsage]\n");
     for (unsigned i = 1; i <= 7u; i++) {
         fprintf(f, "Dummy%04u=0\n", i);

@@ -71,9 +71,8 @@ static void put_product(FILE *f, const product_t *p, const char *family)
         fprintf(f, "%s%u", i > 0u ? ", " : "",
                 nodes[i] != NULL ? co_node_id(nodes[i]) : p->cfg->default_node_id);
     }
-    unsigned kbps = p->kbps != NULL ? p->kbps[p->cfg->default_bitrate & 15u] : 0u;
-    fprintf(f, "], \"default_bitrate_kbps\": %u, \"lss\": %s,\n   \"inputs\": [", kbps,
-            p->lss ? "true" : "false");
+    fprintf(f, "], \"default_bitrate_kbps\": %u, \"lss\": %s,\n   \"inputs\": [",
+            (unsigned)product_kbps(p, p->cfg->default_bitrate), product_lss(p) ? "true" : "false");
     for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && p->inputs[i].name != NULL; i++) {
         const product_input_t *in = &p->inputs[i];
         fputs(i > 0u ? ", {\"name\": " : "{\"name\": ", f);

@@ -103,12 +103,7 @@ extern const product_t dst_x710_xy10, dst_x710_xy15, dst_x710_xy20, dst_x710_xy3
                            .faults = {PRODUCT_FAULT("sensor"), NULL, NULL, NULL},               \
                            .nodes = 1, .inst_size = sizeof(dst_dev_t), .create = dst_create,    \
                            .sample = dst_sample, .variant = &(var), .cfg = (cfgp),              \
-                           .vendor = PRODUCT_TEXT("Danfoss A/S"), .bitrates = DST_BITRATES,     \
-                           .kbps = product_kbps_cia}
-/* 0x20F2 codes 0..7: 1000, 800, 500, 250, 125, 100, 50, 20 kbit/s (100 has no EDS key). */
-#define DST_BITRATES                                                                    \
-    (PRODUCT_BR_20K | PRODUCT_BR_50K | PRODUCT_BR_125K | PRODUCT_BR_250K | PRODUCT_BR_500K | \
-     PRODUCT_BR_800K | PRODUCT_BR_1000K)
+                           .vendor = PRODUCT_TEXT("Danfoss A/S")}
 #define DST_XY_INPUTS {{"x", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}, {"y", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}}
 #define DST_Z_INPUTS {{"z", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}}
 

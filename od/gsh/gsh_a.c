@@ -121,10 +121,6 @@ const co_node_cfg_t gsh_ch2_cfg = GSH_CFG(&ch2_od, 0x14);
      {"angle", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT},                                            \
      {"field", PRODUCT_TEXT("%"), 100000, 1000}}
 #define GSH_FAULTS {PRODUCT_FAULT("extension-element"), PRODUCT_FAULT("tilt-element"), NULL, NULL}
-#define GSH_BITRATES                                                                     \
-    (PRODUCT_BR_20K | PRODUCT_BR_50K | PRODUCT_BR_125K | PRODUCT_BR_250K | PRODUCT_BR_500K | \
-     PRODUCT_BR_800K | PRODUCT_BR_1000K)
-
 #ifndef CO_OD_NO_NAMES
 /* Where the manual asks the EDS to differ from the device (product_eds.h). */
 static const product_eds_override_t gsh_eds_overrides[] = {
@@ -144,10 +140,10 @@ const product_t gsh_a = {
     .summary = PRODUCT_TEXT("Gefran GSH-A draw-wire + tilt, node 0x13 (CiA 406 + 410)"),
     .inputs = GSH_INPUTS, .faults = GSH_FAULTS, .nodes = 1, .inst_size = sizeof(gsh_dev_t),
     .create = gsh_create, .sample = gsh_sample, .cfg = &gsh_ch1_cfg, .vendor = PRODUCT_TEXT("Gefran"),
-    .bitrates = GSH_BITRATES, .kbps = product_kbps_cia, PRODUCT_EDS_OVERRIDES(gsh_eds_overrides)};
+    PRODUCT_EDS_OVERRIDES(gsh_eds_overrides)};
 const product_t gsh_a_redundant = {
     .id = PRODUCT_TEXT("gsh-a-redundant"),
     .summary = PRODUCT_TEXT("Gefran GSH-A redundant: two nodes 0x13 + 0x14 (--iface A or A,B)"),
     .inputs = GSH_INPUTS, .faults = GSH_FAULTS, .nodes = 2, .inst_size = sizeof(gsh_dev_t),
     .create = gsh_create, .sample = gsh_sample, .cfg = &gsh_ch1_cfg, .vendor = PRODUCT_TEXT("Gefran"),
-    .bitrates = GSH_BITRATES, .kbps = product_kbps_cia, PRODUCT_EDS_OVERRIDES(gsh_eds_overrides)};
+    PRODUCT_EDS_OVERRIDES(gsh_eds_overrides)};

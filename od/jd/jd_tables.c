@@ -163,20 +163,14 @@ const co_node_cfg_t jd1_cfg = JD_CFG(&jd1_od);
 static const uint8_t axes2 = 2;
 static const uint8_t axes1 = 1;
 
-#define JD_BITRATES                                                                        \
-    (PRODUCT_BR_20K | PRODUCT_BR_50K | PRODUCT_BR_125K | PRODUCT_BR_250K | PRODUCT_BR_500K | \
-     PRODUCT_BR_800K | PRODUCT_BR_1000K)
-
 const product_t jd2xxx = {
     .id = PRODUCT_TEXT("jd2xxx"), .summary = PRODUCT_TEXT("ifm JD2xxx dual axis +-90 deg, LSS (CiA 410)"),
     .inputs = {{"x", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}, {"y", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT},
                {"temp", PRODUCT_TEXT("degC"), 25000, 200}},
     .nodes = 1, .inst_size = sizeof(jd_dev_t), .create = jd_create, .sample = jd_sample,
-    .variant = &axes2, .cfg = &jd2_cfg, .vendor = PRODUCT_TEXT("ifm electronic"), .bitrates = JD_BITRATES,
-    .lss = true, .kbps = product_kbps_ifm};
+    .variant = &axes2, .cfg = &jd2_cfg, .vendor = PRODUCT_TEXT("ifm electronic")};
 const product_t jd1xxx = {
     .id = PRODUCT_TEXT("jd1xxx"), .summary = PRODUCT_TEXT("ifm JD1xxx single axis 0..360 deg, LSS (CiA 410)"),
     .inputs = {{"z", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}, {"temp", PRODUCT_TEXT("degC"), 25000, 200}},
     .nodes = 1, .inst_size = sizeof(jd_dev_t), .create = jd_create, .sample = jd_sample,
-    .variant = &axes1, .cfg = &jd1_cfg, .vendor = PRODUCT_TEXT("ifm electronic"), .bitrates = JD_BITRATES,
-    .lss = true, .kbps = product_kbps_ifm};
+    .variant = &axes1, .cfg = &jd1_cfg, .vendor = PRODUCT_TEXT("ifm electronic")};

@@ -103,8 +103,6 @@ static const co_service_t *const pf_services[] = {&co_guard_service, &co_rtr_ser
 const co_node_cfg_t pf_inx_cfg = PF_CFG(&inx_od);
 const co_node_cfg_t pf_iny_cfg = PF_CFG(&iny_od);
 
-#define PF_EDS_BITRATES (PRODUCT_BR_125K | PRODUCT_BR_250K | PRODUCT_BR_500K | PRODUCT_BR_1000K)
-
 static const pf_variant_t v_inx = {.cfg = &pf_inx_cfg, .axes = 1};
 static const pf_variant_t v_iny = {.cfg = &pf_iny_cfg, .axes = 2};
 
@@ -113,12 +111,10 @@ const product_t pf_inx360d = {
     .inputs = {{"x", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}},
     .faults = {PRODUCT_FAULT("range-x"), PRODUCT_FAULT("range-y"), PRODUCT_FAULT("undervoltage"), NULL},
     .nodes = 1, .inst_size = sizeof(pf_dev_t), .create = pf_create, .sample = pf_sample,
-    .variant = &v_inx, .cfg = &pf_inx_cfg, .vendor = PRODUCT_TEXT("Pepperl+Fuchs"), .bitrates = PF_EDS_BITRATES,
-    .kbps = product_kbps_pf};
+    .variant = &v_inx, .cfg = &pf_inx_cfg, .vendor = PRODUCT_TEXT("Pepperl+Fuchs")};
 const product_t pf_iny360d = {
     .id = PRODUCT_TEXT("iny360d"), .summary = PRODUCT_TEXT("Pepperl+Fuchs INY360D dual axis 0..359.9 deg (CiA 410)"),
     .inputs = {{"x", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}, {"y", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}},
     .faults = {PRODUCT_FAULT("range-x"), PRODUCT_FAULT("range-y"), PRODUCT_FAULT("undervoltage"), NULL},
     .nodes = 1, .inst_size = sizeof(pf_dev_t), .create = pf_create, .sample = pf_sample,
-    .variant = &v_iny, .cfg = &pf_iny_cfg, .vendor = PRODUCT_TEXT("Pepperl+Fuchs"), .bitrates = PF_EDS_BITRATES,
-    .kbps = product_kbps_pf};
+    .variant = &v_iny, .cfg = &pf_iny_cfg, .vendor = PRODUCT_TEXT("Pepperl+Fuchs")};

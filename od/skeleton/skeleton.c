@@ -128,14 +128,21 @@ static const co_od_t skel_od = {.entries = skel_entries, .count = sizeof(skel_en
 
 _Static_assert(sizeof(skel_para_t) <= CO_STORE_MAX_DATA, "PARA set must fit one store slot");
 
+/* Its bit rates (kbit/s by code): 250 only, code 3 as in the CiA table
+ * (product_kbps_cia), since nothing here changes the code. A family
+ * whose node-ID/bit-rate objects or LSS select others lists them, or
+ * takes a manual's table of od/bitrates.c; the EDS declares the rates
+ * listed (product_eds_bitrates). */
+static const uint16_t skel_kbps[16] = {[3] = 250};
+
 /* The node config: what the stack needs to know of the product. */
 const co_node_cfg_t skel_cfg = {
     .od = &skel_od, .ops = &skel_ops, .led = NULL /* CiA 303-3 LEDs */,
     .services = NULL /* no guarding, no LSS, no RTR: core services only */,
     .sdo_segmented = NULL, .sdo_block = NULL, /* every object fits an expedited transfer */
     .ram_size = {0, 0, sizeof(skel_para_t), 0},
-    .default_node_id = 0x20, .default_bitrate = 3 /* 250 kbit/s: product_kbps_cia */,
-    .kbps = product_kbps_cia,
+    .default_node_id = 0x20, .default_bitrate = 3,
+    .kbps = skel_kbps,
 };
 
 /* The registry row: what the boards need to know of the product. */
@@ -144,5 +151,4 @@ const product_t skel_incl = {
     .inputs = {{"x", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}},
     .faults = {PRODUCT_FAULT("sensor"), NULL},
     .nodes = 1, .inst_size = sizeof(skel_dev_t), .create = skel_create, .sample = skel_sample,
-    .variant = NULL, .cfg = &skel_cfg, .vendor = PRODUCT_TEXT("(template)"),
-    .bitrates = PRODUCT_BR_250K, .kbps = product_kbps_cia};
+    .variant = NULL, .cfg = &skel_cfg, .vendor = PRODUCT_TEXT("(template)")};
