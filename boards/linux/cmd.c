@@ -453,21 +453,28 @@ static void apply_quit(cmd_ctx_t *c, unsigned k, unsigned node, const cmd_args_t
 
 /* The table: a new verb is a row here and its two functions. */
 const cmd_verb_t cmd_verbs[] = {
-    {"set", "NAME=VALUE [NAME=VALUE...]", "true value of inputs (the product's names)",
-     CMD_INPUTS, parse_set, apply_set},
-    {"ramp", "NAME=VALUE in DURATION", "linear from the input's value now to VALUE",
+    {"set", "NAME=VALUE ...", "true value of the product's inputs (below)", CMD_INPUTS,
+     parse_set, apply_set},
+    {"ramp", "NAME=VALUE in DUR",
+     "linear from the value now to VALUE over DUR (5s, 250ms, at most a day), then held",
      CMD_INPUTS, parse_ramp, apply_ramp},
-    {"sine", "NAME amp=A period=DURATION", "around the input's value now, starting upwards",
+    {"sine", "NAME amp=A period=DUR", "around the value now, starting there going up",
      CMD_INPUTS, parse_sine, apply_sine},
-    {"noise", "NAME sd=S", "Gaussian noise on top of the motion (sd=0 stops it)", CMD_INPUTS,
+    {"noise", "NAME sd=S",
+     "Gaussian noise (S in the input's unit) on top of the motion; sd=0 stops it", CMD_INPUTS,
      parse_noise, apply_noise},
-    {"replay", "FILE.csv", "play a table of values from now (t,NAME,... rows)", CMD_INPUTS,
-     parse_replay, apply_replay},
-    {"fault", "NAME on|off", "force a fault (the product's names: sensor, ...)", CMD_INPUTS,
+    {"replay", "FILE.csv",
+     "header t,NAME,... then rows SECONDS,VALUE,... from now: linear between rows, last row "
+     "held. set, ramp, sine and replay replace an input's motion, noise stays; values beyond "
+     "an input's limit are refused, noise is saturated at it",
+     CMD_INPUTS, parse_replay, apply_replay},
+    {"fault", "NAME on|off", "force one of the product's faults (below)", CMD_INPUTS,
      parse_fault, apply_fault},
     {"can", "bus-off [SECONDS] | passive | warning | active",
-     "the simulated CAN controller's state", CMD_NODES, parse_can, apply_can},
-    {"get", "", "one node's true inputs and NMT state: ok NAME=VALUE ... nmt=STATE",
+     "the nodes' simulated CAN controller: bus-off sends nothing; the bus stays unusable "
+     "SECONDS (default 0, at most 1800), then it is back after 128 x 11 bits at its bit rate",
+     CMD_NODES, parse_can, apply_can},
+    {"get", "", "one node's true inputs and NMT state: ok x=1.000 ... nmt=operational",
      CMD_QUERY, parse_get, NULL},
     {"quit", "", "stop the program", CMD_PROGRAM, parse_quit, apply_quit},
 };
@@ -484,10 +491,36 @@ void cmd_verb_names(char *buf, size_t len)
 
 void cmd_usage(FILE *f)
 {
+    enum { COL = 28, WIDTH = 79 };
     for (unsigned v = 0; v < cmd_nverbs; v++) {
         char head[80];
-        snprintf(head, sizeof(head), "%s %s", cmd_verbs[v].name, cmd_verbs[v].usage);
-        fprintf(f, "  %-40s %s\n", head, cmd_verbs[v].what);
+        int n = snprintf(head, sizeof(head), "  %s %s", cmd_verbs[v].name, cmd_verbs[v].usage);
+        fputs(head, f);
+        int at = n;
+        if (n >= COL - 1) {
+            fputs("\n", f);
+            at = 0;
+        }
+        /* the text wrapped at WIDTH, each line from column COL */
+        for (const char *w = cmd_verbs[v].what; *w != '\0';) {
+            int len = (int)strcspn(w, " ");
+            if (at > COL && at + 1 + len > WIDTH) {
+                fputs("\n", f);
+                at = 0;
+            }
+            if (at < COL) {
+                fprintf(f, "%*s", COL - at, "");
+                at = COL;
+            } else {
+                fputc(' ', f);
+                at++;
+            }
+            fprintf(f, "%.*s", len, w);
+            at += len;
+            w += len;
+            w += strspn(w, " ");
+        }
+        fputs("\n", f);
     }
 }
 

@@ -119,18 +119,27 @@ static void test_verb_table(void)
         CHECK(cmd_verbs[v].parse != NULL && cmd_verbs[v].usage != NULL);
         CHECK((cmd_verbs[v].apply != NULL) == (cmd_verbs[v].scope != CMD_QUERY));
     }
-    /* --help's lines come from the table, one a verb. */
+    /* --help's rows come from the table: one a verb, in its order, each
+     * line within 79 columns (continuations indented). */
     char *text = NULL;
     size_t size = 0;
     FILE *f = open_memstream(&text, &size);
     cmd_usage(f);
     fclose(f);
-    unsigned lines = 0;
-    for (const char *p = text; *p != '\0'; p++) {
-        lines += *p == '\n';
+    unsigned rows = 0;
+    for (const char *p = text; *p != '\0'; p += strcspn(p, "\n") + 1u) {
+        CHECK(strcspn(p, "\n") <= 79u);
+        if (p[0] == ' ' && p[1] == ' ' && p[2] != ' ') {
+            CHECK(rows < cmd_nverbs && strncmp(p + 2, cmd_verbs[rows].name,
+                                               strlen(cmd_verbs[rows].name)) == 0);
+            rows++;
+        }
+        if (p[strcspn(p, "\n")] == '\0') {
+            break;
+        }
     }
-    CHECK_EQ(lines, cmd_nverbs);
-    CHECK(strstr(text, "  can bus-off [SECONDS] | passive | warning | active") != NULL);
+    CHECK_EQ(rows, cmd_nverbs);
+    CHECK(strstr(text, "\n  can bus-off [SECONDS] | passive | warning | active\n") != NULL);
     free(text);
 }
 
