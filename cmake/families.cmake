@@ -3,8 +3,9 @@
 # what the declarations set: the root build (the stack library, the Linux
 # program's product registry), boards/CMakeLists.txt (one MCU image per
 # product), tests/ (each family's unit tests, once per fixed config, on the
-# host and on the emulated Cortex-M0), tests/bench, tools/emu and the
-# integration tests (which parse the PRODUCTS rows of the same files).
+# host and on the emulated Cortex-M0), tests/bench, and through the Linux
+# program's `--list-products --json` tools/emu, tools/demo.py and the
+# integration tests.
 #
 # co_family(<name>
 #   HEADER   <file.h>         the family's header (declares the products)
@@ -36,7 +37,8 @@
 #   CO_MCU_FIXED_CFGS           "config family" rows, each config once
 #   CO_MCU_SIZES_<config>       the SIZES of that config
 # and writes <build>/generated/product_registry.h (the registry's rows,
-# od/registry.c; the union of the instance types, product.h).
+# od/registry.c; each product's family, MCU config and template flag,
+# boards/linux/products_json.c; the union of the instance types, product.h).
 
 set(CO_FAMILIES)
 set(CO_PRODUCT_SOURCES ${CMAKE_SOURCE_DIR}/od/bitrates.c ${CMAKE_SOURCE_DIR}/od/registry.c)
@@ -46,7 +48,7 @@ set(CO_MCU_PRODUCTS)
 set(CO_MCU_FIXED_CFGS)
 set(co_registry_includes "")
 set(co_registry_rows "")
-set(co_registry_families "")
+set(co_registry_info "")
 set(co_registry_examples "")
 set(co_registry_union "")
 set(co_registry_ids "")
@@ -117,15 +119,22 @@ macro(co_family name)
     list(APPEND co_all_ids ${id})
     list(APPEND co_all_syms ${sym})
     list(APPEND fam_cfgs ${cfg})
+    set(info_cfg "\"${cfg}\"")
+    if(cfg STREQUAL "-")
+      set(info_cfg NULL)
+    endif()
+    set(info_example false)
     if(fam_EXAMPLE)
+      set(info_example true)
       string(APPEND co_registry_examples "&${sym}, ")
       string(APPEND co_registry_example_ids "\"${id}\", ")
     else()
       string(APPEND co_registry_rows "&${sym}, ")
       string(APPEND co_registry_ids "\"${id}\", ")
-      string(APPEND co_registry_families "\"${name}\", ")
       list(APPEND CO_MCU_PRODUCTS "${id} ${sym} ${name} ${fam_INSTANCE} ${cfg}")
     endif()
+    string(APPEND co_registry_info "    {.id = \"${id}\", .family = \"${name}\", "
+      ".mcu_cfg = ${info_cfg}, .example = ${info_example}}, \\\n")
     if(NOT cfg STREQUAL "-" AND NOT "${cfg} ${name}" IN_LIST CO_MCU_FIXED_CFGS)
       list(APPEND CO_MCU_FIXED_CFGS "${cfg} ${name}")
     endif()
@@ -173,17 +182,28 @@ file(CONFIGURE OUTPUT ${CMAKE_BINARY_DIR}/generated/product_registry.h CONTENT
  * (od/<family>/family.cmake): do not edit. */
 #ifndef PRODUCT_REGISTRY_H
 #define PRODUCT_REGISTRY_H
+
+#include <stdbool.h>
 @co_registry_includes@
 /* The products of the Linux program (--list-products order). */
 #define PRODUCT_REGISTRY_ROWS @co_registry_rows@
-/* The family of each of those products, in the same order. */
-#define PRODUCT_REGISTRY_FAMILIES @co_registry_families@
 /* Templates (EXAMPLE families): built and tested, not shipped. */
 #define PRODUCT_REGISTRY_EXAMPLES @co_registry_examples@
 /* The IDs the declarations give the rows above, in the same order (a
  * unit test checks each product's own id against its row). */
 #define PRODUCT_REGISTRY_IDS @co_registry_ids@
 #define PRODUCT_REGISTRY_EXAMPLE_IDS @co_registry_example_ids@
+/* What a declaration says of a product besides its row (for
+ * --list-products --json). */
+typedef struct product_registry_info {
+    const char *id;      /* its ID */
+    const char *family;  /* its family (the folder under od/) */
+    const char *mcu_cfg; /* the node config its MCU image fixes; NULL: none (two nodes) */
+    bool example;        /* a template (EXAMPLE): no MCU image, not in the program's list */
+} product_registry_info_t;
+/* That of every product, templates too, in declaration order. */
+#define PRODUCT_REGISTRY_INFO \\
+@co_registry_info@
 /* Every instance type, for memory that holds any product (product.h). */
 typedef union product_any {
 @co_registry_union@} product_any_t;

@@ -1,21 +1,33 @@
 /*
  * products_json.c - see products_json.h.
  *
- * The family of each product comes from the families' declarations
- * (od/<family>/family.cmake): cmake/families.cmake generates
- * PRODUCT_REGISTRY_FAMILIES in the order of PRODUCT_REGISTRY_ROWS, which
- * is product_list[]'s order (od/registry.c), so that no product table has
- * to repeat its family's name.
+ * A product's family, the config of its MCU image and whether it is a
+ * template come from the families' declarations (od/<family>/family.cmake):
+ * cmake/families.cmake generates PRODUCT_REGISTRY_INFO, one row per
+ * declared product, so that no product table repeats them.
  */
 #include "products_json.h"
 
 #include <stddef.h>
+#include <string.h>
 
 #include "co_node.h"
 #include "product.h"
 #include "product_registry.h"
 
-static const char *const families[] = {PRODUCT_REGISTRY_FAMILIES NULL};
+static const product_registry_info_t info[] = {PRODUCT_REGISTRY_INFO{.id = NULL}};
+
+/* What the declarations say of p (by its ID); family NULL where none
+ * declares it (a product a test made up). */
+static product_registry_info_t info_of(const product_t *p)
+{
+    for (size_t i = 0; info[i].id != NULL; i++) {
+        if (p->id != NULL && strcmp(info[i].id, p->id) == 0) {
+            return info[i];
+        }
+    }
+    return (product_registry_info_t){.id = p->id};
+}
 
 /* s as a JSON string ("null" for NULL); control characters escaped. */
 static void put_string(FILE *f, const char *s)
@@ -47,7 +59,7 @@ static void put_milli(FILE *f, int32_t v)
     }
 }
 
-static void put_product(FILE *f, const product_t *p, const char *family)
+static void put_product(FILE *f, const product_t *p)
 {
     /* The instance, only to read each node's node-ID after co_node_init
      * (create() calls no port: NULL ports are never used). */
@@ -57,8 +69,9 @@ static void put_product(FILE *f, const product_t *p, const char *family)
     unsigned n = p->nodes <= PRODUCT_MAX_NODES ? p->nodes : PRODUCT_MAX_NODES;
     fputs("  {\"id\": ", f);
     put_string(f, p->id);
+    product_registry_info_t decl = info_of(p);
     fputs(", \"family\": ", f);
-    put_string(f, family);
+    put_string(f, decl.family != NULL ? decl.family : "");
     fputs(", \"summary\": ", f);
     put_string(f, p->summary);
     fputs(", \"vendor\": ", f);
@@ -88,7 +101,14 @@ static void put_product(FILE *f, const product_t *p, const char *family)
         fputs(i > 0u ? ", " : "", f);
         put_string(f, p->faults[i]);
     }
-    fputs("]}", f);
+    fputs("],\n   \"template\": ", f);
+    fputs(decl.example ? "true" : "false", f);
+    /* Every declared product but a template has an image per MCU board
+     * (boards/CMakeLists.txt). */
+    fprintf(f, ", \"mcu_image\": %s, \"mcu_config\": ",
+            decl.family != NULL && !decl.example ? "true" : "false");
+    put_string(f, decl.mcu_cfg);
+    fputs("}", f);
 }
 
 int products_json(FILE *f, const product_t *only)
@@ -99,11 +119,8 @@ int products_json(FILE *f, const product_t *only)
         if (only != NULL && product_list[i] != only) {
             continue;
         }
-        /* The unit tests' registry also lists the templates, after the rows
-         * families[] names: those have no family here. */
-        bool named = i < sizeof(families) / sizeof(families[0]) && families[i] != NULL;
         fputs(first ? "" : ",\n", f);
-        put_product(f, product_list[i], named ? families[i] : "");
+        put_product(f, product_list[i]);
         first = false;
     }
     fputs(first ? "" : "\n", f);

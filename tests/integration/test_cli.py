@@ -47,7 +47,8 @@ def test_list_products_json():
     by_id = {p["id"]: p for p in products}
     for p in products:
         assert set(p) == {"id", "family", "summary", "vendor", "nodes", "default_node_ids",
-                          "default_bitrate_kbps", "lss", "inputs", "faults"}
+                          "default_bitrate_kbps", "lss", "inputs", "faults", "template",
+                          "mcu_image", "mcu_config"}
         assert len(p["default_node_ids"]) == p["nodes"]
         assert all(1 <= n <= 127 for n in p["default_node_ids"])
         assert p["inputs"] and all(set(i) == {"name", "unit", "limit", "initial"}
@@ -64,6 +65,17 @@ def test_list_products_json():
     assert by_id["jd2xxx"]["default_node_ids"] == [10]
     assert by_id["inx360d"]["family"] == "pf"
     assert by_id["inx360d"]["faults"] == ["range-x", "range-y", "undervoltage"]
+    # From the declarations: the program lists no template, and every
+    # product it lists has an MCU image with its config fixed, but for a
+    # device of two nodes (two configs).
+    assert all(p["template"] is False and p["mcu_image"] is True for p in products)
+    assert (dst["mcu_config"], by_id["dst-x710-z360"]["mcu_config"]) == ("dst_x730_cfg",
+                                                                         "dst_x710_cfg")
+    assert (by_id["gsh-a"]["mcu_config"], by_id["gsh-a-redundant"]["mcu_config"]) \
+        == ("gsh_ch1_cfg", None)
+    od = Path(__file__).resolve().parents[2] / "od"
+    assert all((od / p["family"] / "family.cmake").is_file() for p in products)
+    assert all(p["mcu_config"] for p in products if p["nodes"] == 1)
     one_line(run("--json"), 2, "--json goes with --list-products")
 
 
