@@ -427,9 +427,16 @@ static void notify(co_node_t *node, uint32_t sig)
     }
 }
 
-/* CiA 301 groups of 0x1010 / 0x1011 sub 2, 3, 4 (at sub - 2). */
-static const uint16_t group_lo[3] = {0x1000, 0x6000, 0x2000};
-static const uint16_t group_hi[3] = {0x1FFF, 0x9FFF, 0x5FFF};
+/* The CiA 301 groups of 0x1010 / 0x1011 sub 2, 3, 4 (at sub - 2): their
+ * index ranges. */
+enum { GROUP_COMM, GROUP_APP, GROUP_MANUF };
+static const struct {
+    uint16_t lo, hi;
+} groups[] = {
+    [GROUP_COMM] = {0x1000, 0x1FFF},  /* sub 2: communication parameters */
+    [GROUP_APP] = {0x6000, 0x9FFF},   /* sub 3: application (device profile) parameters */
+    [GROUP_MANUF] = {0x2000, 0x5FFF}, /* sub 4: manufacturer-specific parameters */
+};
 
 /* Save or restore (defaults) the group of sub-index sub (2..4: group_hook)
  * in PARA, and in LSS where the product keeps node-ID and bit rate among
@@ -437,9 +444,9 @@ static const uint16_t group_hi[3] = {0x1FFF, 0x9FFF, 0x5FFF};
 static co_res_t group_op(co_node_t *node, uint8_t sub, bool defaults)
 {
     unsigned g = (unsigned)sub - 2u;
-    co_res_t r = co_store_save_group(node, CO_CLS_PARA, group_lo[g], group_hi[g], defaults);
+    co_res_t r = co_store_save_group(node, CO_CLS_PARA, groups[g].lo, groups[g].hi, defaults);
     if (r == CO_OK && co_cfg(node)->save_includes_lss && stored_class(node, CO_CLS_LSS)) {
-        r = co_store_save_group(node, CO_CLS_LSS, group_lo[g], group_hi[g], defaults);
+        r = co_store_save_group(node, CO_CLS_LSS, groups[g].lo, groups[g].hi, defaults);
     }
     return r;
 }

@@ -250,7 +250,8 @@ void dst_create(const product_t *p, void *mem, void *const ports[], co_node_t *n
     const dst_variant_t *v = p->variant;
     memset(d, 0, sizeof(*d));
     co_incl_init(&d->incl, &d->para.incl, v->axes, v->limit_mdeg, v->wrap);
-    void *const ram[CO_CLS_COUNT] = {NULL, &d->vol, &d->para, &d->lss};
+    void *const ram[CO_CLS_COUNT] = {[CO_CLS_VOL] = &d->vol, [CO_CLS_PARA] = &d->para,
+                                     [CO_CLS_LSS] = &d->lss};
     co_node_init(&d->node, v->cfg, ports[0], d, ram, 0);
     nodes[0] = &d->node;
 }

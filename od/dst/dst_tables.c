@@ -146,7 +146,8 @@ _Static_assert(sizeof(co_lss_para_t) <= CO_STORE_MAX_DATA, "LSS set must fit one
 #define DST_CFG(odp, ...)                                                                    \
     {.od = (odp), .ops = &dst_ops,                                                           \
      /* No SDO block transfer: the manual's SDO section (10) has only expedited transfer. */ \
-     .ram_size = {0, sizeof(dst_vol_t), sizeof(dst_para_t), sizeof(co_lss_para_t)},          \
+     .ram_size = {[CO_CLS_VOL] = sizeof(dst_vol_t), [CO_CLS_PARA] = sizeof(dst_para_t),       \
+                  [CO_CLS_LSS] = sizeof(co_lss_para_t)},                                     \
      .default_node_id = 0x7F, .default_bitrate = 3 /* 250 kbit/s */,                        \
      .kbps = product_kbps_cia, .tpdo_dlc = 8 /* the manual's frames are always 8 bytes */, \
      .store_write_limit = DST_WRITE_LIMIT, __VA_ARGS__}

@@ -123,7 +123,7 @@ void gsh_create(const product_t *p, void *mem, void *const ports[], co_node_t *n
         co_incl_init(&c->incl, &c->incl_para, 1, 0, true);
         c->incl.circular = true;
         c->incl.shift = 0; /* the manual describes no filter */
-        void *const ram[CO_CLS_COUNT] = {NULL, NULL, &c->para, &c->lss};
+        void *const ram[CO_CLS_COUNT] = {[CO_CLS_PARA] = &c->para, [CO_CLS_LSS] = &c->lss};
         co_node_init(&c->node, cfgs[i], ports[i], c, ram, i * CO_STORE_NVM_SIZE);
         nodes[i] = &c->node;
     }

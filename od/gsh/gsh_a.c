@@ -108,7 +108,7 @@ static const co_service_t *const gsh_services[] = {&co_rtr_service, NULL};
 #define GSH_CFG(odp, id)                                                             \
     {.od = (odp), .ops = &gsh_ops, .led = NULL, .services = gsh_services,              \
      .sdo_segmented = co_sdo_segmented, .sdo_block = co_sdo_block,                     \
-     .ram_size = {0, 0, sizeof(gsh_para_t), sizeof(co_lss_para_t)},                    \
+     .ram_size = {[CO_CLS_PARA] = sizeof(gsh_para_t), [CO_CLS_LSS] = sizeof(co_lss_para_t)}, \
      .default_node_id = (id), .default_bitrate = 3, .tpdo_dlc = 8,                     \
      .store_write_limit = 100000u /* manual, section 7 */,                             \
      .save_includes_lss = true /* the manual's example 1 saves 0x3001 */,              \

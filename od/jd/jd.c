@@ -333,7 +333,7 @@ void jd_create(const product_t *p, void *mem, void *const ports[], co_node_t *no
     jd_dev_t *d = mem;
     memset(d, 0, sizeof(*d));
     d->axes = *(const uint8_t *)p->variant;
-    void *const ram[CO_CLS_COUNT] = {NULL, NULL, &d->para, NULL};
+    void *const ram[CO_CLS_COUNT] = {[CO_CLS_PARA] = &d->para};
     co_node_init(&d->node, p->cfg, ports[0], d, ram, 0);
     nodes[0] = &d->node;
 }

@@ -153,7 +153,7 @@ static const co_service_t *const jd_services[] = {&co_lss_service, &co_guard_ser
     {.od = (odp), .ops = &jd_ops, .led = NULL /* CiA 303-3 timing: the manual has none */, \
      .services = jd_services,                                                           \
      .sdo_segmented = co_sdo_segmented, .sdo_block = co_sdo_block,                      \
-     .ram_size = {0, 0, sizeof(jd_para_t), 0}, .default_node_id = 10,                   \
+     .ram_size = {[CO_CLS_PARA] = sizeof(jd_para_t)}, .default_node_id = 10,            \
      .id_index = 0x3000, .id_offset = 1 /* 3000h = node-ID - 1 (manual, 9.21) */,       \
      .default_bitrate = 3, .tpdo_dlc = 0, .lss = true, .lss_bitrates = JD_LSS_BITRATES,     \
      .kbps = product_kbps_ifm}

@@ -100,7 +100,7 @@ void pf_create(const product_t *p, void *mem, void *const ports[], co_node_t *no
     co_incl_init(&d->incl, &d->para.incl, v->axes, 0, true);
     d->incl.circular = true;
     d->incl.shift = 0; /* no filter (the manual has none): one sample, one calculation */
-    void *const ram[CO_CLS_COUNT] = {NULL, NULL, &d->para, &d->lss};
+    void *const ram[CO_CLS_COUNT] = {[CO_CLS_PARA] = &d->para, [CO_CLS_LSS] = &d->lss};
     co_node_init(&d->node, v->cfg, ports[0], d, ram, 0);
     nodes[0] = &d->node;
 }

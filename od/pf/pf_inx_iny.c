@@ -95,7 +95,7 @@ static const co_service_t *const pf_services[] = {&co_guard_service, &co_rtr_ser
     {.od = (odp), .ops = &pf_ops, .led = NULL /* CiA 303-3 timing: the manual has none */, \
      .services = pf_services,                                                        \
      .sdo_segmented = co_sdo_segmented, .sdo_block = co_sdo_block,                   \
-     .ram_size = {0, 0, sizeof(pf_para_t), sizeof(co_lss_para_t)},                   \
+     .ram_size = {[CO_CLS_PARA] = sizeof(pf_para_t), [CO_CLS_LSS] = sizeof(co_lss_para_t)}, \
      .default_node_id = 1, .default_bitrate = PF_BR_250K, .tpdo_dlc = 0,             \
      .autosave = true /* node-ID and bit rate survive without a save (6.2) */, \
      .load_keeps_lss = true /* decision: "load" keeps node-ID and bit rate */, \

@@ -74,7 +74,7 @@ static void skel_create(const product_t *p, void *mem, void *const ports[], co_n
     memset(d, 0, sizeof(*d));
     co_incl_init(&d->incl, &d->para.incl, 1, 0, false);
     d->incl.shift = 0; /* no filter: one sample, one output */
-    void *const ram[CO_CLS_COUNT] = {NULL, NULL, &d->para, NULL};
+    void *const ram[CO_CLS_COUNT] = {[CO_CLS_PARA] = &d->para};
     co_node_init(&d->node, p->cfg, ports[0], d, ram, 0);
     nodes[0] = &d->node;
 }
@@ -140,7 +140,7 @@ const co_node_cfg_t skel_cfg = {
     .od = &skel_od, .ops = &skel_ops, .led = NULL /* CiA 303-3 LEDs */,
     .services = NULL /* no guarding, no LSS, no RTR: core services only */,
     .sdo_segmented = NULL, .sdo_block = NULL, /* every object fits an expedited transfer */
-    .ram_size = {0, 0, sizeof(skel_para_t), 0},
+    .ram_size = {[CO_CLS_PARA] = sizeof(skel_para_t)},
     .default_node_id = 0x20, .default_bitrate = 3,
     .kbps = skel_kbps,
 };
