@@ -4,10 +4,19 @@ and every way a family differs is a value here (shared/specs/<family>.md
 is the source of each; the spec's rule numbers are given where a value is
 not plain CiA 301).
 
+A family without a table here (one tools/new-family just made) is
+expected to do what the template it was made from does (TEMPLATE below),
+at the node-IDs the Linux program lists for it; CI runs its first product
+on every target. Its own table replaces that once it differs.
+
 A value written ID(base) means base + the node's node-ID.
 """
 from dataclasses import dataclass, replace
+import json
 import struct
+import subprocess
+
+from conftest import BINARY
 
 SAVE = b"save"  # 0x1010 signature, CiA 301
 
@@ -89,7 +98,7 @@ class Facts:
     nodes: tuple                 # factory node-IDs, one per node of the device
     device_type: int             # 0x1000
     identity: dict               # 0x1018 sub -> value (sub 4, the serial, is per unit)
-    name: bytes                  # 0x1008
+    name: bytes                  # 0x1008; None: the product has none
     boot_state: int              # heartbeat state after boot-up: 0x7F pre-op, 0x05 operational
     reads: tuple                 # more SDO reads (Read)
     rw: tuple                    # (index, sub, data): written, read back the same
@@ -106,10 +115,11 @@ class Facts:
     set_b: tuple                 # and of the second (the one a power cut hits)
     autosave: bool               # every SDO write is stored at once
     corrupt: Corrupt
-    node_id_change: NodeIdChange
+    node_id_change: NodeIdChange  # None: no way to change it (the template)
     tpdo_cob: ID = ID(0x180)
     sdo_block: bool = True       # SDO block download (CiA 301)
-    sync_cobid_writable: bool = True  # 1005h rw (where the product has SYNC types)
+    sync_cobid_writable: bool = True  # 1005h rw (where the product has SYNC types);
+                                      # None: no 1005h, SYNC fixed at 080h
     dynamic_mapping: bool = False  # 0x1A00.. writable (CiA 301 dynamic mapping)
 
 
@@ -264,6 +274,39 @@ PF = Facts(
     dynamic_mapping=True,
 )
 
+# The template (od/skeleton, tests/unit/test_skeleton.c): CiA 301 and CiA
+# 410 defaults, no 1008h, no 1005h (SYNC on 080h), no node-ID object, no LSS.
+TEMPLATE = Facts(
+    family="template",
+    nodes=(0x20,),
+    device_type=0x0000019A,
+    identity={1: 0, 2: 1, 3: 0x00010000},                 # sub 4 per unit
+    name=None,
+    boot_state=0x7F,
+    reads=(Read(0x1010, 1, u32(1)), Read(0x1800, 1, ID(0x180)), Read(0x1800, 2, u8(254)),
+           Read(0x1800, 5, u16(0)), Read(0x6000, 0, u16(10))),
+    rw=((0x1017, 0, u16(250)), (0x6013, 0, i16(-200))),
+    app_param=(0x6013, 0, i16(-200), i16(0)),
+    aborts=COMMON_ABORTS + (
+        Abort("w", 0x6000, 0, 0x06090030, u16(7)),         # 1, 10, 100, 1000 only (CiA 410)
+    ),
+    sync_type=2,
+    sync_refused=None,
+    event_mode=(),                                         # 254 + event timer by default
+    fault=Fault(on=("fault sensor on",), off=("fault sensor off",),
+                emcy=bytes.fromhex("0050010000000000"),    # 5000h, generic error
+                emcy_off=bytes(8)),
+    stored=(HEARTBEAT, EVENT_TIMER),
+    defaults=(0, 0),
+    set_a=(300, 40),
+    set_b=(500, 60),
+    autosave=False,
+    corrupt=Corrupt(emcy_code=0x6300),
+    node_id_change=None,
+    sdo_block=False,                                       # expedited transfers only
+    sync_cobid_writable=None,
+)
+
 
 def _dst(pid):
     x710 = pid.startswith("dst-x710")
@@ -300,4 +343,30 @@ CI_PRODUCTS = {
     "microbit": ("dst-x730-z360", "dst-x710-xy90", "gsh-a", "gsh-a-redundant", "jd2xxx",
                  "inx360d"),
 }
+
+
+def listed_products():
+    """The Linux program's products (`canopen-sensor --list-products
+    --json`, BINARY); none when it cannot be run (no build yet)."""
+    try:
+        out = subprocess.run([BINARY, "--list-products", "--json"], check=True,
+                             capture_output=True, text=True, timeout=30).stdout
+    except (OSError, subprocess.SubprocessError):
+        return []
+    return json.loads(out)
+
+
+# A family none of the tables above covers: the template's facts at its
+# products' own node-IDs.
+_LISTED = listed_products()
+_COVERED = {p["family"] for p in _LISTED if p["id"] in PRODUCTS}
+PRODUCTS.update({p["id"]: replace(TEMPLATE, family=p["family"], nodes=tuple(p["default_node_ids"]))
+                 for p in _LISTED if p["family"] not in _COVERED})
+# A family CI_PRODUCTS names no product of on a target: its first there.
+_FIRST = {}
+for _p in _LISTED:
+    _FIRST.setdefault(_p["family"], _p["id"])
+for _target, _ids in CI_PRODUCTS.items():
+    _in = {p["family"] for p in _LISTED if p["id"] in _ids}
+    CI_PRODUCTS[_target] = _ids + tuple(i for fam, i in _FIRST.items() if fam not in _in)
 
