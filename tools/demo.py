@@ -7,10 +7,13 @@ The node-IDs are the ones the sensor's boot-up messages come from (the
 GSH-A redundant runs two nodes); the dictionary is the product's EDS
 (canopen-sensor --eds), so only objects the product has are read. What is
 done with each product family, and how its TPDO1 is decoded, is the
-FAMILIES table below: every product ID must match one of its entries
-(tests/integration/test_demo.py checks that).
+FAMILIES table below; a family it does not name (one tools/new-family just
+made) gets a session made from what `canopen-sensor --list-products --json`
+says of the product (generic_family): its inputs stepped, its first fault
+raised and cleared, TPDO1 read as CiA 410 slopes.
 """
 import argparse
+import json
 import os
 import queue
 import subprocess
@@ -147,11 +150,42 @@ FAMILIES = [
 ]
 
 
-def family_of(product):
-    """The FAMILIES entry of a product ID, or None."""
+def generic_family(p):
+    """A session for product p (its --list-products --json entry) of a
+    family FAMILIES does not name: each input set to 0, 12.5, -20 and 45
+    (within its limit), its first fault raised and cleared; TPDO1 read as
+    one INTEGER16 slope a degree input (CiA 410, 6000h the resolution)."""
+    inputs = p["inputs"]
+    steps = ["set " + " ".join(f"{i['name']}={max(-i['limit'], min(i['limit'], v)):g}"
+                               for i in inputs)
+             for v in (0, 12.5, -20, 45)]
+    if p["faults"]:
+        steps[2:2] = [f"fault {p['faults'][0]} on", f"fault {p['faults'][0]} off"]
+    angles = [i["name"] for i in inputs if i["unit"] == "deg"]
+
+    def tpdo(d, deg):
+        return "  ".join(f"{name}={s16(d[2 * k], d[2 * k + 1]) * deg:+7.2f} deg"
+                         for k, name in enumerate(angles[:len(d) // 2]))
+    return Family((p["id"],), 0x6000, [], steps, tpdo)
+
+
+def listed_products():
+    """The sensor's products, as `canopen-sensor --list-products --json` gives them."""
+    out = subprocess.run([BINARY, "--list-products", "--json"], check=True, capture_output=True,
+                         text=True).stdout
+    return json.loads(out)
+
+
+def family_of(product, listed=None):
+    """The FAMILIES entry of a product ID; for another product the sensor
+    lists (listed: listed_products() unless given) its generic_family;
+    None for an ID it does not list."""
     for f in FAMILIES:
         if product.startswith(f.prefixes):
             return f
+    for p in listed_products() if listed is None else listed:
+        if p["id"] == product:
+            return generic_family(p)
     return None
 
 
@@ -267,10 +301,9 @@ def main():
     ap.add_argument("--iface", default="vcan0")
     ap.add_argument("--step", type=float, default=1.6, help="seconds per simulator step")
     args = ap.parse_args()
-    out = subprocess.run([BINARY, "--list-products"], check=True, capture_output=True,
-                         text=True).stdout
-    known = [line.split()[0] for line in out.splitlines()]
-    family = family_of(args.product)
+    listed = listed_products()
+    known = [p["id"] for p in listed]
+    family = family_of(args.product, listed)
     if args.product not in known or family is None:
         raise SystemExit(f"demo: no demo for product '{args.product}' (see "
                          f"canopen-sensor --list-products)")
