@@ -450,7 +450,7 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
 {
     lp_port_t *p = port;
     if (p->filt_node != NULL) {
-        lp_filter(p, p->filt_node); /* the filter first, then the answer (port.h) */
+        lp_filter(p, p->filt_node); /* the filter first, then the answer (can_port.h) */
     }
     if (lp_can_state(p) == CO_CAN_BUSOFF) {
         p->tx_off++; /* a controller off the bus sends nothing */

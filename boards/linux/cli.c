@@ -43,7 +43,7 @@ static void usage(FILE *f)
             "                     interface; a two-node product's nodes share one file);\n"
             "                     --nvm, if given, stays --product's\n"
             "  --control unix:PATH|tcp:PORT\n"
-            "                     take the standard-input commands from clients of a unix\n"
+            "                     take the commands below from clients of a unix\n"
             "                     socket or a TCP port on 127.0.0.1 too; each line may begin\n"
             "                     with a node selector: 0xNN or NN (the node with that active\n"
             "                     node-ID), @N (node index N, command-line order from 0), @all\n"

@@ -1,6 +1,6 @@
 /*
  * control.h - the control socket (--control unix:PATH | tcp:PORT): clients
- * send the standard-input line language, one command a line, and get one
+ * send the line language (cmd.h), one command a line, and get one
  * answer line for each ("ok ..." or "error: <cause>"). This module owns
  * the sockets and each client's buffers; lines are assembled as on every
  * channel (cmd.h, cmd_lines_t) and answered by the program (ctl_line_fn). Everything runs in the program's one thread; nothing

@@ -65,7 +65,7 @@ static bool former_nvm_name(const options_t *o, unsigned k, uint8_t id, char *bu
 
 /*
  * Open instance k's EEPROM file (read only: nothing on disk changes) and
- * hold it (port.h, lp_nvm_lock: one file, one user, also when --nvm and
+ * hold it (nvm_file.h, lp_nvm_lock: one file, one user, also when --nvm and
  * --nvm-dir name it both). Returns CLI_GO_ON or an exit status.
  * The name before the interface was in it (DIR/PRODUCT-0xID.nvm) is
  * taken over when the new name does not exist yet, so that a stored set
