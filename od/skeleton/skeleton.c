@@ -72,6 +72,7 @@ static void skel_create(const product_t *p, void *mem, void *const ports[], co_n
 {
     skel_dev_t *d = mem;
     memset(d, 0, sizeof(*d));
+    d->sent = INT32_MIN;
     co_incl_init(&d->incl, &d->para.incl, 1, 0, false);
     d->incl.shift = 0; /* no filter: one sample, one output */
     void *const ram[CO_CLS_COUNT] = {[CO_CLS_PARA] = &d->para};
@@ -86,8 +87,16 @@ static void skel_sample(void *mem, const int32_t values[], uint32_t faults)
     d->faults = faults;
     d->incl.fault = (faults & SKEL_FAULT_SENSOR) != 0u;
     co_incl_sample(&d->incl, values);
-    co_node_wake(&d->node);   /* the poll hook looks at the faults */
-    co_tpdo_event(&d->node, 0); /* transmission types 254/255: on every sample */
+    co_node_wake(&d->node); /* the poll hook looks at the faults */
+    /* Transmission types 254/255: an event when the slope changes (CiA
+     * 301's application event), not on every sample (200 a second of one
+     * value); the event timer (1800h:05) sends it cyclically besides. An
+     * event counts once the node is operational, where it is sent. */
+    int16_t slope = co_incl_slope(&d->incl, 0);
+    if (slope != d->sent && co_node_nmt_state(&d->node) == CO_NMT_OPERATIONAL) {
+        d->sent = slope;
+        co_tpdo_event(&d->node, 0);
+    }
 }
 
 /* ---- dictionary (sorted by index, sub-index) -------------------------- */

@@ -35,6 +35,7 @@ typedef struct skel_dev {
     skel_para_t para;
     co_incl_t incl;
     uint32_t faults;       /* simulator faults (SKEL_FAULT_*) */
+    int32_t sent;          /* the slope TPDO1 last carried as an event; INT32_MIN: none */
 } skel_dev_t;
 
 /* The product (registry row) and its node config (its MCU image fixes it). */

@@ -26,7 +26,7 @@ static void test_boot_and_identity(void)
     SDO(d, "2B 00 60 00 07 00 00 00", "80 00 60 00 30 00 09 06"); /* not a CiA 410 resolution */
 }
 
-/* The slope in 0.01 deg on TPDO1 (type 254: every sample) once operational. */
+/* The slope in 0.01 deg on TPDO1 (type 254: at each change) once operational. */
 static void test_slope_on_tpdo(void)
 {
     h_boot(d, &skel_incl, false);
@@ -43,6 +43,36 @@ static void test_slope_on_tpdo(void)
     h_drain(d);
     h_advance(d, 20000);
     EXPECT_ID(d, 0x1A0, "00 00");
+}
+
+/* Type 254 without an event timer: a TPDO when the node becomes
+ * operational and at each change of the slope, none for a sample of the
+ * same value; back in pre-operational nothing, and the next start sends
+ * again. */
+static void test_event_on_change(void)
+{
+    h_boot(d, &skel_incl, false);
+    d->truth[0] = 5000;
+    h_advance(d, 20000);
+    h_drain(d);
+    h_rx(d, 0x000, "01 20");
+    h_advance(d, 20000);
+    EXPECT_ID(d, 0x1A0, "F4 01"); /* 500 = 5.00 deg */
+    h_advance(d, 100000);         /* 20 samples of one value */
+    EXPECT_NONE(d);
+    d->truth[0] = 5010;
+    h_advance(d, 20000);
+    EXPECT_ID(d, 0x1A0, "F5 01");
+    EXPECT_NONE(d);
+    h_rx(d, 0x000, "80 20"); /* pre-operational */
+    h_advance(d, 20000);
+    d->truth[0] = 6000;
+    h_advance(d, 20000);
+    EXPECT_NONE(d);
+    h_rx(d, 0x000, "01 20");
+    h_advance(d, 20000);
+    EXPECT_ID(d, 0x1A0, "58 02");
+    EXPECT_NONE(d);
 }
 
 /* A fault raises its EMCY and the error register, and the slope holds
@@ -201,6 +231,7 @@ int main(void)
 {
     RUN(test_boot_and_identity);
     RUN(test_slope_on_tpdo);
+    RUN(test_event_on_change);
     RUN(test_fault_emcy);
     RUN(test_store);
     RUN(test_dictionary_defaults);
