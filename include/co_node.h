@@ -148,7 +148,6 @@ typedef struct co_node_cfg {
     bool load_keeps_lss;        /* 0x1011 "load" leaves node-ID and bit rate alone */
     bool comm_reset_applies_id; /* reset communication also activates a new node-ID */
     bool save_includes_lss;     /* 0x1010 "save" stores the node-ID / bit-rate set too */
-    bool lss;                   /* LSS slave (CiA 305): list co_lss_service too */
     uint16_t lss_bitrates;      /* CiA 305 bit-timing indices supported (bit n = index n) */
     uint8_t id_offset;          /* id_index holds the node-ID minus this (the JD's 3000h: 1) */
     uint16_t id_index;          /* 0, or a product's own U8 object (sub 0) of the PARA class
@@ -157,6 +156,18 @@ typedef struct co_node_cfg {
                                  * loaded. A node-ID in the LSS class needs none. */
     const uint16_t *kbps;       /* kbit/s of each bit-rate code (16 codes; 0: unused), or NULL */
 } co_node_cfg_t;
+
+/* Whether cfg lists service sv (a node is an LSS slave when it lists
+ * co_lss_service: the list is the one place that says so). */
+static inline bool co_cfg_has_service(const co_node_cfg_t *cfg, const co_service_t *sv)
+{
+    for (const co_service_t *const *s = cfg->services; s != NULL && *s != NULL; s++) {
+        if (*s == sv) {
+            return true;
+        }
+    }
+    return false;
+}
 
 /* The node's state. Its fields are the stack's: the accessors below and
  * the modules' functions are the product's and the board's way in. */

@@ -109,10 +109,11 @@ uint16_t product_kbps(const product_t *p, uint8_t code);
  * is left out; 0 without a config or table. */
 uint8_t product_eds_bitrates(const product_t *p);
 
-/* Whether p's node 0 is an LSS slave (CiA 305): its config's lss. */
+/* Whether p's node 0 is an LSS slave (CiA 305): its config lists the
+ * LSS service. */
 static inline bool product_lss(const product_t *p)
 {
-    return p->cfg != NULL && p->cfg->lss;
+    return p->cfg != NULL && co_cfg_has_service(p->cfg, &co_lss_service);
 }
 
 /* Every product, in --list-products order; NULL-terminated. */

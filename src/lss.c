@@ -165,7 +165,7 @@ bool co_lss_receive(co_node_t *node, const co_frame_t *f)
     if (f->id != 0x7E5u || f->rtr) {
         return false;
     }
-    if (f->dlc != 8u || !co_cfg(node)->lss) {
+    if (f->dlc != 8u) {
         return true;
     }
     co_lss_t *l = &node->lss;

@@ -125,7 +125,7 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
     if (co_cfg(node)->ops != NULL && co_cfg(node)->ops->reset != NULL) {
         co_cfg(node)->ops->reset(node, kind); /* may set the node-ID from its own objects */
     }
-    if (co_cfg(node)->lss && node->lss.pending_id != 0u) {
+    if (co_cfg_has_service(co_cfg(node), &co_lss_service) && node->lss.pending_id != 0u) {
         /* CiA 305: an LSS-configured node-ID is active from reset communication on. */
         node->node_id = node->lss.pending_id;
         node->lss.pending_id = 0;

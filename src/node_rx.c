@@ -30,17 +30,6 @@ static unsigned add(co_rx_id_t *ids, unsigned n, unsigned max, uint16_t id, bool
     return n + 1u;
 }
 
-/* Whether the product's config lists service sv. */
-static bool has_service(const co_node_t *node, const co_service_t *sv)
-{
-    for (const co_service_t *const *s = co_cfg(node)->services; s != NULL && *s != NULL; s++) {
-        if (*s == sv) {
-            return true;
-        }
-    }
-    return false;
-}
-
 unsigned co_node_rx_ids(const co_node_t *node, co_rx_id_t *ids, unsigned max)
 {
     unsigned n = 0;
@@ -51,7 +40,7 @@ unsigned co_node_rx_ids(const co_node_t *node, co_rx_id_t *ids, unsigned max)
     if (configured) {
         n = add(ids, n, max, (uint16_t)(0x600u + id), false);
     }
-    if (co_cfg(node)->lss) {
+    if (co_cfg_has_service(co_cfg(node), &co_lss_service)) {
         n = add(ids, n, max, 0x7E5u, false);
     }
     if (configured && node->guard.enabled) {
@@ -60,7 +49,7 @@ unsigned co_node_rx_ids(const co_node_t *node, co_rx_id_t *ids, unsigned max)
     if (node->hbc.node_id != 0u && node->hbc.time_ms != 0u) {
         n = add(ids, n, max, (uint16_t)(0x700u + node->hbc.node_id), false);
     }
-    if (has_service(node, &co_rtr_service)) {
+    if (co_cfg_has_service(co_cfg(node), &co_rtr_service)) {
         for (unsigned k = 0; k < CO_TPDO_MAX; k++) {
             const co_tpdo_t *t = &node->tpdo[k];
             if (t->valid && t->rtr_allowed) {

@@ -155,7 +155,7 @@ static const co_service_t *const jd_services[] = {&co_lss_service, &co_guard_ser
      .sdo_segmented = co_sdo_segmented, .sdo_block = co_sdo_block,                      \
      .ram_size = {[CO_CLS_PARA] = sizeof(jd_para_t)}, .default_node_id = 10,            \
      .id_index = 0x3000, .id_offset = 1 /* 3000h = node-ID - 1 (manual, 9.21) */,       \
-     .default_bitrate = 3, .tpdo_dlc = 0, .lss = true, .lss_bitrates = JD_LSS_BITRATES,     \
+     .default_bitrate = 3, .tpdo_dlc = 0, .lss_bitrates = JD_LSS_BITRATES,     \
      .kbps = product_kbps_ifm}
 const co_node_cfg_t jd2_cfg = JD_CFG(&jd2_od);
 const co_node_cfg_t jd1_cfg = JD_CFG(&jd1_od);

@@ -101,7 +101,7 @@ static void test_rx_ids_every_product(void)
             CHECK(has(ids, n, 0x000, false));
             CHECK(has(ids, n, 0x600u + id, false));
             CHECK(has(ids, n, node->sync.cob_id, false));
-            CHECK_EQ(has(ids, n, 0x7E5, false), node->cfg->lss);
+            CHECK_EQ(has(ids, n, 0x7E5, false), co_cfg_has_service(node->cfg, &co_lss_service));
             for (unsigned a = 0; a < n; a++) {
                 CHECK(ids[a].id <= 0x7FFu);
                 for (unsigned b = a + 1u; b < n; b++) {

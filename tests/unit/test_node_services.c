@@ -120,7 +120,6 @@ static const co_node_cfg_t n_cfg = {
     .ram_size = {0, sizeof(n_vol_t), sizeof(n_para_t), sizeof(co_lss_para_t)},
     .default_node_id = 0x40,
     .default_bitrate = 3,
-    .lss = true,
     .lss_bitrates = 0x01DF, /* CiA 305 indices 0-4, 6-8 */
 };
 
@@ -134,7 +133,6 @@ static const co_node_cfg_t n_comm_id_cfg = {
     .default_node_id = 0x40,
     .default_bitrate = 3,
     .comm_reset_applies_id = true,
-    .lss = true,
     .lss_bitrates = 0x01DF,
 };
 
@@ -162,7 +160,6 @@ static const co_node_cfg_t n_min_cfg = {
     .ram_size = {0, 0, sizeof(n_para_t), 0},
     .default_node_id = 0x40,
     .default_bitrate = 3,
-    .lss = true,
     .lss_bitrates = 0x0008,
 };
 
@@ -180,7 +177,7 @@ static void n_create(const product_t *p, void *mem, void *const ports[], co_node
     bool no_lss = v != NULL && v->no_lss;
     const co_node_cfg_t *cfg = v != NULL ? v->cfg : &n_cfg;
     void *const ram[CO_CLS_COUNT] = {NULL, cfg->ram_size[CO_CLS_VOL] != 0u ? &t->vol : NULL,
-                                     &t->para, no_lss || !cfg->lss ? NULL : &t->lss};
+                                     &t->para, no_lss || !co_cfg_has_service(cfg, &co_lss_service) ? NULL : &t->lss};
     co_node_init(&t->node, cfg, ports[0], t, ram, 0);
     nodes[0] = &t->node;
 }
