@@ -1,8 +1,8 @@
 """What the one integration suite (test_targets.py) expects of each product,
 as a table: the checks are the same code for every product and target,
-and every way a family differs is a value here (shared/specs/<family>.md
-is the source of each; the spec's rule numbers are given where a value is
-not plain CiA 301).
+and every way a family differs is a value here (the product's manual is
+the source of each; its section is given where a value is not plain
+CiA 301, "decision:" where the manual leaves it open).
 
 A family without a table here (one tools/new-family just made) is
 expected to do what the template it was made from does (TEMPLATE below),
@@ -147,26 +147,28 @@ DST = Facts(
     rw=((0x1017, 0, u16(250)), (0x2001, 0, u8(2))),
     app_param=(0x6014, 0, i16(-120), i16(0)),
     aborts=COMMON_ABORTS + (
-        Abort("w", 0x1017, 0, 0x06090030, u16(10)),        # 1..19 not accepted (B-17)
-        Abort("w", 0x1800, 2, 0x06090030, u8(255)),        # 1..240, 254 only (C-18)
-        Abort("w", 0x20F0, 0, 0x06090032, u8(0)),          # node-ID 1..127 (B-42)
+        Abort("w", 0x1017, 0, 0x06090030, u16(10)),        # 1..19 not accepted (DST guides, 12)
+        Abort("w", 0x1800, 2, 0x06090030, u8(255)),        # 1..240, 254 only (DST guides, 12)
+        Abort("w", 0x20F0, 0, 0x06090032, u8(0)),          # node-ID 1..127 (DST guides, 20F0h)
         Abort("w", 0x2001, 0, 0x06070012, bytes(9)),       # segmented, longer than the object
     ),
     sync_type=2,
     sync_refused=None,
     event_mode=(),                                         # 254 + event timer by default
     fault=Fault(on=("fault sensor on",), off=("fault sensor off",),
-                emcy=bytes.fromhex("0010000001000000"),    # 0x1000, 0x4001 = 0x01 (B-22)
+                emcy=bytes.fromhex("0010000001000000"),    # 0x1000, 0x4001 = 0x01 (DST guides, 9)
                 emcy_off=bytes(8)),
     stored=(HEARTBEAT, EVENT_TIMER),
     defaults=(0, 100),
     set_a=(300, 40),
     set_b=(500, 60),
     autosave=False,
-    # 0x4001 bit 6: the LSS set's checksum (B-31); a bad PARA set only
-    # brings the defaults back, which the stored-set checks catch.
+    # 0x4001 bit 6: the LSS set's checksum (DST guides, 9); decision:
+    # a bad PARA set (no bit for it) only brings the defaults back, which the
+    # stored-set checks catch.
     corrupt=Corrupt(sdo_bit=(0x4001, 0, 0x40)),
-    # B-41..B-44: both copies, stored by the device itself, active after a reset.
+    # DST guides, 20F0h and example 2: both copies, active after a power cycle;
+    # decision: stored by the device itself (the example has no save).
     node_id_change=NodeIdChange(steps=(("sdo", 0x20F0, 0, u8(6)), ("sdo", 0x20F1, 0, u8(6)),
                                        ("power-cycle",)), new_id=6),
     sdo_block=False,                                       # expedited and segmented (README)
@@ -177,22 +179,24 @@ GSH = Facts(
     family="gsh",
     nodes=(0x13,),
     device_type=0xFFFF0196,
-    identity={1: 0x93, 2: 0x67, 3: 1},                     # sub 4 per unit (C-31)
+    identity={1: 0x93, 2: 0x67, 3: 1},                     # sub 4 per unit
     name=b"GSHA",
-    boot_state=0x05,                                       # 0x5000 = 1: starts by itself (R-02)
+    boot_state=0x05,                                       # auto-start: 5000h (GSH-A manual, 12)
     reads=(Read(0x100A, 0, b"1.00"), Read(0x1200, 1, ID(0x600)), Read(0x1800, 1, ID(0x180)),
            Read(0x1800, 2, u8(254)), Read(0x5000, 0, u8(1)), Read(0x1010, 1, u32(1))),
     rw=((0x1017, 0, u16(250)), (0x1800, 5, u16(200))),
     app_param=(0x5000, 0, u8(0), u8(1)),
     aborts=COMMON_ABORTS + (
-        Abort("r", 0x1011, 1, 0x06020000),                 # no 0x1011 (C-09)
-        Abort("w", 0x3001, 0, 0x06090032, u8(0)),          # node-ID 1..127 (R-27)
-        Abort("w", 0x1800, 5, 0x06090032, u16(3)),         # 0 or 4..65535 ms (D-38)
+        Abort("r", 0x1011, 1, 0x06020000),                 # no 0x1011 (nor in the GSH-A manual)
+        Abort("w", 0x3001, 0, 0x06090032, u8(0)),          # node-ID 01h..7Fh (GSH-A manual, 4)
+        # 4..65535 ms (GSH-A manual, 11); decision: 0 accepted, as "off".
+        Abort("w", 0x1800, 5, 0x06090032, u16(3)),
     ),
-    sync_type=None,                                        # type 254, fixed (C-11)
+    sync_type=None,                                        # type 254, ro (GSH-A manual, 12)
     sync_refused=0x06010002,
     event_mode=(),
-    # No EMCY at all (R-14, C-37): the alarm word of TPDO1 (bytes 4-5) shows it.
+    # No EMCY at all (the GSH-A manual has no EMCY object): the alarm word of
+    # TPDO1 (bytes 4-5, GSH-A manual, 9) shows it.
     fault=Fault(on=("fault extension-element on",), off=("fault extension-element off",),
                 pdo_alarm=(5, 0x02)),
     stored=(HEARTBEAT, EVENT_TIMER),
@@ -200,8 +204,8 @@ GSH = Facts(
     set_a=(300, 40),
     set_b=(500, 60),
     autosave=False,
-    corrupt=Corrupt(),                                     # defaults only (C-38)
-    # R-27..R-29: write, save, reset (power cycle in the manual's example).
+    corrupt=Corrupt(),                                     # decision: defaults only (manual silent)
+    # GSH-A manual, 13, example 1: write, save, reset (a power cycle).
     node_id_change=NodeIdChange(steps=(("sdo", 0x3001, 0, u8(6)), ("sdo", 0x1010, 1, SAVE),
                                        ("power-cycle",)), new_id=6),
 )
@@ -218,14 +222,16 @@ JD = Facts(
     rw=((0x1017, 0, u16(250)), (0x3100, 0, u16(4))),
     app_param=(0x3100, 0, u16(4), u16(0)),
     aborts=COMMON_ABORTS + (
-        Abort("w", 0x3000, 0, 0x06090031, u8(0x7F)),       # node number 0..0x7E (C1)
-        Abort("w", 0x1800, 3, 0x06090030, u16(10)),        # inhibit only while invalid (R21)
+        Abort("w", 0x3000, 0, 0x06090031, u8(0x7F)),       # node number 0..0x7E (JD manual, 9.21)
+        # Inhibit time only while the TPDO is invalid (JD manual, 8.9.4).
+        Abort("w", 0x1800, 3, 0x06090030, u16(10)),
     ),
     sync_type=2,
     sync_refused=None,
     event_mode=((0x1800, 2, u8(254)),),
     fault=Fault(on=("can passive",), off=("can active",),
-                emcy=bytes.fromhex("2081110000000000"),    # 8120h CAN error passive (R34)
+                # 8120h CAN error passive: CiA 301's code (the JD manual lists none).
+                emcy=bytes.fromhex("2081110000000000"),
                 emcy_off=bytes(8)),
     stored=(HEARTBEAT, EVENT_TIMER),
     defaults=(0, 10),
@@ -233,7 +239,7 @@ JD = Facts(
     set_b=(500, 60),
     autosave=False,
     corrupt=Corrupt(emcy_code=0x6300),
-    # R41, R44: LSS configure node-ID + store, then reset communication.
+    # LSS (JD manual, 6.3; CiA 305): configure node-ID + store, then reset comm.
     node_id_change=NodeIdChange(steps=(("lss-node-id", 32), ("nmt", 0x82)), new_id=32),
     dynamic_mapping=True,
 )
@@ -242,7 +248,7 @@ PF = Facts(
     family="pf",
     nodes=(1,),
     device_type=0x0000019A,
-    identity={1: 0, 2: 0, 3: 0},                           # placeholders (G4); 4 per unit
+    identity={1: 0, 2: 0, 3: 0},                           # placeholders: the manual has none
     name=b"INY360D-F99-B16-V15",
     boot_state=0x7F,
     reads=(Read(0x1010, 1, u32(3)), Read(0x1800, 1, ID(0x180)), Read(0x1800, 2, u8(1)),
@@ -257,8 +263,9 @@ PF = Facts(
     ),
     sync_type=2,
     sync_refused=None,
-    # FEh is sent after each calculation, like FFh (R26, C10), the event timer
-    # only adds to that (R31): the inhibit time (R27) makes the 50 ms here.
+    # FEh is sent after each calculation, like FFh (decision: the P+F manual,
+    # 7.1.1, lists only FFh), the event timer (CiA 301) only adds to that: the
+    # inhibit time (P+F manual, 7.1.1) makes the 50 ms here.
     event_mode=((0x1800, 2, u8(0xFE)), (0x1800, 3, u16(500))),
     fault=Fault(on=("fault range-x on",), off=("fault range-x off",),
                 emcy=bytes.fromhex("1050110000000000"),    # 5010h, register 0x11
@@ -267,9 +274,10 @@ PF = Facts(
     defaults=(0, 0),
     set_a=(300, 40),
     set_b=(500, 60),
-    autosave=True,                                         # G2: every write is stored
-    corrupt=Corrupt(emcy_code=0x6300),                     # R52
-    # L297-307: write 2000h, active after Reset Node.
+    # Decision: every write is stored at once (no save step in the P+F manual).
+    autosave=True,
+    corrupt=Corrupt(emcy_code=0x6300),                     # EEPROM checksum (P+F manual, 7.2.1)
+    # P+F manual, 6.2: write 2000h, active after Reset Node or a power cycle.
     node_id_change=NodeIdChange(steps=(("sdo", 0x2000, 0, u8(15)), ("nmt", 0x81)), new_id=15),
     dynamic_mapping=True,
 )
