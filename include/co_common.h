@@ -25,15 +25,15 @@
  * instructions in that loop. */
 typedef struct co_frame {
     _Alignas(4) uint16_t id; /* 11-bit CAN identifier */
-    uint8_t dlc;     /* 0..8 */
-    bool rtr;        /* remote transmission request */
+    uint8_t dlc;             /* 0..8 */
+    bool rtr;                /* remote transmission request */
     uint8_t data[8];
 } co_frame_t;
 
 /* State of the CAN controller as the board reports it. */
 typedef enum co_can_state {
     CO_CAN_ACTIVE = 0,
-    CO_CAN_WARNING,  /* an error counter reached the warning limit (96) */
+    CO_CAN_WARNING, /* an error counter reached the warning limit (96) */
     CO_CAN_PASSIVE,
     CO_CAN_BUSOFF,
 } co_can_state_t;
@@ -108,8 +108,7 @@ static inline uint16_t co_get_u16(const uint8_t *p)
 /* The 32-bit value at p. */
 static inline uint32_t co_get_u32(const uint8_t *p)
 {
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) |
-           ((uint32_t)p[3] << 24);
+    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 
 /* v into the 2 bytes at p. */
@@ -135,33 +134,33 @@ static inline void co_put_u32(uint8_t *p, uint32_t v)
  */
 typedef enum co_res {
     CO_OK = 0,
-    CO_E_TOGGLE = 0x05030000,      /* toggle bit not alternated */
-    CO_E_TIMEOUT = 0x05040000,     /* SDO protocol timed out */
-    CO_E_CMD = 0x05040001,         /* client/server command specifier invalid */
-    CO_E_BLKSIZE = 0x05040002,     /* invalid block size */
-    CO_E_SEQNO = 0x05040003,       /* invalid sequence number */
-    CO_E_CRC = 0x05040004,         /* CRC error (block mode) */
-    CO_E_OOM = 0x05040005,         /* out of memory */
-    CO_E_UNSUPP = 0x06010000,      /* unsupported access to an object */
-    CO_E_WO = 0x06010001,          /* attempt to read a write-only object */
-    CO_E_RO = 0x06010002,          /* attempt to write a read-only object */
-    CO_E_NO_OBJ = 0x06020000,      /* object does not exist */
-    CO_E_NO_MAP = 0x06040041,      /* object cannot be mapped to the PDO */
-    CO_E_MAP_LEN = 0x06040042,     /* mapped objects exceed PDO length */
-    CO_E_PARAM = 0x06040043,       /* general parameter incompatibility */
-    CO_E_HW = 0x06060000,          /* access failed due to a hardware error */
-    CO_E_LEN = 0x06070010,         /* data type / length does not match */
-    CO_E_LEN_HIGH = 0x06070012,    /* length of service parameter too high */
-    CO_E_LEN_LOW = 0x06070013,     /* length of service parameter too low */
-    CO_E_NO_SUB = 0x06090011,      /* sub-index does not exist */
-    CO_E_VAL = 0x06090030,         /* invalid value for parameter */
-    CO_E_VAL_HIGH = 0x06090031,    /* value of parameter written too high */
-    CO_E_VAL_LOW = 0x06090032,     /* value of parameter written too low */
-    CO_E_GENERAL = 0x08000000,     /* general error */
-    CO_E_STORE = 0x08000020,       /* data cannot be transferred or stored */
-    CO_E_LOCAL = 0x08000021,       /* ... because of local control */
-    CO_E_STATE = 0x08000022,       /* ... because of the present device state */
-    CO_E_NO_DATA = 0x08000024,     /* no data available */
+    CO_E_TOGGLE = 0x05030000,   /* toggle bit not alternated */
+    CO_E_TIMEOUT = 0x05040000,  /* SDO protocol timed out */
+    CO_E_CMD = 0x05040001,      /* client/server command specifier invalid */
+    CO_E_BLKSIZE = 0x05040002,  /* invalid block size */
+    CO_E_SEQNO = 0x05040003,    /* invalid sequence number */
+    CO_E_CRC = 0x05040004,      /* CRC error (block mode) */
+    CO_E_OOM = 0x05040005,      /* out of memory */
+    CO_E_UNSUPP = 0x06010000,   /* unsupported access to an object */
+    CO_E_WO = 0x06010001,       /* attempt to read a write-only object */
+    CO_E_RO = 0x06010002,       /* attempt to write a read-only object */
+    CO_E_NO_OBJ = 0x06020000,   /* object does not exist */
+    CO_E_NO_MAP = 0x06040041,   /* object cannot be mapped to the PDO */
+    CO_E_MAP_LEN = 0x06040042,  /* mapped objects exceed PDO length */
+    CO_E_PARAM = 0x06040043,    /* general parameter incompatibility */
+    CO_E_HW = 0x06060000,       /* access failed due to a hardware error */
+    CO_E_LEN = 0x06070010,      /* data type / length does not match */
+    CO_E_LEN_HIGH = 0x06070012, /* length of service parameter too high */
+    CO_E_LEN_LOW = 0x06070013,  /* length of service parameter too low */
+    CO_E_NO_SUB = 0x06090011,   /* sub-index does not exist */
+    CO_E_VAL = 0x06090030,      /* invalid value for parameter */
+    CO_E_VAL_HIGH = 0x06090031, /* value of parameter written too high */
+    CO_E_VAL_LOW = 0x06090032,  /* value of parameter written too low */
+    CO_E_GENERAL = 0x08000000,  /* general error */
+    CO_E_STORE = 0x08000020,    /* data cannot be transferred or stored */
+    CO_E_LOCAL = 0x08000021,    /* ... because of local control */
+    CO_E_STATE = 0x08000022,    /* ... because of the present device state */
+    CO_E_NO_DATA = 0x08000024,  /* no data available */
 } co_res_t;
 
 /* The SDO abort code of a result (CO_OK gives 0). */

@@ -25,7 +25,7 @@ enum {
     CO_EMCY_GENERIC = 0x1000,
     CO_EMCY_VOLTAGE_LOW = 0x3100,
     CO_EMCY_DATA_SET = 0x6300,
-    CO_EMCY_LIFE_GUARD = 0x8130,   /* life guard or heartbeat consumer event */
+    CO_EMCY_LIFE_GUARD = 0x8130, /* life guard or heartbeat consumer event */
 };
 
 /* Error register (0x1001) bits. */
@@ -66,8 +66,8 @@ typedef struct co_emcy {
     uint16_t code[CO_EMCY_ACTIVE_MAX];
     uint8_t bits[CO_EMCY_ACTIVE_MAX];
 #if CO_EMCY_HIST_MAX > 0
-    uint8_t nhist;                     /* entries in hist, newest first */
-    uint32_t hist[CO_EMCY_HIST_MAX];   /* 0x1003: code | additional info << 16 */
+    uint8_t nhist;                   /* entries in hist, newest first */
+    uint32_t hist[CO_EMCY_HIST_MAX]; /* 0x1003: code | additional info << 16 */
 #endif
 } co_emcy_t;
 

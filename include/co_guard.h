@@ -30,11 +30,11 @@
 typedef struct co_node co_node_t;
 
 typedef struct co_guard {
-    bool enabled;     /* the dictionary has guarding objects */
-    uint8_t toggle;   /* 0x00 or 0x80, the next answer's bit 7 */
-    bool seen;        /* a request came since the last reset */
-    bool kick;        /* a request came: restart the life time at next poll */
-    bool lost;        /* life-guard event active */
+    bool enabled;      /* the dictionary has guarding objects */
+    uint8_t toggle;    /* 0x00 or 0x80, the next answer's bit 7 */
+    bool seen;         /* a request came since the last reset */
+    bool kick;         /* a request came: restart the life time at next poll */
+    bool lost;         /* life-guard event active */
     uint32_t deadline; /* end of the current lap of the life time */
     uint32_t left_ms;  /* life time still to run after this lap */
 } co_guard_t;

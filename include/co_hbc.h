@@ -16,11 +16,11 @@
 typedef struct co_node co_node_t;
 
 typedef struct co_hbc {
-    uint8_t node_id;   /* monitored node; 0: off */
+    uint8_t node_id; /* monitored node; 0: off */
     uint16_t time_ms;
-    bool started;      /* a heartbeat came since configuration */
-    bool kick;         /* one came: restart the time at the next poll */
-    bool lost;         /* heartbeat event active */
+    bool started; /* a heartbeat came since configuration */
+    bool kick;    /* one came: restart the time at the next poll */
+    bool lost;    /* heartbeat event active */
     uint32_t deadline;
 } co_hbc_t;
 

@@ -225,15 +225,15 @@ typedef struct co_incl_para {
 
 typedef struct co_incl {
     co_incl_para_t *p;
-    uint8_t axes;        /* 1 (single axis) or 2 */
-    bool wrap;           /* full turn: the angle wraps at +-180 deg */
+    uint8_t axes; /* 1 (single axis) or 2 */
+    bool wrap;    /* full turn: the angle wraps at +-180 deg */
 #if CO_INCL_CIRCULAR
-    bool circular;       /* outputs 0..full turn - 1 LSB, modulo a full turn (P+F) */
+    bool circular; /* outputs 0..full turn - 1 LSB, modulo a full turn (P+F) */
 #endif
-    bool fault;          /* sensor element error: outputs hold */
-    int32_t limit_mdeg;  /* output stops here, error beyond it; 0: none */
-    uint8_t shift;       /* active filter shift */
-    bool beyond[CO_INCL_AXES];  /* measured angle strictly beyond the limit */
+    bool fault;                  /* sensor element error: outputs hold */
+    int32_t limit_mdeg;          /* output stops here, error beyond it; 0: none */
+    uint8_t shift;               /* active filter shift */
+    bool beyond[CO_INCL_AXES];   /* measured angle strictly beyond the limit */
     int32_t angle[CO_INCL_AXES]; /* filtered, saturated angle (mdeg) */
     /* Wrap mode: each axis' own continuous input to its filter (one value
      * for both makes the second axis follow the first's turns). */
@@ -352,6 +352,5 @@ co_res_t co_incl_set_resolution(co_incl_t *incl, uint16_t res);
  * written. Range checks of the value are the product's, before calling.
  */
 void co_incl_set_preset(co_incl_t *incl, unsigned axis, int16_t preset);
-
 
 #endif /* CO_INCL_H */

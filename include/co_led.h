@@ -11,10 +11,10 @@
 typedef enum co_led_pattern {
     CO_LED_OFF = 0,
     CO_LED_ON,
-    CO_LED_FLICKER,    /* on/off flicker_ms */
-    CO_LED_BLINK,      /* on/off blink_ms */
-    CO_LED_FLASH1,     /* flash_ms on, then pause_ms off */
-    CO_LED_FLASH2,     /* on, off, on (flash_ms each), then pause_ms */
+    CO_LED_FLICKER, /* on/off flicker_ms */
+    CO_LED_BLINK,   /* on/off blink_ms */
+    CO_LED_FLASH1,  /* flash_ms on, then pause_ms off */
+    CO_LED_FLASH2,  /* on, off, on (flash_ms each), then pause_ms */
 } co_led_pattern_t;
 
 /* Timings in ms; products adapt them to their manuals. */

@@ -32,15 +32,15 @@ typedef struct co_node co_node_t;
 #define CO_LSS_UNCONFIGURED 0xFFu
 
 typedef struct co_lss {
-    uint8_t state;       /* 0 waiting, 1 configuration */
-    uint8_t selective;   /* switch-state-selective progress (matched parts) */
-    uint8_t pending_id;  /* node-ID for the next reset communication; 0: none */
-    uint8_t pending_br;  /* CiA 305 bit-timing index configured; 0xFF: none */
-    uint8_t identify;    /* identify-remote-slave progress */
-    uint8_t fs_sub;      /* Fastscan: which LSS address part is checked next */
-    bool fs_active;      /* Fastscan: confirmed so far */
-    bool switching;      /* activate bit timing: the switch is due at switch_at */
-    uint32_t switch_at;  /* (us) */
+    uint8_t state;      /* 0 waiting, 1 configuration */
+    uint8_t selective;  /* switch-state-selective progress (matched parts) */
+    uint8_t pending_id; /* node-ID for the next reset communication; 0: none */
+    uint8_t pending_br; /* CiA 305 bit-timing index configured; 0xFF: none */
+    uint8_t identify;   /* identify-remote-slave progress */
+    uint8_t fs_sub;     /* Fastscan: which LSS address part is checked next */
+    bool fs_active;     /* Fastscan: confirmed so far */
+    bool switching;     /* activate bit timing: the switch is due at switch_at */
+    uint32_t switch_at; /* (us) */
 } co_lss_t;
 
 /* Reset communication (co_service_t.reset): back to the waiting state, no

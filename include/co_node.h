@@ -78,7 +78,6 @@
 #include "co_sync.h"
 #include "co_tpdo.h"
 
-
 /* Stored node-ID and bit rate: the RAM struct of class LSS. */
 typedef struct co_lss_para {
     uint8_t node_id;
@@ -174,26 +173,26 @@ static inline bool co_cfg_has_service(const co_node_cfg_t *cfg, const co_service
 struct co_node {
     /* Bytes first: on a Cortex-M0 a byte field is one load only within the
      * first 32 bytes of the struct (words: 128), so the hot ones go here. */
-    uint8_t node_id;            /* active node-ID */
-    uint8_t bitrate;            /* active bit-rate code (the product's table) */
-    uint8_t can_state;          /* co_can_state_t */
-    bool autostart;             /* set by the reset op: go operational after boot-up */
-    uint8_t reset_request;      /* co_reset_t to perform at the next poll (0: none) */
-    bool dirty;                 /* something happened since the last full poll */
-    bool due_never;             /* the last full poll found no deadline at all */
-    bool od_checking;           /* write hooks only validate (co_od_validate) */
-    uint8_t factory_id;         /* co_node_set_factory_id(); 0: the config's default */
+    uint8_t node_id;       /* active node-ID */
+    uint8_t bitrate;       /* active bit-rate code (the product's table) */
+    uint8_t can_state;     /* co_can_state_t */
+    bool autostart;        /* set by the reset op: go operational after boot-up */
+    uint8_t reset_request; /* co_reset_t to perform at the next poll (0: none) */
+    bool dirty;            /* something happened since the last full poll */
+    bool due_never;        /* the last full poll found no deadline at all */
+    bool od_checking;      /* write hooks only validate (co_od_validate) */
+    uint8_t factory_id;    /* co_node_set_factory_id(); 0: the config's default */
     co_nmt_t nmt;
-    uint16_t can_kbps;          /* bit rate the board was last asked for (co_port_can_bitrate);
-                                 * here, in what was padding before cfg */
+    uint16_t can_kbps; /* bit rate the board was last asked for (co_port_can_bitrate);
+                        * here, in what was padding before cfg */
     const co_node_cfg_t *cfg;
-    void *port;                 /* board context for co_port_* */
-    void *app;                  /* product context for its hooks */
-    void *ram[CO_CLS_COUNT];    /* the class structs, owned by the caller */
-    uint32_t nvm_base;          /* where this node's records start in NVM */
-    uint32_t now;               /* time of the latest co_node_poll() or co_node_receive() */
-    uint32_t due;               /* not dirty: no service needs to run before this time */
-    uint32_t tx_dropped;        /* frames the board could not queue */
+    void *port;              /* board context for co_port_* */
+    void *app;               /* product context for its hooks */
+    void *ram[CO_CLS_COUNT]; /* the class structs, owned by the caller */
+    uint32_t nvm_base;       /* where this node's records start in NVM */
+    uint32_t now;            /* time of the latest co_node_poll() or co_node_receive() */
+    uint32_t due;            /* not dirty: no service needs to run before this time */
+    uint32_t tx_dropped;     /* frames the board could not queue */
     co_sync_t sync;
     co_hb_t hb;
     co_store_t store;
@@ -354,8 +353,7 @@ static inline void co_node_set_autostart(co_node_t *node, bool on)
  */
 static inline void co_node_set_factory_id(co_node_t *node, uint8_t id)
 {
-    if (CO_CHECK(node->nmt.state == CO_NMT_INIT) &&
-        CO_CHECK(id >= 1u && id <= 127u)) {
+    if (CO_CHECK(node->nmt.state == CO_NMT_INIT) && CO_CHECK(id >= 1u && id <= 127u)) {
         node->factory_id = id;
         node->node_id = id;
     }
@@ -384,8 +382,6 @@ static inline uint32_t co_node_serial(const co_node_t *node)
 {
     return node->serial;
 }
-
-
 
 /* The node's factory node-ID: co_node_set_factory_id()'s, else the config's. */
 static inline uint8_t co_node_factory_id(const co_node_t *node)

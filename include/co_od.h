@@ -46,8 +46,8 @@ typedef enum co_type {
 
 /* Attribute bits of an entry. */
 enum {
-    CO_A_R = 0x01,      /* readable */
-    CO_A_W = 0x02,      /* writable */
+    CO_A_R = 0x01, /* readable */
+    CO_A_W = 0x02, /* writable */
     CO_A_RW = 0x03,
     CO_A_CONST = 0x04,  /* never changes (EDS "const"); combine with CO_A_R */
     CO_A_PDO = 0x08,    /* may be mapped into a TPDO */
@@ -100,11 +100,11 @@ typedef struct co_od_ext {
 struct co_od_entry {
     uint16_t index;
     uint8_t sub;
-    uint8_t type;  /* co_type_t */
-    uint8_t attr;  /* CO_A_* */
-    uint8_t cls;   /* co_cls_t */
-    uint8_t size;  /* bytes: 1, 2 or 4 for numbers, string length (< 256) */
-    uint8_t off;   /* offset of the value in the class's RAM struct (< 256) */
+    uint8_t type; /* co_type_t */
+    uint8_t attr; /* CO_A_* */
+    uint8_t cls;  /* co_cls_t */
+    uint8_t size; /* bytes: 1, 2 or 4 for numbers, string length (< 256) */
+    uint8_t off;  /* offset of the value in the class's RAM struct (< 256) */
     union {
         uint32_t def;      /* default / constant value (numbers) */
         const void *cdata; /* constant bytes (strings) */
@@ -248,6 +248,8 @@ static inline uint32_t co_od_size(const co_od_entry_t *e)
 #define CO_AT(c, T, f) .cls = (c), .off = offsetof(T, f)
 /* Limits and hooks: CO_EXT(.min = 1, .max = 127, .write = fn). A compound
  * literal at file scope: a constant in flash next to the table. */
+/* clang-format off */
 #define CO_EXT(...) .ext = &(const co_od_ext_t){__VA_ARGS__}
+/* clang-format on */
 
 #endif /* CO_OD_H */

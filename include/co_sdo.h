@@ -42,8 +42,8 @@ typedef struct co_sdo {
     uint8_t toggle; /* expected toggle bit of the next segment (0 or 0x10) */
     bool restart;   /* a segment arrived: the timeout restarts at next poll */
     const co_od_entry_t *e;
-    uint32_t size;  /* bytes of the transfer */
-    uint32_t pos;   /* bytes done */
+    uint32_t size; /* bytes of the transfer */
+    uint32_t pos;  /* bytes done */
     uint32_t deadline;
     uint8_t blksize;    /* block transfer: segments per block */
     uint8_t seq;        /* block download: last good seqno; upload: segments sent */

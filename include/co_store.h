@@ -43,7 +43,7 @@
  * and slot (the flash EEPROM programs half-words from a slot's start,
  * flash_ee.h), room for data and the CRC, and a slot in the 1 KiB page of
  * the smallest flash (STM32F042: one slot a page). */
-#if CO_STORE_HDR < 20 || CO_STORE_HDR % 2 != 0 || CO_STORE_SLOT % 2 != 0 || \
+#if CO_STORE_HDR < 20 || CO_STORE_HDR % 2 != 0 || CO_STORE_SLOT % 2 != 0 ||                        \
     CO_STORE_SLOT < CO_STORE_HDR + 4 + 2 || CO_STORE_SLOT > 1024
 #error "CO_STORE_HDR must be even and >= 20, CO_STORE_SLOT even, above header + CRC, <= 1024"
 #endif
@@ -53,18 +53,18 @@
 #define CO_SIG_LOAD 0x64616F6Cu
 
 typedef enum co_store_status {
-    CO_STORE_OK = 0,       /* a valid record was applied */
-    CO_STORE_BLANK,        /* nothing ever stored: defaults */
-    CO_STORE_DEFAULTS,     /* "load" was requested: defaults */
-    CO_STORE_CORRUPT,      /* the slots hold something (not erased) but no valid record:
-                            * defaults; or the newest record passed its CRC but some
-                            * values failed validation (co_od_validate): those are
-                            * defaults. Stays until the next full save */
-    CO_STORE_HW,           /* NVM read failed: defaults */
+    CO_STORE_OK = 0,   /* a valid record was applied */
+    CO_STORE_BLANK,    /* nothing ever stored: defaults */
+    CO_STORE_DEFAULTS, /* "load" was requested: defaults */
+    CO_STORE_CORRUPT,  /* the slots hold something (not erased) but no valid record:
+                        * defaults; or the newest record passed its CRC but some
+                        * values failed validation (co_od_validate): those are
+                        * defaults. Stays until the next full save */
+    CO_STORE_HW,       /* NVM read failed: defaults */
 } co_store_status_t;
 
 typedef struct co_store {
-    uint32_t writes;       /* save cycles so far (from the newest record) */
+    uint32_t writes;              /* save cycles so far (from the newest record) */
     uint8_t status[CO_CLS_COUNT]; /* co_store_status_t of the last restore */
 } co_store_t;
 

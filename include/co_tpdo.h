@@ -48,25 +48,25 @@
 #define CO_PDO_MAP_MAX 8u
 
 typedef struct co_tpdo {
-    bool valid;          /* exists, COB-ID bit 31 clear, mapping usable */
-    bool rtr_allowed;    /* COB-ID bit 30 clear */
-    uint8_t type;        /* transmission type */
+    bool valid;       /* exists, COB-ID bit 31 clear, mapping usable */
+    bool rtr_allowed; /* COB-ID bit 30 clear */
+    uint8_t type;     /* transmission type */
     uint8_t nmap;
-    uint8_t sync_count;  /* SYNCs since the last synchronous send */
-    bool timer_armed;    /* event timer running (type 254/255; read only while operational) */
-    bool pending;        /* an application event waits for the inhibit time (operational) */
-    bool have_last;      /* last[] holds the last data sent (type 0) or sampled (252) */
+    uint8_t sync_count; /* SYNCs since the last synchronous send */
+    bool timer_armed;   /* event timer running (type 254/255; read only while operational) */
+    bool pending;       /* an application event waits for the inhibit time (operational) */
+    bool have_last;     /* last[] holds the last data sent (type 0) or sampled (252) */
     uint16_t cob_id;
     uint16_t event_ms;
-    uint32_t inhibit_us;   /* inhibit time (us; in the dictionary in the product's unit) */
-    uint32_t next_event;   /* time of the next event-timer send */
-    uint32_t inhibit_end;  /* earliest time of the next event-driven send */
+    uint32_t inhibit_us;  /* inhibit time (us; in the dictionary in the product's unit) */
+    uint32_t next_event;  /* time of the next event-timer send */
+    uint32_t inhibit_end; /* earliest time of the next event-driven send */
     const co_od_entry_t *map[CO_PDO_MAP_MAX]; /* mapped entries */
-    uint8_t map_drop[CO_PDO_MAP_MAX]; /* 32 - bits of each: the high bits not sent */
-    uint8_t len;           /* mapped bytes */
-    uint8_t dlc;           /* of its frames: len, or 8 where the product pads */
-    bool msb_first;        /* mapped values big-endian (the product's choice, DST 0x5001 = 0):
-                            * co_tpdo_set_msb_first(); kept by co_tpdo_reconfig() */
+    uint8_t map_drop[CO_PDO_MAP_MAX];         /* 32 - bits of each: the high bits not sent */
+    uint8_t len;                              /* mapped bytes */
+    uint8_t dlc;                              /* of its frames: len, or 8 where the product pads */
+    bool msb_first;              /* mapped values big-endian (the product's choice, DST 0x5001 = 0):
+                                  * co_tpdo_set_msb_first(); kept by co_tpdo_reconfig() */
     _Alignas(4) uint8_t last[8]; /* word aligned: copied in words (tpdo.c) */
 } co_tpdo_t;
 

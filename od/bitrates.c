@@ -28,4 +28,3 @@ uint8_t product_eds_bitrates(const product_t *p)
     }
     return bits;
 }
-

@@ -47,19 +47,19 @@ _Static_assert(PRODUCT_ANGLE_LIMIT * 1000 <= CO_FILTER_IN_MAX,
 
 /* One simulated physical input. */
 typedef struct product_input {
-    const char *name;  /* "x", "length"; NULL ends the list */
-    const char *unit;  /* "deg", "mm", "%" */
-    int32_t initial;   /* value at power-on, thousandths of the unit */
-    int32_t limit;     /* largest magnitude accepted, in the unit */
+    const char *name; /* "x", "length"; NULL ends the list */
+    const char *unit; /* "deg", "mm", "%" */
+    int32_t initial;  /* value at power-on, thousandths of the unit */
+    int32_t limit;    /* largest magnitude accepted, in the unit */
 } product_input_t;
 
 struct product {
-    const char *id;          /* e.g. "dst-x730-xy30" */
-    const char *summary;     /* one line for --list-products */
+    const char *id;                             /* e.g. "dst-x730-xy30" */
+    const char *summary;                        /* one line for --list-products */
     product_input_t inputs[PRODUCT_MAX_INPUTS]; /* simulated inputs */
-    const char *faults[PRODUCT_MAX_INPUTS]; /* simulator fault names, NULL-ended */
-    unsigned nodes;          /* nodes this product runs */
-    size_t inst_size;        /* bytes create() needs */
+    const char *faults[PRODUCT_MAX_INPUTS];     /* simulator fault names, NULL-ended */
+    unsigned nodes;                             /* nodes this product runs */
+    size_t inst_size;                           /* bytes create() needs */
     /*
      * Build the instance in mem (inst_size bytes, aligned for any type);
      * node i talks through ports[i]. Stores the node pointers in nodes[].
@@ -72,12 +72,12 @@ struct product {
      * fault faults[i]. Call every CO_FILTER_PERIOD_US.
      */
     void (*sample)(void *mem, const int32_t values[], uint32_t faults);
-    const void *variant;     /* product-specific constants */
+    const void *variant; /* product-specific constants */
     /* For the EDS (CiA 306), from the same tables the firmware runs: the
      * bit rates and LSS support are the config's (product_kbps(),
      * product_eds_bitrates(), product_lss()), written there only. */
-    const co_node_cfg_t *cfg;    /* node 0's configuration and dictionary */
-    const char *vendor;          /* vendor name */
+    const co_node_cfg_t *cfg; /* node 0's configuration and dictionary */
+    const char *vendor;       /* vendor name */
 #ifndef CO_OD_NO_NAMES
     /* EDS values the manual wants other than the device's (product_eds.h),
      * ended by index 0; NULL: none. Not in MCU images (they print no EDS). */
@@ -96,9 +96,9 @@ struct product {
 #define PRODUCT_BR_1000K 0x80u
 
 /* The bit-rate code tables of the manuals (kbit/s by code). */
-extern const uint16_t product_kbps_cia[16];  /* 0 = 1000 ... 7 = 20: DST, GSH-A */
-extern const uint16_t product_kbps_ifm[16];  /* 0 = 20 ... 7 = 1000: ifm JD (3001h) */
-extern const uint16_t product_kbps_pf[16];   /* 1 = 125, 2 = 250, 4 = 500, 8 = 1000: P+F */
+extern const uint16_t product_kbps_cia[16]; /* 0 = 1000 ... 7 = 20: DST, GSH-A */
+extern const uint16_t product_kbps_ifm[16]; /* 0 = 20 ... 7 = 1000: ifm JD (3001h) */
+extern const uint16_t product_kbps_pf[16];  /* 1 = 125, 2 = 250, 4 = 500, 8 = 1000: P+F */
 
 /* kbit/s of code for product p (its config's table, co_node_cfg_t.kbps),
  * 0 if the code means nothing or p has no config or table. */

@@ -25,9 +25,9 @@
 
 /* One EDS entry whose DefaultValue differs from the device's default. */
 typedef struct product_eds_override {
-    uint16_t index;     /* dictionary entry, which must exist; 0 ends a list */
+    uint16_t index; /* dictionary entry, which must exist; 0 ends a list */
     uint8_t sub;
-    uint32_t value;     /* the EDS's DefaultValue (numeric entries only) */
+    uint32_t value; /* the EDS's DefaultValue (numeric entries only) */
     /* The value is node-relative: DefaultValue=$NODEID+value (CiA 306),
      * for a default that is each node's own node-ID, so that one EDS
      * describes every node of a device with several. */

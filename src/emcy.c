@@ -114,7 +114,8 @@ co_res_t co_emcy_read_hist(co_node_t *node, const co_od_entry_t *e, uint32_t *va
     if (e->sub == 0u) {
         /* No more than the dictionary has entries for (the JD keeps one). */
         uint32_t depth = 0;
-        while (depth < CO_EMCY_HIST_MAX && co_node_entry(node, 0x1003, (uint8_t)(depth + 1u)) != NULL) {
+        while (depth < CO_EMCY_HIST_MAX &&
+               co_node_entry(node, 0x1003, (uint8_t)(depth + 1u)) != NULL) {
             depth++;
         }
         *value = co_min_u32(em->nhist, depth);

@@ -95,5 +95,5 @@ uint32_t co_guard_poll(co_node_t *node, uint32_t now)
     return g->deadline - now;
 }
 
-const co_service_t co_guard_service = {.receive = co_guard_receive, .poll = co_guard_poll,
-                                       .reset = co_guard_reset};
+const co_service_t co_guard_service = {
+    .receive = co_guard_receive, .poll = co_guard_poll, .reset = co_guard_reset};

@@ -74,5 +74,5 @@ uint32_t co_hbc_poll(co_node_t *node, uint32_t now)
     return CO_NEVER;
 }
 
-const co_service_t co_hbc_service = {.receive = co_hbc_receive, .poll = co_hbc_poll,
-                                     .reset = co_hbc_reset};
+const co_service_t co_hbc_service = {
+    .receive = co_hbc_receive, .poll = co_hbc_poll, .reset = co_hbc_reset};

@@ -272,5 +272,5 @@ static uint32_t co_lss_poll(co_node_t *node, uint32_t now)
     return CO_NEVER;
 }
 
-const co_service_t co_lss_service = {.receive = co_lss_receive, .poll = co_lss_poll,
-                                     .reset = co_lss_reset, .always = true};
+const co_service_t co_lss_service = {
+    .receive = co_lss_receive, .poll = co_lss_poll, .reset = co_lss_reset, .always = true};

@@ -90,11 +90,11 @@ const co_od_entry_t *sdo_download_target(co_node_t *node, const uint8_t *d, bool
         return NULL;
     }
     uint32_t size = co_get_u32(&d[4]);
-    co_res_t r = (e->attr & CO_A_W) == 0u           ? CO_E_RO
-        : sized && size > co_od_size(e)    ? CO_E_LEN_HIGH
-        : sized && size < co_od_size(e)    ? CO_E_LEN_LOW
-        : co_od_size(e) > CO_SDO_BUF       ? CO_E_OOM
-                                           : CO_OK;
+    co_res_t r = (e->attr & CO_A_W) == 0u        ? CO_E_RO
+                 : sized && size > co_od_size(e) ? CO_E_LEN_HIGH
+                 : sized && size < co_od_size(e) ? CO_E_LEN_LOW
+                 : co_od_size(e) > CO_SDO_BUF    ? CO_E_OOM
+                                                 : CO_OK;
     if (r != CO_OK) {
         sdo_abort(node, d, r);
         return NULL;
@@ -122,10 +122,10 @@ static void download_initiate(co_node_t *node, const uint8_t *d)
     sdo->e = e;
     uint32_t size = co_od_size(e);
     uint32_t given = co_get_u32(&d[4]);
-    co_res_t r = (e->attr & CO_A_W) == 0u ? CO_E_RO
-        : (d[0] & 0x03u) != 0x01u || given == size ? CO_OK
-        : given > size                             ? CO_E_LEN_HIGH
-                                                   : CO_E_LEN_LOW;
+    co_res_t r = (e->attr & CO_A_W) == 0u                   ? CO_E_RO
+                 : (d[0] & 0x03u) != 0x01u || given == size ? CO_OK
+                 : given > size                             ? CO_E_LEN_HIGH
+                                                            : CO_E_LEN_LOW;
     if (r != CO_OK) {
         sdo_abort(node, d, r);
     } else if ((d[0] & 0x02u) != 0u) {

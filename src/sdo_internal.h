@@ -12,11 +12,11 @@ enum {
     SDO_IDLE = 0,
     SDO_DOWNLOAD,
     SDO_UPLOAD,
-    SDO_BLK_DL,      /* block download: receiving segments */
-    SDO_BLK_DL_END,  /* block download: waiting for the end request */
+    SDO_BLK_DL,       /* block download: receiving segments */
+    SDO_BLK_DL_END,   /* block download: waiting for the end request */
     SDO_BLK_UL_START, /* block upload: waiting for the start request */
-    SDO_BLK_UL,      /* block upload: a block sent, waiting for its acknowledge */
-    SDO_BLK_UL_END,  /* block upload: end sent, waiting for the client's end */
+    SDO_BLK_UL,       /* block upload: a block sent, waiting for its acknowledge */
+    SDO_BLK_UL_END,   /* block upload: end sent, waiting for the client's end */
 };
 
 /* Client command specifiers (byte 0 bits 7..5). */

@@ -23,7 +23,7 @@ static bool begin(co_node_t *node, const uint8_t *d, uint8_t state, const co_od_
     sdo_restart(sdo);
     /* Download: 0x60; upload: 0x41 with the size indicated. */
     sdo_reply_head(node, state == SDO_DOWNLOAD ? 0x60 : 0x41, d,
-                      state == SDO_DOWNLOAD ? 0u : sdo->size);
+                   state == SDO_DOWNLOAD ? 0u : sdo->size);
     return true;
 }
 

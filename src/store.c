@@ -26,9 +26,9 @@ typedef struct slot_info {
  * callers use, not a whole slot_info_t: on the Cortex-M0 that answer costs
  * 128 bytes more code and 56 more of stack. */
 typedef struct newest {
-    int8_t k;      /* its slot, -1: none */
-    bool present;  /* some slot has the magic (a record, maybe a broken one) */
-    bool hw;       /* a read failed */
+    int8_t k;     /* its slot, -1: none */
+    bool present; /* some slot has the magic (a record, maybe a broken one) */
+    bool hw;      /* a read failed */
     uint8_t flags;
     uint32_t seq;
     uint32_t writes;
@@ -279,13 +279,13 @@ bool co_store_limit_reached(const co_node_t *node)
  * newest record holds (their defaults when there is none). */
 typedef struct group {
     uint16_t lo, hi;
-    bool defaults;   /* the group's entries take their default values */
-    int from;        /* slot holding the record to keep the rest from; -1: defaults */
+    bool defaults; /* the group's entries take their default values */
+    int from;      /* slot holding the record to keep the rest from; -1: defaults */
 } group_t;
 
 /* Bytes [at, at + n) of the record data for class cls. */
-static bool record_chunk(co_node_t *node, co_cls_t cls, const group_t *g, uint32_t at,
-                         uint8_t *out, uint32_t n)
+static bool record_chunk(co_node_t *node, co_cls_t cls, const group_t *g, uint32_t at, uint8_t *out,
+                         uint32_t n)
 {
     memcpy(out, (const uint8_t *)node->ram[cls] + at, n);
     if (g == NULL) {
@@ -304,9 +304,9 @@ static bool record_chunk(co_node_t *node, co_cls_t cls, const group_t *g, uint32
         uint8_t v[4];
         if (in_group || g->from < 0) {
             co_od_native(e, e->def, v); /* records hold the RAM image */
-        } else if (!co_port_nvm_read(node->port,
-                                     slot_addr(node, cls, (unsigned)g->from) + CO_STORE_HDR + e->off,
-                                     v, e->size)) {
+        } else if (!co_port_nvm_read(
+                       node->port, slot_addr(node, cls, (unsigned)g->from) + CO_STORE_HDR + e->off,
+                       v, e->size)) {
             return false;
         }
         for (uint16_t b = 0; b < e->size; b++) {
@@ -321,8 +321,8 @@ static bool record_chunk(co_node_t *node, co_cls_t cls, const group_t *g, uint32
 
 /* Write a record with sequence seq into slot target: header, data, CRC.
  * Not inlined: its buffers never share the stack with newest()'s. */
-static CO_NOINLINE co_res_t write_slot(co_node_t *node, co_cls_t cls, unsigned target,
-                                       uint32_t seq, uint8_t flags, const group_t *g)
+static CO_NOINLINE co_res_t write_slot(co_node_t *node, co_cls_t cls, unsigned target, uint32_t seq,
+                                       uint8_t flags, const group_t *g)
 {
     uint32_t len = (flags & FLAG_DEFAULTS) != 0u ? 0u : co_cfg(node)->ram_size[cls];
     uint8_t h[CO_STORE_HDR] = {0};
@@ -394,8 +394,7 @@ co_res_t co_store_request_defaults(co_node_t *node, co_cls_t cls)
     return write_record(node, cls, FLAG_DEFAULTS, NULL);
 }
 
-co_res_t co_store_save_group(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi,
-                             bool defaults)
+co_res_t co_store_save_group(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi, bool defaults)
 {
     group_t g = {.lo = lo, .hi = hi, .defaults = defaults, .from = -1};
     return write_record(node, cls, 0, &g);

@@ -259,8 +259,7 @@ static inline void build_mapped(co_node_t *node, unsigned n, co_frame_t *f)
 #endif
         shift += 32u - drop;
     }
-#if UINTPTR_MAX <= 0xFFFFFFFFu && defined(__GNUC__) && \
-    __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#if UINTPTR_MAX <= 0xFFFFFFFFu && defined(__GNUC__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
     /* A little-endian 32-bit core stores the two words as they are: the
      * frame's data is word aligned (co_frame_t). Two co_put_u32() calls,
      * byte by byte, were 24 more Cortex-M0 instructions a TPDO. */

@@ -16,8 +16,7 @@ void serial_link_init(serial_link_t *s, const product_t *p)
     }
 }
 
-void serial_link_sample(serial_link_t *s, const product_t *p, int32_t values[],
-                        uint32_t *faults)
+void serial_link_sample(serial_link_t *s, const product_t *p, int32_t values[], uint32_t *faults)
 {
     if (s->prod != p) {
         serial_link_init(s, p);
@@ -38,7 +37,8 @@ void serial_link_sample(serial_link_t *s, const product_t *p, int32_t values[],
 static void put_str(serial_put_fn put, const char *t)
 {
     for (; *t != '\0'; t++) {
-        put((char)((*t >= ' ' && *t <= '~') || *t == '\r' ? *t : '?')); /* '\r': ours, ends a line */
+        put((char)((*t >= ' ' && *t <= '~') || *t == '\r' ? *t
+                                                          : '?')); /* '\r': ours, ends a line */
     }
 }
 
@@ -249,7 +249,8 @@ static bool cmd_fault(serial_link_t *s, tokens_t *t, serial_put_fn put)
     char *what = next_token(t);
     char *onoff = next_token(t);
     int k = -1;
-    for (unsigned i = 0; what != NULL && i < PRODUCT_MAX_INPUTS && s->prod->faults[i] != NULL; i++) {
+    for (unsigned i = 0; what != NULL && i < PRODUCT_MAX_INPUTS && s->prod->faults[i] != NULL;
+         i++) {
         if (equal(what, s->prod->faults[i])) {
             k = (int)i;
         }
@@ -280,8 +281,10 @@ static bool cmd_can(serial_link_t *s, tokens_t *t, serial_put_fn put)
     static const struct {
         const char *name;
         uint8_t state;
-    } states[] = {{"active", CO_CAN_ACTIVE}, {"warning", CO_CAN_WARNING},
-                  {"passive", CO_CAN_PASSIVE}, {"bus-off", CO_CAN_BUSOFF}};
+    } states[] = {{"active", CO_CAN_ACTIVE},
+                  {"warning", CO_CAN_WARNING},
+                  {"passive", CO_CAN_PASSIVE},
+                  {"bus-off", CO_CAN_BUSOFF}};
     char *what = next_token(t);
     char *arg = next_token(t);
     int k = -1;
@@ -296,7 +299,8 @@ static bool cmd_can(serial_link_t *s, tokens_t *t, serial_put_fn put)
         return fail(put, "'", arg, "': not a number of seconds within 0..60");
     }
     if (k < 0 || next_token(t) != NULL || (arg != NULL && !hold)) {
-        return fail(put, "usage: can bus-off [SECONDS] | can passive | can warning | can active", "", "");
+        return fail(put, "usage: can bus-off [SECONDS] | can passive | can warning | can active",
+                    "", "");
     }
     s->can_state = states[k].state;
     s->busoff_pending = states[k].state == CO_CAN_BUSOFF;

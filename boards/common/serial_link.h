@@ -73,8 +73,7 @@ void serial_link_init(serial_link_t *s, const product_t *p);
  * line set for product p (its initial values until a `set` line). The
  * first call, made before the node starts (mcu_main.c), starts the link
  * for p, so that a board needs no product at board_init(). */
-void serial_link_sample(serial_link_t *s, const product_t *p, int32_t values[],
-                        uint32_t *faults);
+void serial_link_sample(serial_link_t *s, const product_t *p, int32_t values[], uint32_t *faults);
 
 /* Feed one received character. Returns true when it completed a received
  * frame line, which is then in *f. An input line is applied and answered

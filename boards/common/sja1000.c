@@ -215,11 +215,10 @@ static bool reprogram(sja1000_t *c, uint8_t btr0, uint8_t btr1)
     return set_mode(c, 0u);
 }
 
-bool sja1000_init(sja1000_t *c, const sja1000_io_t *io, void *ctx, uint32_t clock_hz,
-                  uint16_t kbps)
+bool sja1000_init(sja1000_t *c, const sja1000_io_t *io, void *ctx, uint32_t clock_hz, uint16_t kbps)
 {
-    *c = (sja1000_t){.io = io, .ctx = ctx, .clock_hz = clock_hz, .kbps = kbps,
-                     .state = (uint8_t)CO_CAN_ACTIVE};
+    *c = (sja1000_t){
+        .io = io, .ctx = ctx, .clock_hz = clock_hz, .kbps = kbps, .state = (uint8_t)CO_CAN_ACTIVE};
     uint8_t btr0;
     uint8_t btr1;
     if (!set_mode(c, SJA_MOD_RM) || !sja1000_timing(clock_hz, kbps, &btr0, &btr1)) {

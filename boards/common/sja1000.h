@@ -63,26 +63,26 @@ enum {
 };
 
 /* Register bits used here. */
-#define SJA_MOD_RM 0x01u   /* reset mode */
-#define SJA_MOD_AFM 0x08u  /* single acceptance filter (clear: dual) */
-#define SJA_CMR_TR 0x01u   /* transmission request */
-#define SJA_CMR_AT 0x02u   /* abort transmission */
-#define SJA_CMR_RRB 0x04u  /* release receive buffer */
-#define SJA_CMR_CDO 0x08u  /* clear data overrun */
-#define SJA_SR_RBS 0x01u   /* receive buffer status: a frame is in the FIFO */
-#define SJA_SR_DOS 0x02u   /* data overrun */
-#define SJA_SR_TBS 0x04u   /* transmit buffer released */
-#define SJA_SR_ES 0x40u    /* an error counter reached the warning limit */
-#define SJA_SR_BS 0x80u    /* bus-off */
+#define SJA_MOD_RM 0x01u  /* reset mode */
+#define SJA_MOD_AFM 0x08u /* single acceptance filter (clear: dual) */
+#define SJA_CMR_TR 0x01u  /* transmission request */
+#define SJA_CMR_AT 0x02u  /* abort transmission */
+#define SJA_CMR_RRB 0x04u /* release receive buffer */
+#define SJA_CMR_CDO 0x08u /* clear data overrun */
+#define SJA_SR_RBS 0x01u  /* receive buffer status: a frame is in the FIFO */
+#define SJA_SR_DOS 0x02u  /* data overrun */
+#define SJA_SR_TBS 0x04u  /* transmit buffer released */
+#define SJA_SR_ES 0x40u   /* an error counter reached the warning limit */
+#define SJA_SR_BS 0x80u   /* bus-off */
 #define SJA_IR_RI 0x01u
 #define SJA_IR_TI 0x02u
-#define SJA_IR_EI 0x04u   /* error warning: ES or BS changed */
+#define SJA_IR_EI 0x04u /* error warning: ES or BS changed */
 #define SJA_IR_DOI 0x08u
-#define SJA_IR_EPI 0x20u  /* error passive entered or left */
+#define SJA_IR_EPI 0x20u /* error passive entered or left */
 #define SJA_CDR_PELICAN 0x80u
 #define SJA_CDR_CLKOFF 0x08u /* CLKOUT pin off */
 #define SJA_OCR_NORMAL 0x1Au /* normal output mode, TX0 push-pull */
-#define SJA_FI_FF 0x80u  /* frame information: extended frame */
+#define SJA_FI_FF 0x80u      /* frame information: extended frame */
 #define SJA_FI_RTR 0x40u
 
 /* Frames the software transmit queue holds behind the transmit buffer. */
@@ -94,7 +94,7 @@ enum {
  * and leaves it to the software check. */
 #define SJA1000_IDS_MAX (2u * CO_NODE_RX_IDS_MAX)
 _Static_assert(SJA1000_IDS_MAX <= 255u && SJA1000_TXQ_LEN <= 255u,
-              "nids, tx_head and tx_len are bytes");
+               "nids, tx_head and tx_len are bytes");
 /* At most this many IDs get the exact two-filter choice (2^(n-1)
  * partitions are tried); more get a greedy one. */
 #define SJA1000_EXACT_IDS 12u
@@ -123,17 +123,17 @@ typedef struct sja1000 {
     uint8_t nids;
     bool filtered;
     bool filter_pending; /* acr/amr not yet in the controller */
-    uint8_t acr[4]; /* the acceptance code and mask as programmed */
+    uint8_t acr[4];      /* the acceptance code and mask as programmed */
     uint8_t amr[4];
     /* Transmit queue: frames waiting for the transmit buffer, oldest at head. */
     co_frame_t txq[SJA1000_TXQ_LEN];
     uint8_t tx_head;
     uint8_t tx_len;
-    bool tx_busy;       /* the head is in the transmit buffer */
-    uint8_t state;      /* co_can_state_t, as of the last sja1000_service */
-    uint32_t overruns;  /* data overruns (frames lost in the controller) */
+    bool tx_busy;          /* the head is in the transmit buffer */
+    uint8_t state;         /* co_can_state_t, as of the last sja1000_service */
+    uint32_t overruns;     /* data overruns (frames lost in the controller) */
     uint32_t filtered_out; /* frames the software check dropped */
-    uint32_t restarts;  /* bus-off recoveries started */
+    uint32_t restarts;     /* bus-off recoveries started */
 } sja1000_t;
 
 /*

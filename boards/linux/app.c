@@ -7,8 +7,7 @@
 
 #include "log.h"
 
-int app_add(app_t *a, const product_t *prod, const char *const ifn[], uint8_t id,
-            uint32_t serial)
+int app_add(app_t *a, const product_t *prod, const char *const ifn[], uint8_t id, uint32_t serial)
 {
     unsigned k = a->ninst;
     app_inst_t *in = &a->inst[k];
@@ -40,10 +39,10 @@ int app_add(app_t *a, const product_t *prod, const char *const ifn[], uint8_t id
     /* Each node its own serial number, so that LSS can address it (CiA 305). */
     for (unsigned i = 0; i < prod->nodes; i++) {
         unsigned g = in->first + i;
-        co_node_set_serial(a->nodes[g],
-                           serial != 0u ? serial + g
-                                        : app_derived_serial(prod->id, a->ifn[g],
-                                                             co_node_factory_id(a->nodes[g])));
+        co_node_set_serial(a->nodes[g], serial != 0u
+                                            ? serial + g
+                                            : app_derived_serial(prod->id, a->ifn[g],
+                                                                 co_node_factory_id(a->nodes[g])));
     }
     return (int)k;
 }
@@ -133,8 +132,10 @@ uint32_t app_poll(app_t *a, uint32_t t, uint32_t wait, bool *backlog)
 
 const char *app_nmt_name(const app_t *a, unsigned node)
 {
-    static const char *const names[] = {[0x00] = "initialising", [0x04] = "stopped",
-                                        [0x05] = "operational", [0x7F] = "pre-operational"};
+    static const char *const names[] = {[0x00] = "initialising",
+                                        [0x04] = "stopped",
+                                        [0x05] = "operational",
+                                        [0x7F] = "pre-operational"};
     uint8_t s = (uint8_t)co_node_nmt_state(a->nodes[node]);
     return (s < sizeof(names) / sizeof(names[0]) && names[s]) ? names[s] : "?";
 }
@@ -154,8 +155,9 @@ static void log_id_clashes(const app_t *a)
         for (unsigned j = 0; j < i && id >= 1u && id <= 127u; j++) {
             if (co_node_id(a->nodes[j]) == id && strcmp(a->ifn[i], a->ifn[j]) == 0) {
                 lp_log("warning: node %u (%s) and node %u (%s) both have node-ID 0x%02X on %s: "
-                       "their frames collide", j, a->inst[a->node_inst[j]].prod->id, i,
-                       a->inst[a->node_inst[i]].prod->id, id, a->ifn[i]);
+                       "their frames collide",
+                       j, a->inst[a->node_inst[j]].prod->id, i, a->inst[a->node_inst[i]].prod->id,
+                       id, a->ifn[i]);
             }
         }
     }

@@ -47,9 +47,9 @@ struct app {
     uint8_t last_id[APP_MAX_NODES]; /* active node-IDs last looked at (app_log_states) */
     const char *ifn[APP_MAX_NODES]; /* each node's interface */
     app_inst_t inst[APP_MAX_NODES];
-    bool quit;             /* stop the loop: `quit`, a signal, the end of input */
-    lp_tx_t tx;            /* the one sending socket (can_port.h) */
-    sim_replay_t replay;   /* the table a `replay` line loads (cmd.c) */
+    bool quit;           /* stop the loop: `quit`, a signal, the end of input */
+    lp_tx_t tx;          /* the one sending socket (can_port.h) */
+    sim_replay_t replay; /* the table a `replay` line loads (cmd.c) */
 };
 
 /*
@@ -59,8 +59,7 @@ struct app {
  * product, interface and factory node-ID, app_derived_serial). Returns the
  * instance's index, or -1 when the product's instance does not fit.
  */
-int app_add(app_t *a, const product_t *prod, const char *const ifn[], uint8_t id,
-            uint32_t serial);
+int app_add(app_t *a, const product_t *prod, const char *const ifn[], uint8_t id, uint32_t serial);
 
 /* A node's serial number without --serial: FNV-1a over its product ID,
  * interface and factory node-ID, never 0. */

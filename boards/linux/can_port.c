@@ -120,7 +120,8 @@ static void link_check(lp_port_t *p, uint32_t now, bool lost)
         break;
     case LP_LINK_DOWN:
         lp_log("node %u: %s is down%s: shown as CAN bus-off until it is up (checked every %u "
-               "ms)", p->node, p->iface, again, LP_LINK_POLL_US / 1000u);
+               "ms)",
+               p->node, p->iface, again, LP_LINK_POLL_US / 1000u);
         break;
     case LP_LINK_ABSENT:
     default:
@@ -136,14 +137,15 @@ static int can_socket(char *err, unsigned errlen)
 {
     int fd = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
     if (fd < 0) {
-        snprintf(err, errlen, "CAN socket: %s (is CAN supported by this kernel? see tools/vcan-run)",
+        snprintf(err, errlen,
+                 "CAN socket: %s (is CAN supported by this kernel? see tools/vcan-run)",
                  strerror(errno));
     }
     return fd;
 }
 
-int lp_open(lp_port_t *p, const char *iface, unsigned node, lp_nvm_t *nvm, uint32_t now,
-            char *err, unsigned errlen)
+int lp_open(lp_port_t *p, const char *iface, unsigned node, lp_nvm_t *nvm, uint32_t now, char *err,
+            unsigned errlen)
 {
     memset(p, 0, sizeof(*p));
     p->iface = iface;
@@ -214,7 +216,8 @@ void lp_sim_can(lp_port_t *p, co_can_state_t s, uint32_t now, uint32_t hold_us,
             p->sim_recover_at = now + recovery_us;
         }
         lp_log("node %u: simulated CAN controller: bus usable again, back from bus-off in "
-               "%u.%03u ms", p->node, recovery_us / 1000u, recovery_us % 1000u);
+               "%u.%03u ms",
+               p->node, recovery_us / 1000u, recovery_us % 1000u);
     } else {
         p->sim_state = (int)s;
         lp_log("node %u: simulated CAN controller %s", p->node, state_names[s]);
@@ -236,7 +239,8 @@ static void report_drops(lp_port_t *p, uint32_t now)
 {
     if (p->rx_unlogged != 0u && lp_rate_allow(&p->rx_rate, now, 1u)) {
         lp_log("node %u: %lu received frames dropped on %s (socket receive queue full; "
-               "%lu in all)", p->node, p->rx_unlogged, p->iface, p->rx_dropped);
+               "%lu in all)",
+               p->node, p->rx_unlogged, p->iface, p->rx_dropped);
         p->rx_unlogged = 0;
     }
 }
@@ -283,8 +287,8 @@ static void filter_install(lp_port_t *p)
         cf[k].can_mask = CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG;
     }
     p->filt_changes++;
-    if (setsockopt(p->fd, SOL_CAN_RAW, CAN_RAW_FILTER, cf,
-                   (socklen_t)(p->nfilt * sizeof(cf[0]))) == 0) {
+    if (setsockopt(p->fd, SOL_CAN_RAW, CAN_RAW_FILTER, cf, (socklen_t)(p->nfilt * sizeof(cf[0]))) ==
+        0) {
         return;
     }
     int e = errno;
@@ -488,8 +492,8 @@ static void error_frame(lp_port_t *p, const struct can_frame *cf)
             s = CO_CAN_ACTIVE;
         }
     }
-    lp_log("node %u: CAN error frame on %s (id %08X): %s", p->node, p->iface,
-           (unsigned)cf->can_id, state_names[s]);
+    lp_log("node %u: CAN error frame on %s (id %08X): %s", p->node, p->iface, (unsigned)cf->can_id,
+           state_names[s]);
     if (s == CO_CAN_BUSOFF) {
         drop_txq(p);
     }

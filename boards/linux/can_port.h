@@ -38,9 +38,9 @@
 #define LP_BUSOFF_RECOVERY_BITS (128u * 11u)
 
 typedef enum lp_link {
-    LP_LINK_UP = 0,  /* bound, interface up */
-    LP_LINK_DOWN,    /* the interface exists but is down */
-    LP_LINK_ABSENT,  /* no such interface (deleted), or not a CAN interface */
+    LP_LINK_UP = 0, /* bound, interface up */
+    LP_LINK_DOWN,   /* the interface exists but is down */
+    LP_LINK_ABSENT, /* no such interface (deleted), or not a CAN interface */
 } lp_link_t;
 
 /*
@@ -55,25 +55,25 @@ typedef enum lp_link {
  * that sent it: a node does not hear itself. It receives nothing.
  */
 typedef struct lp_tx {
-    int fd;                /* CAN_RAW socket bound to no interface, receiving nothing */
-    bool addressed;        /* each message names its port's interface (false: fd is a
-                            * connected socket, the unit tests') */
-    unsigned long calls;   /* sendmmsg() calls that sent something */
-    unsigned long frames;  /* frames sent */
+    int fd;               /* CAN_RAW socket bound to no interface, receiving nothing */
+    bool addressed;       /* each message names its port's interface (false: fd is a
+                           * connected socket, the unit tests') */
+    unsigned long calls;  /* sendmmsg() calls that sent something */
+    unsigned long frames; /* frames sent */
 } lp_tx_t;
 
 typedef struct lp_port {
-    int fd;               /* CAN_RAW socket, non-blocking; kept across link changes;
-                           * receives (frames go out through an lp_tx_t) */
+    int fd; /* CAN_RAW socket, non-blocking; kept across link changes;
+             * receives (frames go out through an lp_tx_t) */
     const char *iface;
-    unsigned node;        /* index, for log lines */
-    uint16_t kbps;        /* the node's bit rate (co_port_can_bitrate; vcan has none) */
-    bool kbps_set;        /* kbps was given (at the node's start) */
+    unsigned node; /* index, for log lines */
+    uint16_t kbps; /* the node's bit rate (co_port_can_bitrate; vcan has none) */
+    bool kbps_set; /* kbps was given (at the node's start) */
     lp_nvm_t *nvm;
     co_frame_t txq[LP_TXQ]; /* frames the kernel could not take yet */
     unsigned txh, txn;
-    unsigned long tx_lost;  /* frames dropped because txq was full */
-    unsigned long tx_off;   /* frames not sent because the controller was off the bus */
+    unsigned long tx_lost; /* frames dropped because txq was full */
+    unsigned long tx_off;  /* frames not sent because the controller was off the bus */
     /* link watch */
     int link;               /* lp_link_t */
     int ifindex;            /* of the interface last bound (0: never) */
@@ -81,25 +81,25 @@ typedef struct lp_port {
     bool link_blip;         /* the link went down and came back before it was
                              * looked at: bus-off until the next lp_poll */
     /* CAN controller */
-    int ctrl_state;         /* co_can_state_t from the kernel's error frames */
-    int sim_state;          /* co_can_state_t of the simulated controller */
+    int ctrl_state;          /* co_can_state_t from the kernel's error frames */
+    int sim_state;           /* co_can_state_t of the simulated controller */
     uint32_t sim_recover_at; /* simulated bus-off: back to error active then */
     /* received frames: a batch read in one call, served one by one */
     struct can_frame rxb[LP_RXB];
-    uint8_t rxlen[LP_RXB];    /* bytes each message had (a classic frame: 16) */
-    unsigned rxi, rxn;        /* next to serve, how many */
-    unsigned long rx_frames;  /* frames read */
-    uint32_t rx_ovfl;         /* the kernel's drop count (SO_RXQ_OVFL) last seen */
-    unsigned long rx_dropped; /* frames the kernel dropped for this socket, in all */
+    uint8_t rxlen[LP_RXB];     /* bytes each message had (a classic frame: 16) */
+    unsigned rxi, rxn;         /* next to serve, how many */
+    unsigned long rx_frames;   /* frames read */
+    uint32_t rx_ovfl;          /* the kernel's drop count (SO_RXQ_OVFL) last seen */
+    unsigned long rx_dropped;  /* frames the kernel dropped for this socket, in all */
     unsigned long rx_unlogged; /* of those, not logged yet */
-    lp_rate_t rx_rate;        /* one drop line a second at most */
-    lp_rate_t err_rate;       /* unexpected socket errors: a few lines a second */
-    uint32_t now;             /* latest time given to lp_poll / lp_read */
+    lp_rate_t rx_rate;         /* one drop line a second at most */
+    lp_rate_t err_rate;        /* unexpected socket errors: a few lines a second */
+    uint32_t now;              /* latest time given to lp_poll / lp_read */
     /* the kernel's receive filter (CAN_RAW_FILTER): the node's CAN-IDs as
      * last installed (lp_filter) */
     co_rx_id_t filt[CO_NODE_RX_IDS_MAX];
     unsigned nfilt;
-    bool filt_set;            /* filt[] is what the kernel has */
+    bool filt_set;              /* filt[] is what the kernel has */
     const co_node_t *filt_node; /* the node filtered for (lp_filter), or NULL */
     unsigned long filt_changes; /* times the filter was (re)installed */
 } lp_port_t;
@@ -111,8 +111,8 @@ typedef struct lp_port {
  * interface not named: the caller says which option named it) when the
  * interface does not exist, is not a CAN interface, or the kernel has no CAN.
  */
-int lp_open(lp_port_t *p, const char *iface, unsigned node, lp_nvm_t *nvm, uint32_t now,
-            char *err, unsigned errlen);
+int lp_open(lp_port_t *p, const char *iface, unsigned node, lp_nvm_t *nvm, uint32_t now, char *err,
+            unsigned errlen);
 
 /* Close the socket. */
 void lp_close(lp_port_t *p);

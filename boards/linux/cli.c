@@ -87,14 +87,13 @@ static void usage(FILE *f)
                "selector at its start names: 0xNN, NN, @N, @all; values beyond an\n"
                "input's limit are refused):\n");
     cmd_usage(f);
-    fprintf(f,
-            "\n"
-            "Exit status: 0 clean stop (quit, end of input, SIGINT, SIGTERM, SIGHUP, also\n"
-            "while starting); 1 failure at start (interface, EEPROM read, GPIO), of the\n"
-            "event loop or of the output; 2 wrong command line (an option twice: only\n"
-            "--node repeats; an EEPROM file another process holds).\n"
-            "\n"
-            "Products, their inputs and faults:\n");
+    fprintf(f, "\n"
+               "Exit status: 0 clean stop (quit, end of input, SIGINT, SIGTERM, SIGHUP, also\n"
+               "while starting); 1 failure at start (interface, EEPROM read, GPIO), of the\n"
+               "event loop or of the output; 2 wrong command line (an option twice: only\n"
+               "--node repeats; an EEPROM file another process holds).\n"
+               "\n"
+               "Products, their inputs and faults:\n");
     for (size_t i = 0; product_list[i] != NULL; i++) {
         char d[256];
         cmd_describe(product_list[i], d, sizeof(d));
@@ -186,7 +185,8 @@ static int split_ifaces(node_spec_t *o)
                        ? USAGE_ERROR("%s has one node: give one interface, not '%s'", prod->id,
                                      iface)
                        : USAGE_ERROR("%s has %u nodes: give one interface, or one per node "
-                                     "(A,B), not '%s'", prod->id, prod->nodes, iface);
+                                     "(A,B), not '%s'",
+                                     prod->id, prod->nodes, iface);
         }
         o->ifn[nif++] = s;
         if (comma == NULL) {
@@ -230,8 +230,9 @@ static int parse_node(options_t *o, const char *arg)
     }
     if (n->id != 0u && n->id + n->prod->nodes - 1u > 127u) {
         return USAGE_ERROR("--node %s: %s has %u nodes, node-IDs 0x%02X to 0x%02X: the last "
-                           "passes 127 (give at most 0x%02X)", arg, n->prod->id, n->prod->nodes,
-                           n->id, n->id + n->prod->nodes - 1u, 128u - n->prod->nodes);
+                           "passes 127 (give at most 0x%02X)",
+                           arg, n->prod->id, n->prod->nodes, n->id, n->id + n->prod->nodes - 1u,
+                           128u - n->prod->nodes);
     }
     n->iface = slash != NULL ? slash + 1 : NULL;
     n->arg = arg;
@@ -299,16 +300,24 @@ int cli_parse(int argc, char **argv, options_t *o)
     o->quit_on_eof = true;
     o->seed = SIM_SEED_DEFAULT;
     static const struct option opts[] = {
-        {"product", required_argument, NULL, 'p'}, {"iface", required_argument, NULL, 'i'},
-        {"nvm", required_argument, NULL, 'n'},     {"log", required_argument, NULL, 'l'},
-        {"led-chip", required_argument, NULL, 'c'}, {"led-green", required_argument, NULL, 'g'},
-        {"led-red", required_argument, NULL, 'r'}, {"list-products", no_argument, NULL, 'L'},
-        {"eds", no_argument, NULL, 'E'},           {"on-eof", required_argument, NULL, 'o'},
+        {"product", required_argument, NULL, 'p'},
+        {"iface", required_argument, NULL, 'i'},
+        {"nvm", required_argument, NULL, 'n'},
+        {"log", required_argument, NULL, 'l'},
+        {"led-chip", required_argument, NULL, 'c'},
+        {"led-green", required_argument, NULL, 'g'},
+        {"led-red", required_argument, NULL, 'r'},
+        {"list-products", no_argument, NULL, 'L'},
+        {"eds", no_argument, NULL, 'E'},
+        {"on-eof", required_argument, NULL, 'o'},
         {"seed", required_argument, NULL, 's'},
-        {"help", no_argument, NULL, 'h'},          {"json", no_argument, NULL, 'J'},
+        {"help", no_argument, NULL, 'h'},
+        {"json", no_argument, NULL, 'J'},
         {"node", required_argument, NULL, 'N'},
-        {"nvm-dir", required_argument, NULL, 'D'}, {"control", required_argument, NULL, 'C'},
-        {"log-time", required_argument, NULL, 'T'}, {"serial", required_argument, NULL, 'S'},
+        {"nvm-dir", required_argument, NULL, 'D'},
+        {"control", required_argument, NULL, 'C'},
+        {"log-time", required_argument, NULL, 'T'},
+        {"serial", required_argument, NULL, 'S'},
         {NULL, 0, NULL, 0},
     };
     opterr = 0; /* our own one-line messages */
@@ -330,11 +339,21 @@ int cli_parse(int argc, char **argv, options_t *o)
         }
         li = -1;
         switch (c) {
-        case 'p': product = optarg; break;
-        case 'i': o->iface = optarg; break;
-        case 'n': o->nvm_path = optarg; break;
-        case 'D': o->nvm_dir = optarg; break;
-        case 'C': o->control = optarg; break;
+        case 'p':
+            product = optarg;
+            break;
+        case 'i':
+            o->iface = optarg;
+            break;
+        case 'n':
+            o->nvm_path = optarg;
+            break;
+        case 'D':
+            o->nvm_dir = optarg;
+            break;
+        case 'C':
+            o->control = optarg;
+            break;
         case 'N': {
             int rc = parse_node(o, optarg);
             if (rc != CLI_GO_ON) {
@@ -342,8 +361,12 @@ int cli_parse(int argc, char **argv, options_t *o)
             }
             break;
         }
-        case 'l': o->log_path = optarg; break;
-        case 'c': o->led_chip = optarg; break;
+        case 'l':
+            o->log_path = optarg;
+            break;
+        case 'c':
+            o->led_chip = optarg;
+            break;
         case 'g':
         case 'r':
             if (parse_int(optarg, c == 'g' ? &o->led_green : &o->led_red) != 0) {
@@ -375,7 +398,8 @@ int cli_parse(int argc, char **argv, options_t *o)
         case 'S':
             if (!parse_serial(optarg, &o->serial)) {
                 return USAGE_ERROR("--serial takes a serial number 1..0xFFFFFFFF (decimal or 0x "
-                                   "hex), not '%s'", optarg);
+                                   "hex), not '%s'",
+                                   optarg);
             }
             break;
         case 'E':
@@ -470,4 +494,3 @@ int cli_print_eds(const product_t *prod)
     }
     return stdout_done("--eds");
 }
-

@@ -49,7 +49,7 @@ typedef struct options {
     const char *iface;
     const char *nvm_path;
     const char *nvm_dir;
-    const char *control; /* --control unix:PATH | tcp:PORT, or NULL */
+    const char *control;             /* --control unix:PATH | tcp:PORT, or NULL */
     node_spec_t spec[APP_MAX_NODES]; /* --product first (if given), then each --node */
     unsigned nspec;
     unsigned nnodes_total;

@@ -257,14 +257,13 @@ static bool parse_sine(cmd_ctx_t *c, unsigned k, char **save, cmd_args_t *args, 
         return false;
     }
     if (!parse_duration(per, &args->dur_us)) {
-        snprintf(err, errlen, "period=%s: not a duration (s or ms, more than 0, at most %us)",
-                 per, SIM_DURATION_MAX_S);
+        snprintf(err, errlen, "period=%s: not a duration (s or ms, more than 0, at most %us)", per,
+                 SIM_DURATION_MAX_S);
         return false;
     }
     int32_t now = sim_motion_now(s, (unsigned)i);
     if (llabs((long long)now) + args->value > (long long)lim * 1000) {
-        snprintf(err, errlen, "sine around %.3f with amp=%s leaves +-%.0f", now / 1000.0, amp,
-                 lim);
+        snprintf(err, errlen, "sine around %.3f with amp=%s leaves +-%.0f", now / 1000.0, amp, lim);
         return false;
     }
     args->input = (unsigned)i;
@@ -402,8 +401,9 @@ static bool parse_can(cmd_ctx_t *c, unsigned k, char **save, cmd_args_t *args, c
         arg = token(save);
     }
     if (st < 0 || arg != NULL) {
-        snprintf(err, errlen, "usage: can bus-off [SECONDS] | can passive | can warning | "
-                              "can active");
+        snprintf(err, errlen,
+                 "usage: can bus-off [SECONDS] | can passive | can warning | "
+                 "can active");
         return false;
     }
     args->can_state = (uint8_t)st;
@@ -453,13 +453,13 @@ static void apply_quit(cmd_ctx_t *c, unsigned k, unsigned node, const cmd_args_t
 
 /* The table: a new verb is a row here and its two functions. */
 const cmd_verb_t cmd_verbs[] = {
-    {"set", "NAME=VALUE ...", "true value of the product's inputs (below)", CMD_INPUTS,
-     parse_set, apply_set},
+    {"set", "NAME=VALUE ...", "true value of the product's inputs (below)", CMD_INPUTS, parse_set,
+     apply_set},
     {"ramp", "NAME=VALUE in DUR",
      "linear from the value now to VALUE over DUR (5s, 250ms, at most a day), then held",
      CMD_INPUTS, parse_ramp, apply_ramp},
-    {"sine", "NAME amp=A period=DUR", "around the value now, starting there going up",
-     CMD_INPUTS, parse_sine, apply_sine},
+    {"sine", "NAME amp=A period=DUR", "around the value now, starting there going up", CMD_INPUTS,
+     parse_sine, apply_sine},
     {"noise", "NAME sd=S",
      "Gaussian noise (S in the input's unit) on top of the motion; sd=0 stops it", CMD_INPUTS,
      parse_noise, apply_noise},
@@ -468,14 +468,14 @@ const cmd_verb_t cmd_verbs[] = {
      "held. set, ramp, sine and replay replace an input's motion, noise stays; values beyond "
      "an input's limit are refused, noise is saturated at it",
      CMD_INPUTS, parse_replay, apply_replay},
-    {"fault", "NAME on|off", "force one of the product's faults (below)", CMD_INPUTS,
-     parse_fault, apply_fault},
+    {"fault", "NAME on|off", "force one of the product's faults (below)", CMD_INPUTS, parse_fault,
+     apply_fault},
     {"can", "bus-off [SECONDS] | passive | warning | active",
      "the nodes' simulated CAN controller: bus-off sends nothing; the bus stays unusable "
      "SECONDS (default 0, at most 1800), then it is back after 128 x 11 bits at its bit rate",
      CMD_NODES, parse_can, apply_can},
-    {"get", "", "one node's true inputs and NMT state: ok x=1.000 ... nmt=operational",
-     CMD_QUERY, parse_get, NULL},
+    {"get", "", "one node's true inputs and NMT state: ok x=1.000 ... nmt=operational", CMD_QUERY,
+     parse_get, NULL},
     {"quit", "", "stop the program", CMD_PROGRAM, parse_quit, apply_quit},
 };
 const unsigned cmd_nverbs = sizeof(cmd_verbs) / sizeof(cmd_verbs[0]);
@@ -544,8 +544,8 @@ bool cmd_number(const char *s, long max, long *out)
 
 /* The nodes a line's selector names (cmd.h) as the range [*first, *end);
  * returns the rest of the line, or NULL with the cause in err. */
-static const char *select_nodes(const app_t *a, const char *line, unsigned *first,
-                                unsigned *end, char *err, size_t errlen)
+static const char *select_nodes(const app_t *a, const char *line, unsigned *first, unsigned *end,
+                                char *err, size_t errlen)
 {
     const char *p = line + strspn(line, " \t");
     size_t n = strcspn(p, " \t");
@@ -577,8 +577,10 @@ static const char *select_nodes(const app_t *a, const char *line, unsigned *firs
     }
     if (!num || v < 1 || v > 127) {
         /* An LSS-unconfigured node has none (it reads 0xFF): @N names it. */
-        snprintf(err, errlen, "'%s': not a node-ID 1..127 (a node without one: select it by "
-                 "index, @N)", tok);
+        snprintf(err, errlen,
+                 "'%s': not a node-ID 1..127 (a node without one: select it by "
+                 "index, @N)",
+                 tok);
         return NULL;
     }
     unsigned found = 0;
@@ -589,9 +591,12 @@ static const char *select_nodes(const app_t *a, const char *line, unsigned *firs
         }
     }
     if (found != 1u) {
-        snprintf(err, errlen, found == 0u ? "no node with node-ID %s" :
-                 "node-ID %s is held by more than one node (several interfaces, or a clash): "
-                 "select it by index (@N)", tok);
+        snprintf(err, errlen,
+                 found == 0u
+                     ? "no node with node-ID %s"
+                     : "node-ID %s is held by more than one node (several interfaces, or a clash): "
+                       "select it by index (@N)",
+                 tok);
         return NULL;
     }
     *end = *first + 1u;
@@ -655,9 +660,10 @@ static bool run_verb(cmd_ctx_t *c, const cmd_verb_t *verb, const char *cmd, unsi
         for (unsigned k = k0; k <= k1; k++) {
             if (!parse_for(c, verb, cmd, k, &args, err, sizeof(err))) {
                 const char *id = a->inst[k].prod->id;
-                snprintf(reply, len, "error: %s%s%s%s", k1 > k0 ? id : "", k1 > k0 ? ": " : "",
-                         err, pass == 1 ? " (it changed meanwhile: the instances before took "
-                                          "the former)" : "");
+                snprintf(reply, len, "error: %s%s%s%s", k1 > k0 ? id : "", k1 > k0 ? ": " : "", err,
+                         pass == 1 ? " (it changed meanwhile: the instances before took "
+                                     "the former)"
+                                   : "");
                 return false;
             }
             if (pass == 1 && verb->scope == CMD_NODES) {
@@ -679,8 +685,7 @@ static bool run_verb(cmd_ctx_t *c, const cmd_verb_t *verb, const char *cmd, unsi
     return true;
 }
 
-void cmd_line(app_t *a, cmd_channel_t ch, const char *line, uint32_t now, char *reply,
-              size_t len)
+void cmd_line(app_t *a, cmd_channel_t ch, const char *line, uint32_t now, char *reply, size_t len)
 {
     cmd_ctx_t c = {.a = a, .now = now};
     char err[256];

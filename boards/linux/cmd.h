@@ -135,7 +135,6 @@ typedef enum cmd_channel { CMD_STDIN, CMD_CONTROL } cmd_channel_t;
 
 /* Serve one line (without its newline) for app a, at time now: the
  * answer into reply (len bytes, no newline). */
-void cmd_line(app_t *a, cmd_channel_t ch, const char *line, uint32_t now, char *reply,
-              size_t len);
+void cmd_line(app_t *a, cmd_channel_t ch, const char *line, uint32_t now, char *reply, size_t len);
 
 #endif /* LINUX_CMD_H */

@@ -3,8 +3,8 @@
  * send the line language (cmd.h), one command a line, and get one
  * answer line for each ("ok ..." or "error: <cause>"). This module owns
  * the sockets and each client's buffers; lines are assembled as on every
- * channel (cmd.h, cmd_lines_t) and answered by the program (ctl_line_fn). Everything runs in the program's one thread; nothing
- * blocks: answers the kernel cannot take at once wait in the client's
+ * channel (cmd.h, cmd_lines_t) and answered by the program (ctl_line_fn). Everything runs in the
+ * program's one thread; nothing blocks: answers the kernel cannot take at once wait in the client's
  * buffer, and while it is full the client's further lines wait unread
  * (in the kernel), so a client that sends faster than it reads is slowed
  * down, never cut off, and one that stops reading only holds its slot.
@@ -31,9 +31,9 @@
 typedef void (*ctl_line_fn)(void *ctx, const char *line, char *reply, size_t len);
 
 typedef struct ctl_client {
-    int fd; /* -1: free */
+    int fd;            /* -1: free */
     cmd_lines_t lines; /* the line being assembled (cmd.h) */
-    char in[CTL_IN]; /* read, not looked at yet (the answers' buffer was full) */
+    char in[CTL_IN];   /* read, not looked at yet (the answers' buffer was full) */
     size_t ipos, ilen;
     char out[CTL_OUT]; /* answers the kernel has not taken yet */
     size_t olen;
@@ -41,8 +41,8 @@ typedef struct ctl_client {
 } ctl_client_t;
 
 typedef struct ctl {
-    int fd;              /* listening socket, -1: none */
-    char path[108];      /* unix socket path to remove at close, "" for tcp */
+    int fd;         /* listening socket, -1: none */
+    char path[108]; /* unix socket path to remove at close, "" for tcp */
     ctl_client_t cl[CTL_CLIENTS];
 } ctl_t;
 

@@ -94,7 +94,8 @@ static void entry_body(FILE *f, const product_t *p, const co_od_entry_t *e, cons
          * an EDS comment line says so (CiA 306: lines starting with ';'). */
         char dev[16];
         format_value(dev, sizeof(dev), e, e->def);
-        fprintf(f, "; the device's default is %s; this EDS gives the value its manual asks for: %s\n",
+        fprintf(f,
+                "; the device's default is %s; this EDS gives the value its manual asks for: %s\n",
                 dev, o->reason);
         value(f, "DefaultValue", e, o->value);
     } else {
@@ -153,8 +154,9 @@ int eds_write(FILE *f, const product_t *p)
             "Description=%s\nCreatedBy=canopen-sensor --eds (generated from the firmware's "
             "dictionary)\n\n",
             p->id, p->summary);
-    fprintf(f, "[DeviceInfo]\nVendorName=%s\nVendorNumber=0x%lX\nProductName=%s\n"
-               "ProductNumber=0x%lX\nRevisionNumber=0x%lX\nOrderCode=%s\n",
+    fprintf(f,
+            "[DeviceInfo]\nVendorName=%s\nVendorNumber=0x%lX\nProductName=%s\n"
+            "ProductNumber=0x%lX\nRevisionNumber=0x%lX\nOrderCode=%s\n",
             p->vendor, vendor != NULL ? (unsigned long)vendor->def : 0ul, p->summary,
             ident != NULL ? (unsigned long)ident->def : 0ul,
             rev != NULL ? (unsigned long)rev->def : 0ul, p->id);

@@ -13,8 +13,7 @@
 #include <gpiod.h>
 #endif
 
-int leds_open(leds_t *l, const char *chip, int green_line, int red_line, char *err,
-              unsigned errlen)
+int leds_open(leds_t *l, const char *chip, int green_line, int red_line, char *err, unsigned errlen)
 {
     memset(l, 0, sizeof(*l));
     l->g = l->r = -1;

@@ -10,11 +10,11 @@
 #include "co_node.h"
 
 typedef struct leds {
-    void *chip;   /* struct gpiod_chip *, NULL without GPIO */
-    void *green;  /* struct gpiod_line * */
+    void *chip;  /* struct gpiod_chip *, NULL without GPIO */
+    void *green; /* struct gpiod_line * */
     void *red;
-    int g, r;     /* last levels, -1 unknown */
-    int gp, rp;   /* last patterns, -1 unknown */
+    int g, r;   /* last levels, -1 unknown */
+    int gp, rp; /* last patterns, -1 unknown */
 } leds_t;
 
 /* chip NULL: log only. Returns 0, or -1 with the cause in err (errlen bytes)

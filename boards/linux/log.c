@@ -9,7 +9,6 @@
 
 #include "co_common.h"
 
-
 /* The log is the process's one piece of board state outside the ports
  * (its file, time zero and clock): set once at start-up, only read
  * afterwards. */

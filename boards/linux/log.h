@@ -17,9 +17,9 @@
 /* A rate limit for one kind of log line: a window of LP_RATE_US from the
  * first line, at most a given number of lines in it. */
 typedef struct lp_rate {
-    uint32_t start;          /* start of the current window */
-    unsigned shown;          /* lines logged in it */
-    bool open;               /* a window was started */
+    uint32_t start; /* start of the current window */
+    unsigned shown; /* lines logged in it */
+    bool open;      /* a window was started */
 } lp_rate_t;
 
 /* Log a line with a time stamp to the log (stderr or --log FILE): by

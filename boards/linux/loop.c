@@ -181,8 +181,7 @@ static void control_line(void *ctx, const char *line, char *reply, size_t len)
 
 /* ---- Set-up ------------------------------------------------------------- */
 
-int loop_open(loop_t *l, app_t *a, const char *control, bool quit_on_eof, char *err,
-              size_t errlen)
+int loop_open(loop_t *l, app_t *a, const char *control, bool quit_on_eof, char *err, size_t errlen)
 {
     memset(l, 0, sizeof(*l));
     l->app = a;

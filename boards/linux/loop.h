@@ -50,8 +50,7 @@ void loop_stop_signals(sigset_t *sigs);
  * err for a control spec that cannot be used (a usage error); -1 with
  * the cause for another failure.
  */
-int loop_open(loop_t *l, app_t *a, const char *control, bool quit_on_eof, char *err,
-              size_t errlen);
+int loop_open(loop_t *l, app_t *a, const char *control, bool quit_on_eof, char *err, size_t errlen);
 
 /* After the nodes' start at time t: standard input that cannot be polled
  * is read a block a pass (a file) or taken as ended; the first sample. */

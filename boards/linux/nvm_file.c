@@ -68,13 +68,15 @@ static bool commit(lp_nvm_t *n, uint32_t addr, const void *buf, uint32_t len)
     int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0644);
     if (fd < 0) {
         lp_log("error: EEPROM file %s: save failed: cannot create %s: %s (the file keeps its "
-               "previous contents)", n->real, tmp, strerror(errno));
+               "previous contents)",
+               n->real, tmp, strerror(errno));
         return false;
     }
     const struct iovec iov[3] = {
         {.iov_base = n->mem, .iov_len = addr},
         /* iov_base is not const, writev only reads it: const dropped through uintptr_t */
-        {.iov_base = (void *)(uintptr_t)buf, .iov_len = len}, /* NOLINT(performance-no-int-to-ptr) */
+        /* NOLINTNEXTLINE(performance-no-int-to-ptr) */
+        {.iov_base = (void *)(uintptr_t)buf, .iov_len = len},
         {.iov_base = n->mem + addr + len, .iov_len = n->size - addr - len},
     };
     const char *step = "write";
@@ -96,7 +98,8 @@ static bool commit(lp_nvm_t *n, uint32_t addr, const void *buf, uint32_t len)
     }
     if (!ok) {
         lp_log("error: EEPROM file %s: save failed (%s): %s (the file keeps its previous "
-               "contents)", n->real, step, strerror(e));
+               "contents)",
+               n->real, step, strerror(e));
         (void)unlink(tmp);
         return false;
     }
@@ -114,8 +117,12 @@ static bool commit(lp_nvm_t *n, uint32_t addr, const void *buf, uint32_t len)
 
 static const char *file_kind(mode_t m)
 {
-    return S_ISDIR(m) ? "a directory" : S_ISFIFO(m) ? "a FIFO" : S_ISCHR(m) ? "a character device"
-         : S_ISBLK(m) ? "a block device" : S_ISSOCK(m) ? "a socket" : "not a regular file";
+    return S_ISDIR(m)    ? "a directory"
+           : S_ISFIFO(m) ? "a FIFO"
+           : S_ISCHR(m)  ? "a character device"
+           : S_ISBLK(m)  ? "a block device"
+           : S_ISSOCK(m) ? "a socket"
+                         : "not a regular file";
 }
 
 int lp_nvm_open(lp_nvm_t *n, const char *opt, const char *path, uint8_t *mem, uint32_t size,
@@ -148,8 +155,10 @@ int lp_nvm_open(lp_nvm_t *n, const char *opt, const char *path, uint8_t *mem, ui
         char to[256];
         ssize_t tl = readlink(path, to, sizeof(to) - 1u);
         to[tl > 0 ? tl : 0] = '\0';
-        snprintf(err, errlen, "%s %s: a symbolic link to %s, which does not exist (create the "
-                 "file, or give the path without the link)", opt, path, to);
+        snprintf(err, errlen,
+                 "%s %s: a symbolic link to %s, which does not exist (create the "
+                 "file, or give the path without the link)",
+                 opt, path, to);
         return -2;
     } else if (errno == ENOENT) {
         /* A new file: its directory must exist (the first save creates the file). */
@@ -169,8 +178,8 @@ int lp_nvm_open(lp_nvm_t *n, const char *opt, const char *path, uint8_t *mem, ui
             return -2;
         }
         if (strcmp(base, "/") == 0 || strcmp(base, ".") == 0 || strcmp(base, "..") == 0 ||
-            snprintf(n->real, sizeof(n->real), "%s/%s", strcmp(rdir, "/") == 0 ? "" : rdir,
-                     base) >= (int)sizeof(n->real)) {
+            snprintf(n->real, sizeof(n->real), "%s/%s", strcmp(rdir, "/") == 0 ? "" : rdir, base) >=
+                (int)sizeof(n->real)) {
             snprintf(err, errlen, "%s %s: not a file name", opt, path);
             return -2;
         }
@@ -218,11 +227,11 @@ int lp_nvm_open(lp_nvm_t *n, const char *opt, const char *path, uint8_t *mem, ui
         /* A shorter file reads as erased beyond its end, like a fresh chip;
          * the file itself is left alone until a save. */
         memset(mem + got, 0xFF, size - got);
-        lp_log("EEPROM file %s has %zu of %u bytes; the rest reads as erased", n->real, got,
-               size);
+        lp_log("EEPROM file %s has %zu of %u bytes; the rest reads as erased", n->real, got, size);
     } else if (st.st_size > (off_t)size) {
         lp_log("EEPROM file %s has %lld bytes, more than the %u used; the rest is ignored (and "
-               "left out at the next save)", n->real, (long long)st.st_size, size);
+               "left out at the next save)",
+               n->real, (long long)st.st_size, size);
     }
     return 0;
 }
@@ -253,8 +262,10 @@ int lp_nvm_lock(lp_nvm_t *n, const char *opt, const char *path, char *err, unsig
             close(fd);
         }
         if (e == EADDRINUSE) {
-            snprintf(err, errlen, "%s %s: EEPROM file %s is in use by another canopen-sensor "
-                     "process (two users would overwrite each other's saves)", opt, path, n->real);
+            snprintf(err, errlen,
+                     "%s %s: EEPROM file %s is in use by another canopen-sensor "
+                     "process (two users would overwrite each other's saves)",
+                     opt, path, n->real);
             return -2;
         }
         snprintf(err, errlen, "%s %s: cannot hold the file: %s", opt, path, strerror(e));

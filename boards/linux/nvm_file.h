@@ -11,12 +11,12 @@
 
 /* The EEPROM: one file shared by the nodes of a product. */
 typedef struct lp_nvm {
-    const char *path;  /* NULL: RAM only, lost at exit; else path[] below */
-    char real[4096];   /* the file's resolved path (symlinks followed) */
-    uint8_t *mem;      /* mirror of the file, size bytes (caller's storage); always
-                        * what the file holds (a write that fails changes neither) */
+    const char *path; /* NULL: RAM only, lost at exit; else path[] below */
+    char real[4096];  /* the file's resolved path (symlinks followed) */
+    uint8_t *mem;     /* mirror of the file, size bytes (caller's storage); always
+                       * what the file holds (a write that fails changes neither) */
     uint32_t size;
-    int lock_fd;       /* lp_nvm_lock's hold on the file; -1 or 0: none */
+    int lock_fd; /* lp_nvm_lock's hold on the file; -1 or 0: none */
 } lp_nvm_t;
 
 /*

@@ -18,8 +18,8 @@
  * mcu_image (one is built per MCU board: every product but a template),
  * mcu_config (the node config that image fixes, null for none: a product
  * of two nodes). Builds each product's instance in a local buffer to read
- * its nodes' node-IDs (nothing is sent, no port is called). only: that product alone (--product), NULL: all.
- * Returns 0, or -1 when f reported a write error.
+ * its nodes' node-IDs (nothing is sent, no port is called). only: that product alone (--product),
+ * NULL: all. Returns 0, or -1 when f reported a write error.
  */
 int products_json(FILE *f, const product_t *only);
 

@@ -128,9 +128,10 @@ bool replay_csv_load(const product_t *prod, const char *file, sim_replay_t *r, c
      * size bounds that wait (a few milliseconds at the limit). A table
      * of SIM_REPLAY_ROWS rows fits many times over. */
     if (st.st_size > (off_t)SIM_REPLAY_BYTES) {
-        snprintf(err, errlen, "replay %s: %lld bytes, more than the %u a replay file may have "
-                 "(it is read while every node waits)", file, (long long)st.st_size,
-                 SIM_REPLAY_BYTES);
+        snprintf(err, errlen,
+                 "replay %s: %lld bytes, more than the %u a replay file may have "
+                 "(it is read while every node waits)",
+                 file, (long long)st.st_size, SIM_REPLAY_BYTES);
         close(fd);
         return false;
     }
@@ -180,8 +181,7 @@ bool replay_csv_load(const product_t *prod, const char *file, sim_replay_t *r, c
         if (cols == 0u) {
             if (n < 2u || n > PRODUCT_MAX_INPUTS + 1u ||
                 (strcmp(field[0], "t") != 0 && strcmp(field[0], "time") != 0)) {
-                snprintf(err, errlen, "replay %s: line %u: expected a header t,NAME,...", file,
-                         no);
+                snprintf(err, errlen, "replay %s: line %u: expected a header t,NAME,...", file, no);
                 ok = false;
                 break;
             }
@@ -221,8 +221,8 @@ bool replay_csv_load(const product_t *prod, const char *file, sim_replay_t *r, c
         }
         uint64_t tu = (uint64_t)llround(t * 1e6);
         if (r->rows > 0u && tu <= r->t_us[r->rows - 1u]) {
-            snprintf(err, errlen, "replay %s: line %u: time %s not after the row before", file,
-                     no, field[0]);
+            snprintf(err, errlen, "replay %s: line %u: time %s not after the row before", file, no,
+                     field[0]);
             ok = false;
             break;
         }
@@ -230,8 +230,8 @@ bool replay_csv_load(const product_t *prod, const char *file, sim_replay_t *r, c
         for (unsigned k = 1; k < n && ok; k++) {
             double lim = prod->inputs[input_of[k - 1u]].limit;
             if (!sim_value(field[k], lim, &r->v[r->rows][k - 1u])) {
-                snprintf(err, errlen, "replay %s: line %u: '%s' not a number within +-%.0f",
-                         file, no, field[k], lim);
+                snprintf(err, errlen, "replay %s: line %u: '%s' not a number within +-%.0f", file,
+                         no, field[k], lim);
                 ok = false;
             }
         }

@@ -59,8 +59,7 @@ static int check_clashes(const app_t *a)
 static bool former_nvm_name(const options_t *o, unsigned k, uint8_t id, char *buf, size_t len)
 {
     return o->nvm_dir != NULL && !(k == 0u && o->prod != NULL && o->nvm_path != NULL) &&
-           snprintf(buf, len, "%s/%s-0x%02X.nvm", o->nvm_dir, o->spec[k].prod->id, id) <
-               (int)len;
+           snprintf(buf, len, "%s/%s-0x%02X.nvm", o->nvm_dir, o->spec[k].prod->id, id) < (int)len;
 }
 
 /*
@@ -97,7 +96,8 @@ static int open_inst_nvm(app_t *a, const options_t *o, unsigned k, bool logf, bo
     if (*former) {
         if (!S_ISREG(st.st_mode)) { /* a link too: renamed, it would point elsewhere */
             return USAGE_ERROR("--nvm-dir %s: %s (the former name of %s) is not a regular "
-                               "file: move it away", o->nvm_dir, old, file);
+                               "file: move it away",
+                               o->nvm_dir, old, file);
         }
         path = old;
     }
@@ -143,7 +143,8 @@ static void rename_former_nvm(const options_t *o, unsigned k, uint8_t id)
     }
     if (rename(old, file) != 0) {
         lp_log("warning: EEPROM file %s (the former name) not renamed %s: %s: its set is in use; "
-               "the first save writes the new name", old, file, strerror(errno));
+               "the first save writes the new name",
+               old, file, strerror(errno));
         return;
     }
     lp_log("EEPROM file %s renamed %s (the interface is in the name now)", old, file);

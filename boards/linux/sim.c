@@ -101,8 +101,8 @@ static int32_t motion_value(const sim_t *s, unsigned i, uint64_t t)
         if (el >= m->dur_us) {
             return m->to;
         }
-        return m->from + (int32_t)scale_round((int64_t)m->to - m->from, (int64_t)el,
-                                              (int64_t)m->dur_us);
+        return m->from +
+               (int32_t)scale_round((int64_t)m->to - m->from, (int64_t)el, (int64_t)m->dur_us);
     case SIM_SINE: {
         double phase = (double)(el % m->dur_us) / (double)m->dur_us;
         return m->from + (int32_t)lround((double)m->amp * sin(6.283185307179586 * phase));

@@ -231,8 +231,11 @@ static void nrf51_read(void *ctx, uint32_t addr, void *buf, uint32_t len)
 
 static const flash_ops_t nrf51_flash = {
     .erase = nrf51_erase, .program16 = nrf51_program16, .read = nrf51_read};
-static const flash_ee_t eeprom = {.ops = &nrf51_flash, .ctx = 0, .base = EEPROM_BASE,
-                                  .page_size = NRF51_PAGE_SIZE, .pages = EEPROM_PAGES};
+static const flash_ee_t eeprom = {.ops = &nrf51_flash,
+                                  .ctx = 0,
+                                  .base = EEPROM_BASE,
+                                  .page_size = NRF51_PAGE_SIZE,
+                                  .pages = EEPROM_PAGES};
 
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {

@@ -45,8 +45,8 @@ typedef void (*vector_t)(void);
 __attribute__((section(".isr_vector"), used)) static const vector_t vectors[48] = {
     (vector_t)(uintptr_t)&_estack, /* initial stack pointer */
     reset_handler,
-    default_handler, /* NMI */
-    default_handler, /* HardFault */
+    default_handler,        /* NMI */
+    default_handler,        /* HardFault */
     [11] = default_handler, /* SVCall */
     [14] = default_handler, /* PendSV */
     [16 + UART_IRQ] = uart0_handler,

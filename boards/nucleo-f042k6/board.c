@@ -158,7 +158,8 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
             WR32(CAN_TDTR(n), frame->dlc);
             WR32(CAN_TDLR(n), co_get_u32(&frame->data[0]));
             WR32(CAN_TDHR(n), co_get_u32(&frame->data[4]));
-            WR32(CAN_TIR(n), ((uint32_t)frame->id << 21) | (frame->rtr ? CAN_TIR_RTR : 0u) | CAN_TIR_TXRQ);
+            WR32(CAN_TIR(n),
+                 ((uint32_t)frame->id << 21) | (frame->rtr ? CAN_TIR_RTR : 0u) | CAN_TIR_TXRQ);
             return true;
         }
     }
@@ -246,9 +247,10 @@ static void f042_read(void *ctx, uint32_t addr, void *buf, uint32_t len)
     }
 }
 
-static const flash_ops_t f042_flash = {.erase = f042_erase, .program16 = f042_program16, .read = f042_read};
-static const flash_ee_t eeprom = {.ops = &f042_flash, .ctx = 0, .base = 0x08006000u,
-                                  .page_size = 1024u, .pages = 8u};
+static const flash_ops_t f042_flash = {
+    .erase = f042_erase, .program16 = f042_program16, .read = f042_read};
+static const flash_ee_t eeprom = {
+    .ops = &f042_flash, .ctx = 0, .base = 0x08006000u, .page_size = 1024u, .pages = 8u};
 
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
 {

@@ -274,8 +274,11 @@ static const flash_ee_t *nvm(void)
         if (cfi_flash_probe(&flash, FLASH_BANK1) &&
             flash.block_size * (EEPROM_SLOTS + 1u) <= flash.size &&
             *(const volatile uint32_t *)(uintptr_t)(flash.base + flash.size - 4u) != 0u) {
-            eeprom = (flash_ee_t){.ops = &cfi_flash_ops, .ctx = &flash, .base = flash.base,
-                                  .page_size = flash.block_size, .pages = EEPROM_SLOTS};
+            eeprom = (flash_ee_t){.ops = &cfi_flash_ops,
+                                  .ctx = &flash,
+                                  .base = flash.base,
+                                  .page_size = flash.block_size,
+                                  .pages = EEPROM_SLOTS};
         }
     }
     return eeprom.ops != NULL ? &eeprom : NULL;

@@ -15,7 +15,9 @@
 #include "cfi_flash.h"
 
 /* A command to both x16 chips: the byte in each half-word. */
+/* clang-format off */
 #define CMD(c) ((uint32_t)(c) * 0x00010001u)
+/* clang-format on */
 #define CMD_READ_ARRAY CMD(0xFFu)
 #define CMD_QUERY CMD(0x98u)
 #define CMD_CLEAR_STATUS CMD(0x50u)
@@ -137,4 +139,5 @@ static void cfi_read(void *ctx, uint32_t addr, void *buf, uint32_t len)
     }
 }
 
-const flash_ops_t cfi_flash_ops = {.erase = cfi_erase, .program16 = cfi_program16, .read = cfi_read};
+const flash_ops_t cfi_flash_ops = {
+    .erase = cfi_erase, .program16 = cfi_program16, .read = cfi_read};

@@ -242,7 +242,8 @@ const co_node_ops_t dst_ops = {
 
 /* Green blinks 200/200 ms; "single flash" is 500 ms on / 500 ms off, as
  * the manual's legend says (section 13), not CiA 303-3's 200/1000 ms. */
-const co_led_timing_t dst_led = {.flicker_ms = 50, .blink_ms = 200, .flash_ms = 500, .pause_ms = 500};
+const co_led_timing_t dst_led = {
+    .flicker_ms = 50, .blink_ms = 200, .flash_ms = 500, .pause_ms = 500};
 
 void dst_create(const product_t *p, void *mem, void *const ports[], co_node_t *nodes[])
 {
@@ -250,8 +251,8 @@ void dst_create(const product_t *p, void *mem, void *const ports[], co_node_t *n
     const dst_variant_t *v = p->variant;
     memset(d, 0, sizeof(*d));
     co_incl_init(&d->incl, &d->para.incl, v->axes, v->limit_mdeg, v->wrap);
-    void *const ram[CO_CLS_COUNT] = {[CO_CLS_VOL] = &d->vol, [CO_CLS_PARA] = &d->para,
-                                     [CO_CLS_LSS] = &d->lss};
+    void *const ram[CO_CLS_COUNT] = {
+        [CO_CLS_VOL] = &d->vol, [CO_CLS_PARA] = &d->para, [CO_CLS_LSS] = &d->lss};
     co_node_init(&d->node, v->cfg, ports[0], d, ram, 0);
     nodes[0] = &d->node;
 }

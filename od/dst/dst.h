@@ -12,19 +12,19 @@
 #include "product.h"
 
 /* 0x4001 error bits (manual "Error code"). */
-#define DST_ERR_SENSOR 0x01u    /* sensor error or angle beyond the limit */
-#define DST_ERR_PROGRAM 0x10u   /* program checksum error */
-#define DST_ERR_FLASH 0x20u     /* flash write-cycle limit reached */
-#define DST_ERR_CHECKSUM 0x40u  /* stored parameter checksum error */
+#define DST_ERR_SENSOR 0x01u   /* sensor error or angle beyond the limit */
+#define DST_ERR_PROGRAM 0x10u  /* program checksum error */
+#define DST_ERR_FLASH 0x20u    /* flash write-cycle limit reached */
+#define DST_ERR_CHECKSUM 0x40u /* stored parameter checksum error */
 
 /* Manual: "maximum 100,000 write cycles" of the parameter memory. */
 #define DST_WRITE_LIMIT 100000u
 
 typedef struct dst_variant {
     const co_node_cfg_t *cfg; /* the model's dictionary and hooks */
-    uint8_t axes;        /* 2: X/Y, 1: Z */
-    bool wrap;           /* Z-360: full turn */
-    int32_t limit_mdeg;  /* output stop and error angle (0: none) */
+    uint8_t axes;             /* 2: X/Y, 1: Z */
+    bool wrap;                /* Z-360: full turn */
+    int32_t limit_mdeg;       /* output stop and error angle (0: none) */
 } dst_variant_t;
 
 /* Stored by "save" (class PARA). */
@@ -81,10 +81,10 @@ co_res_t dst_read_slope(co_node_t *n, const co_od_entry_t *e, uint32_t *v);
 extern const co_node_cfg_t dst_x730_cfg;
 extern const co_node_cfg_t dst_x710_cfg;
 
-extern const product_t dst_x730_xy10, dst_x730_xy15, dst_x730_xy20, dst_x730_xy30,
-    dst_x730_xy45, dst_x730_xy60, dst_x730_xy90, dst_x730_z360;
-extern const product_t dst_x710_xy10, dst_x710_xy15, dst_x710_xy20, dst_x710_xy30,
-    dst_x710_xy45, dst_x710_xy60, dst_x710_xy90, dst_x710_z360;
+extern const product_t dst_x730_xy10, dst_x730_xy15, dst_x730_xy20, dst_x730_xy30, dst_x730_xy45,
+    dst_x730_xy60, dst_x730_xy90, dst_x730_z360;
+extern const product_t dst_x710_xy10, dst_x710_xy15, dst_x710_xy20, dst_x710_xy30, dst_x710_xy45,
+    dst_x710_xy60, dst_x710_xy90, dst_x710_z360;
 
 /* The error limit of each variant: 110 % of the range, +-87 deg on the
  * +-90 variant; shared by both models (section 9 of either manual). */
@@ -97,14 +97,21 @@ extern const product_t dst_x710_xy10, dst_x710_xy15, dst_x710_xy20, dst_x710_xy3
 #define DST_LIMIT_XY90 87000
 
 /* A product of the family: symbol, ID, description, variant, input names, config. */
-#define DST_PRODUCT(sym, idstr, text, var, ins, cfgp)                                           \
-    const product_t sym = {.id = PRODUCT_TEXT(idstr), .summary = PRODUCT_TEXT(text),            \
-                           .inputs = ins, /* NOLINT(bugprone-macro-parentheses): a {...} list */ \
-                           .faults = {PRODUCT_FAULT("sensor"), NULL, NULL, NULL},               \
-                           .nodes = 1, .inst_size = sizeof(dst_dev_t), .create = dst_create,    \
-                           .sample = dst_sample, .variant = &(var), .cfg = (cfgp),              \
+#define DST_PRODUCT(sym, idstr, text, var, ins, cfgp)                                              \
+    const product_t sym = {.id = PRODUCT_TEXT(idstr),                                              \
+                           .summary = PRODUCT_TEXT(text),                                          \
+                           .inputs = ins, /* NOLINT(bugprone-macro-parentheses): a {...} list */   \
+                           .faults = {PRODUCT_FAULT("sensor"), NULL, NULL, NULL},                  \
+                           .nodes = 1,                                                             \
+                           .inst_size = sizeof(dst_dev_t),                                         \
+                           .create = dst_create,                                                   \
+                           .sample = dst_sample,                                                   \
+                           .variant = &(var),                                                      \
+                           .cfg = (cfgp),                                                          \
                            .vendor = PRODUCT_TEXT("Danfoss A/S")}
+/* clang-format off */
 #define DST_XY_INPUTS {{"x", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}, {"y", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}}
 #define DST_Z_INPUTS {{"z", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}}
+/* clang-format on */
 
 #endif /* DST_H */

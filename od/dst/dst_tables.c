@@ -11,6 +11,7 @@
  * The table must stay sorted by (index, sub-index).
  */
 #include "dst.h"
+/* clang-format off */
 
 #define RO (CO_A_R)
 #define RW (CO_A_RW)
@@ -193,3 +194,4 @@ DST_PRODUCT(dst_x710_xy45, "dst-x710-xy45", "Danfoss DST X710 dual axis +-45 deg
 DST_PRODUCT(dst_x710_xy60, "dst-x710-xy60", "Danfoss DST X710 dual axis +-60 deg (CiA 410)", x710_xy60, DST_XY_INPUTS, &dst_x710_cfg);
 DST_PRODUCT(dst_x710_xy90, "dst-x710-xy90", "Danfoss DST X710 dual axis +-90 deg, stops at +-87 (CiA 410)", x710_xy90, DST_XY_INPUTS, &dst_x710_cfg);
 DST_PRODUCT(dst_x710_z360, "dst-x710-z360", "Danfoss DST X710 single axis Z, -180..+180 deg (CiA 410)", x710_z360, DST_Z_INPUTS, &dst_x710_cfg);
+/* clang-format on */

@@ -29,9 +29,9 @@
 
 /* Decisions where the manual is silent (it gives no stroke for channel 2's
  * "backward direction" and no alarm thresholds), as build parameters: */
-#define GSH_STROKE_MM 8000      /* measuring range; channel 2 = stroke - channel 1 */
-#define GSH_FIELD_LOW_PCT 50    /* magnet field below this: "too low" */
-#define GSH_FIELD_HIGH_PCT 150  /* above this: "too high" */
+#define GSH_STROKE_MM 8000     /* measuring range; channel 2 = stroke - channel 1 */
+#define GSH_FIELD_LOW_PCT 50   /* magnet field below this: "too low" */
+#define GSH_FIELD_HIGH_PCT 150 /* above this: "too high" */
 
 /* Stored by 0x1010 (class PARA). */
 typedef struct gsh_para {
@@ -44,14 +44,14 @@ typedef struct gsh_para {
 typedef struct gsh_chan {
     co_node_t node;
     gsh_para_t para;
-    co_lss_para_t lss;       /* 0x3000 bit rate, 0x3001 node-ID */
+    co_lss_para_t lss;        /* 0x3000 bit rate, 0x3001 node-ID */
     co_incl_para_t incl_para; /* fixed: 0.1 deg, channel 2 counts backwards */
     co_incl_t incl;
-    uint16_t position_mm;    /* 0x6004 */
+    uint16_t position_mm; /* 0x6004 */
     uint16_t alarms;
-    uint8_t counter;         /* PDO byte 7 of the next PDO */
-    uint8_t sent_counter;    /* 0x2111: byte 7 of the last PDO sent (0 before one) */
-    uint8_t sent_checksum;   /* 0x2112: its byte 8 */
+    uint8_t counter;       /* PDO byte 7 of the next PDO */
+    uint8_t sent_counter;  /* 0x2111: byte 7 of the last PDO sent (0 before one) */
+    uint8_t sent_checksum; /* 0x2112: its byte 8 */
 } gsh_chan_t;
 
 typedef struct gsh_dev {

@@ -6,6 +6,7 @@
  */
 #include "gsh.h"
 #include "product_eds.h"
+/* clang-format off */
 
 #define RO (CO_A_R)
 #define RW (CO_A_RW)
@@ -147,3 +148,4 @@ const product_t gsh_a_redundant = {
     .inputs = GSH_INPUTS, .faults = GSH_FAULTS, .nodes = 2, .inst_size = sizeof(gsh_dev_t),
     .create = gsh_create, .sample = gsh_sample, .cfg = &gsh_ch1_cfg, .vendor = PRODUCT_TEXT("Gefran"),
     PRODUCT_EDS_OVERRIDES(gsh_eds_overrides)};
+/* clang-format on */

@@ -22,12 +22,11 @@ static jd_dev_t *dev_of(co_node_t *n)
 
 /* sin(deg) x 1000, one entry a degree over a quarter turn. */
 static const int16_t sin_q[91] = {
-    0,   17,  35,  52,  70,  87,  105, 122, 139, 156, 174, 191, 208, 225, 242, 259,
-    276, 292, 309, 326, 342, 358, 375, 391, 407, 423, 438, 454, 469, 485, 500, 515,
-    530, 545, 559, 574, 588, 602, 616, 629, 643, 656, 669, 682, 695, 707, 719, 731,
-    743, 755, 766, 777, 788, 799, 809, 819, 829, 839, 848, 857, 866, 875, 883, 891,
-    899, 906, 914, 921, 927, 934, 940, 946, 951, 956, 961, 966, 970, 974, 978, 982,
-    985, 988, 990, 993, 995, 996, 998, 999, 999, 1000, 1000};
+    0,   17,  35,  52,  70,  87,  105, 122, 139, 156, 174, 191, 208, 225,  242, 259, 276, 292, 309,
+    326, 342, 358, 375, 391, 407, 423, 438, 454, 469, 485, 500, 515, 530,  545, 559, 574, 588, 602,
+    616, 629, 643, 656, 669, 682, 695, 707, 719, 731, 743, 755, 766, 777,  788, 799, 809, 819, 829,
+    839, 848, 857, 866, 875, 883, 891, 899, 906, 914, 921, 927, 934, 940,  946, 951, 956, 961, 966,
+    970, 974, 978, 982, 985, 988, 990, 993, 995, 996, 998, 999, 999, 1000, 1000};
 
 /* sin of an angle in mdeg, x 1000, linear between whole degrees. */
 static int32_t isin(int32_t mdeg)
@@ -151,9 +150,10 @@ co_res_t jd_write_preset(co_node_t *n, const co_od_entry_t *e, uint32_t v)
      * stays out of it. */
     const co_incl_meas_t *c = meas(d);
     d->para.preset[axis] = p;
-    d->para.off16[axis] =
-        (int16_t)co_incl_preset_offset(p, c->m[axis], d->para.op16[axis], 0, fit(d, c, false));
-    d->para.off32[axis] = co_incl_preset_offset(p, c->m[axis], d->para.op32[axis], 0, fit(d, c, true));
+    d->para.off16[axis] = (int16_t)co_incl_preset_offset(p, c->m[axis], d->para.op16[axis], 0,
+                                                         fit(d, c, false));
+    d->para.off32[axis] = co_incl_preset_offset(p, c->m[axis], d->para.op32[axis], 0,
+                                                fit(d, c, true));
     return CO_OK;
 }
 

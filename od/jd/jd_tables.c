@@ -5,6 +5,7 @@
  * not give are marked "(?)"; sorted by (index, sub-index).
  */
 #include "jd.h"
+/* clang-format off */
 
 #define RO (CO_A_R)
 #define RW (CO_A_RW)
@@ -174,3 +175,4 @@ const product_t jd1xxx = {
     .inputs = {{"z", PRODUCT_TEXT("deg"), 0, PRODUCT_ANGLE_LIMIT}, {"temp", PRODUCT_TEXT("degC"), 25000, 200}},
     .nodes = 1, .inst_size = sizeof(jd_dev_t), .create = jd_create, .sample = jd_sample,
     .variant = &axes1, .cfg = &jd1_cfg, .vendor = PRODUCT_TEXT("ifm electronic")};
+/* clang-format on */

@@ -59,8 +59,8 @@ static uint32_t pf_poll(co_node_t *n, uint32_t now)
      * 7.2.1: 11h for 5010h); CiA 301's for the others. */
     (void)co_emcy_error(n, PF_EMCY_RANGE_X, CO_ER_COMM, (d->faults & PF_FAULT_RANGE_X) != 0u, NULL);
     if (d->incl.axes > 1u) {
-        (void)co_emcy_error(n, PF_EMCY_RANGE_Y, CO_ER_COMM,
-                            (d->faults & PF_FAULT_RANGE_Y) != 0u, NULL);
+        (void)co_emcy_error(n, PF_EMCY_RANGE_Y, CO_ER_COMM, (d->faults & PF_FAULT_RANGE_Y) != 0u,
+                            NULL);
     }
     (void)co_emcy_error(n, CO_EMCY_VOLTAGE_LOW, CO_ER_VOLTAGE,
                         (d->faults & PF_FAULT_UNDERVOLTAGE) != 0u, NULL);

@@ -29,26 +29,26 @@
  * the manual's node-ID and bit-rate changes survive a power cycle with no
  * save command (section 6.2). */
 typedef struct pf_para {
-    uint32_t sync_cobid;   /* 0x1005 */
-    uint32_t emcy_cobid;   /* 0x1014 */
-    uint16_t guard_ms;     /* 0x100C */
-    uint8_t life_factor;   /* 0x100D */
-    uint16_t hb_ms;        /* 0x1017 */
-    uint32_t tpdo_cobid;   /* 0x1800 sub 1 */
-    uint8_t tx_type;       /* 0x1800 sub 2 */
-    uint16_t inhibit;      /* 0x1800 sub 3, 100 us */
-    uint16_t event_ms;     /* 0x1800 sub 5 */
-    uint8_t map_count;     /* 0x1A00 sub 0 */
-    uint32_t map[2];       /* 0x1A00 sub 1, 2 */
-    co_incl_para_t incl;   /* 0x6000..0x6024 */
+    uint32_t sync_cobid; /* 0x1005 */
+    uint32_t emcy_cobid; /* 0x1014 */
+    uint16_t guard_ms;   /* 0x100C */
+    uint8_t life_factor; /* 0x100D */
+    uint16_t hb_ms;      /* 0x1017 */
+    uint32_t tpdo_cobid; /* 0x1800 sub 1 */
+    uint8_t tx_type;     /* 0x1800 sub 2 */
+    uint16_t inhibit;    /* 0x1800 sub 3, 100 us */
+    uint16_t event_ms;   /* 0x1800 sub 5 */
+    uint8_t map_count;   /* 0x1A00 sub 0 */
+    uint32_t map[2];     /* 0x1A00 sub 1, 2 */
+    co_incl_para_t incl; /* 0x6000..0x6024 */
 } pf_para_t;
 
 typedef struct pf_dev {
     co_node_t node;
     pf_para_t para;
-    co_lss_para_t lss;     /* 0x2000 node-ID, 0x2001 bit rate (pending values) */
+    co_lss_para_t lss; /* 0x2000 node-ID, 0x2001 bit rate (pending values) */
     co_incl_t incl;
-    uint32_t faults;       /* simulator faults (PF_FAULT_*) */
+    uint32_t faults; /* simulator faults (PF_FAULT_*) */
 } pf_dev_t;
 
 extern const co_node_ops_t pf_ops;

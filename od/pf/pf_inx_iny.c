@@ -11,6 +11,7 @@
  * Tables sorted by (index, sub-index).
  */
 #include "pf.h"
+/* clang-format off */
 
 #define RO (CO_A_R)
 #define RW (CO_A_RW)
@@ -118,3 +119,4 @@ const product_t pf_iny360d = {
     .faults = {PRODUCT_FAULT("range-x"), PRODUCT_FAULT("range-y"), PRODUCT_FAULT("undervoltage"), NULL},
     .nodes = 1, .inst_size = sizeof(pf_dev_t), .create = pf_create, .sample = pf_sample,
     .variant = &v_iny, .cfg = &pf_iny_cfg, .vendor = PRODUCT_TEXT("Pepperl+Fuchs")};
+/* clang-format on */

@@ -99,6 +99,7 @@ static void skel_sample(void *mem, const int32_t values[], uint32_t faults)
     }
 }
 
+/* clang-format off */
 /* ---- dictionary (sorted by index, sub-index) -------------------------- */
 
 #define RO (CO_A_R)
@@ -161,3 +162,4 @@ const product_t skel_incl = {
     .faults = {PRODUCT_FAULT("sensor"), NULL},
     .nodes = 1, .inst_size = sizeof(skel_dev_t), .create = skel_create, .sample = skel_sample,
     .variant = NULL, .cfg = &skel_cfg, .vendor = PRODUCT_TEXT("(template)")};
+/* clang-format on */

@@ -23,19 +23,19 @@
 /* Stored parameters (class PARA: 0x1010 saves them, 0x1011 restores the
  * table's defaults). Field order is the stored layout. */
 typedef struct skel_para {
-    uint16_t hb_ms;        /* 0x1017 */
-    uint8_t tx_type;       /* 0x1800 sub 2 */
-    uint16_t event_ms;     /* 0x1800 sub 5 */
-    uint32_t tpdo_cobid;   /* 0x1800 sub 1 */
-    co_incl_para_t incl;   /* 0x6000, 0x6011..0x6014 */
+    uint16_t hb_ms;      /* 0x1017 */
+    uint8_t tx_type;     /* 0x1800 sub 2 */
+    uint16_t event_ms;   /* 0x1800 sub 5 */
+    uint32_t tpdo_cobid; /* 0x1800 sub 1 */
+    co_incl_para_t incl; /* 0x6000, 0x6011..0x6014 */
 } skel_para_t;
 
 typedef struct skel_dev {
-    co_node_t node;        /* first: the stack's node */
+    co_node_t node; /* first: the stack's node */
     skel_para_t para;
     co_incl_t incl;
-    uint32_t faults;       /* simulator faults (SKEL_FAULT_*) */
-    int32_t sent;          /* the slope TPDO1 last carried as an event; INT32_MIN: none */
+    uint32_t faults; /* simulator faults (SKEL_FAULT_*) */
+    int32_t sent;    /* the slope TPDO1 last carried as an event; INT32_MIN: none */
 } skel_dev_t;
 
 /* The product (registry row) and its node config (its MCU image fixes it). */

@@ -40,8 +40,8 @@
 #include "co_port.h"
 #include "flash_ee.h"
 #include "fuzz_format.h"
-#include "fuzz_products.h"
 #include "fuzz_input.h"
+#include "fuzz_products.h"
 #include "product.h"
 #include "product_registry.h"
 
@@ -57,15 +57,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static const char *g_product = "?";
 
-#define FZ_CHECK(cond, ...)                                                                  \
-    do {                                                                                     \
-        if (!(cond)) {                                                                       \
-            fprintf(stderr, "fuzz invariant violated (%s, page %u x %u): ", g_product,     \
-                    g_flash.page, g_flash.pages);                                            \
-            fprintf(stderr, __VA_ARGS__);                                                    \
-            fprintf(stderr, "\n");                                                           \
-            abort();                                                                         \
-        }                                                                                    \
+#define FZ_CHECK(cond, ...)                                                                        \
+    do {                                                                                           \
+        if (!(cond)) {                                                                             \
+            fprintf(stderr, "fuzz invariant violated (%s, page %u x %u): ", g_product,             \
+                    g_flash.page, g_flash.pages);                                                  \
+            fprintf(stderr, __VA_ARGS__);                                                          \
+            fprintf(stderr, "\n");                                                                 \
+            abort();                                                                               \
+        }                                                                                          \
     } while (0)
 
 /* ---- the input ------------------------------------------------------- */
@@ -90,8 +90,8 @@ static uint32_t area_offset(uint32_t addr, uint32_t len, const char *what)
 {
     uint32_t lo = FLASH_BASE + g_flash.page;
     uint32_t hi = lo + g_flash.pages * g_flash.page;
-    FZ_CHECK(addr >= lo && addr <= hi && len <= hi - addr, "%s of %u bytes at %08X outside the pages",
-             what, len, addr);
+    FZ_CHECK(addr >= lo && addr <= hi && len <= hi - addr,
+             "%s of %u bytes at %08X outside the pages", what, len, addr);
     return addr - FLASH_BASE;
 }
 
@@ -149,7 +149,8 @@ static void sim_read(void *ctx, uint32_t addr, void *buf, uint32_t len)
     memcpy(buf, &g_flash.mem[area_offset(addr, len, "read")], len);
 }
 
-static const flash_ops_t sim_ops = {.erase = sim_erase, .program16 = sim_program16, .read = sim_read};
+static const flash_ops_t sim_ops = {
+    .erase = sim_erase, .program16 = sim_program16, .read = sim_read};
 static flash_ee_t g_fe = {.ops = &sim_ops, .ctx = NULL};
 
 /* ---- the device ------------------------------------------------------------ */
@@ -386,8 +387,8 @@ static void store_with_cuts(fz_t *in, bool every)
         boot(&g_dev); /* power back */
         ram_sets(&g_dev, now);
         char what[80];
-        snprintf(what, sizeof(what), "after a power cut at flash step %u of %u, neither old nor new",
-                 c, total);
+        snprintf(what, sizeof(what),
+                 "after a power cut at flash step %u of %u, neither old nor new", c, total);
         compare_sets(now, old, new_, what);
     }
     /* Go on from the completed store. */
@@ -428,8 +429,8 @@ static void api(fz_t *in)
     uint32_t size = flash_ee_size(&g_fe);
     if ((kind & 1u) == 0u) {
         bool ok = flash_ee_read(&g_fe, addr, buf, len);
-        FZ_CHECK(len == 0u || ok == (addr + len <= size), "read of %u bytes at %u (size %u): %s", len,
-                 addr, size, ok ? "accepted" : "refused");
+        FZ_CHECK(len == 0u || ok == (addr + len <= size), "read of %u bytes at %u (size %u): %s",
+                 len, addr, size, ok ? "accepted" : "refused");
         return;
     }
     for (uint32_t i = 0; i < len; i++) {

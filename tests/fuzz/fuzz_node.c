@@ -59,8 +59,8 @@
 #include "co_node.h"
 #include "co_port.h"
 #include "fuzz_format.h"
-#include "fuzz_products.h"
 #include "fuzz_input.h"
+#include "fuzz_products.h"
 #include "product.h"
 #include "product_registry.h"
 #include "sdo_internal.h"
@@ -83,14 +83,14 @@ static int g_trace;
 static const char *g_product = "?";
 static unsigned g_op;
 
-#define FZ_CHECK(cond, ...)                                                                 \
-    do {                                                                                    \
-        if (!(cond)) {                                                                      \
-            fprintf(stderr, "fuzz invariant violated (%s, op %u): ", g_product, g_op);     \
-            fprintf(stderr, __VA_ARGS__);                                                   \
-            fprintf(stderr, "\n");                                                          \
-            abort();                                                                        \
-        }                                                                                   \
+#define FZ_CHECK(cond, ...)                                                                        \
+    do {                                                                                           \
+        if (!(cond)) {                                                                             \
+            fprintf(stderr, "fuzz invariant violated (%s, op %u): ", g_product, g_op);             \
+            fprintf(stderr, __VA_ARGS__);                                                          \
+            fprintf(stderr, "\n");                                                                 \
+            abort();                                                                               \
+        }                                                                                          \
     } while (0)
 
 /* ---- the input -------------------------------------------------------- */
@@ -103,22 +103,22 @@ typedef struct dev dev_t;
 
 typedef struct port {
     dev_t *dev;
-    unsigned k;    /* the node it serves */
-    bool tx_full;  /* the transmit queue refuses frames */
+    unsigned k;   /* the node it serves */
+    bool tx_full; /* the transmit queue refuses frames */
 } port_t;
 
 /* What the invariants remember of one node. */
 typedef struct watch {
-    bool bootup;          /* a boot-up was sent: check invariant 2 */
-    bool in_guard_rtr;    /* a guard request is being handled */
-    bool guard_answered;  /* some guard request was answered since power-on */
-    bool guard_lost;      /* the guard event was active at the last look */
-    uint64_t guard_at;    /* time of the last answered guard request */
-    uint64_t guard_life;  /* the shortest non-zero guard time x life factor since (us) */
-    uint64_t bound;       /* longest timer configured since power-on (us) */
-    unsigned sdo_count;   /* SDO responses during the current frame */
-    co_frame_t sdo_last;  /* the last of them */
-    unsigned zero_polls;  /* polls in a row that asked to be called again at once */
+    bool bootup;         /* a boot-up was sent: check invariant 2 */
+    bool in_guard_rtr;   /* a guard request is being handled */
+    bool guard_answered; /* some guard request was answered since power-on */
+    bool guard_lost;     /* the guard event was active at the last look */
+    uint64_t guard_at;   /* time of the last answered guard request */
+    uint64_t guard_life; /* the shortest non-zero guard time x life factor since (us) */
+    uint64_t bound;      /* longest timer configured since power-on (us) */
+    unsigned sdo_count;  /* SDO responses during the current frame */
+    co_frame_t sdo_last; /* the last of them */
+    unsigned zero_polls; /* polls in a row that asked to be called again at once */
 } watch_t;
 
 struct dev {
@@ -129,12 +129,12 @@ struct dev {
     port_t port[PRODUCT_MAX_NODES];
     watch_t w[PRODUCT_MAX_NODES];
     uint8_t nvm[NVM_SIZE];
-    long cut_after;       /* EEPROM bytes that may still be written; -1: no cut */
-    bool cut_hit;         /* a write was refused: the power is gone */
+    long cut_after; /* EEPROM bytes that may still be written; -1: no cut */
+    bool cut_hit;   /* a write was refused: the power is gone */
     bool nvm_read_fails;
-    bool scratch;         /* a device booted only to see what a restore gives */
-    bool checking;        /* check_alive's own read is being delivered */
-    uint64_t now;         /* virtual time, us (the node sees the low 32 bits) */
+    bool scratch;  /* a device booted only to see what a restore gives */
+    bool checking; /* check_alive's own read is being delivered */
+    uint64_t now;  /* virtual time, us (the node sees the low 32 bits) */
     uint64_t next_sample;
     unsigned polls, samples;
     int32_t truth[PRODUCT_MAX_INPUTS];
@@ -241,8 +241,8 @@ static void check_frame(dev_t *d, unsigned k, const co_frame_t *f)
     bool ec = id_ok && f->id == 0x700u + n->node_id;
     bool lss = co_cfg(n)->lss && f->id == 0x7E4u;
     FZ_CHECK(id_ok || lss, "frame %03X from a node without node-ID (%02X)", f->id, n->node_id);
-    FZ_CHECK(!restricted(f->id) || sdo || ec || lss,
-             "frame on restricted COB-ID %03X (node-ID %u)", f->id, n->node_id);
+    FZ_CHECK(!restricted(f->id) || sdo || ec || lss, "frame on restricted COB-ID %03X (node-ID %u)",
+             f->id, n->node_id);
     if (sdo) {
         FZ_CHECK(f->dlc == 8u, "SDO response with DLC %u", f->dlc);
         w->sdo_count++;
@@ -296,7 +296,8 @@ bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
     dev_t *d = p->dev;
     /* Invariant 7: node k's records live in [k, k + 1) x CO_STORE_NVM_SIZE. */
     uint32_t base = p->k * CO_STORE_NVM_SIZE;
-    FZ_CHECK(addr >= base && addr <= base + CO_STORE_NVM_SIZE && len <= base + CO_STORE_NVM_SIZE - addr,
+    FZ_CHECK(addr >= base && addr <= base + CO_STORE_NVM_SIZE &&
+                 len <= base + CO_STORE_NVM_SIZE - addr,
              "node %u writes EEPROM bytes %u..%u outside its area", p->k, addr, addr + len);
     const uint8_t *b = buf;
     for (uint32_t i = 0; i < len; i++) {
@@ -438,7 +439,8 @@ static const co_od_entry_t *expedited_write(co_node_t *n, const co_frame_t *f)
 static void check_read_back(dev_t *d, unsigned k, const co_od_entry_t *e, const co_frame_t *f)
 {
     const co_frame_t *r = &d->w[k].sdo_last;
-    if (d->w[k].sdo_count != 1u || r->data[0] != 0x60u || memcmp(&r->data[1], &f->data[1], 3) != 0) {
+    if (d->w[k].sdo_count != 1u || r->data[0] != 0x60u ||
+        memcmp(&r->data[1], &f->data[1], 3) != 0) {
         return; /* refused (or not answered: invariant 5) */
     }
     uint32_t mask = e->size >= 4u ? 0xFFFFFFFFu : (1u << (8u * e->size)) - 1u;
@@ -495,19 +497,21 @@ static void check_alive(dev_t *d, unsigned k)
     }
     bool full = d->port[k].tx_full;
     d->port[k].tx_full = false;
-    co_frame_t f = {.id = (uint16_t)(0x600u + n->node_id), .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}};
+    co_frame_t f = {
+        .id = (uint16_t)(0x600u + n->node_id), .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}};
     d->checking = true; /* the other nodes' checks come after this one */
     deliver(d, &f);
     d->checking = false;
     d->port[k].tx_full = full;
     const co_frame_t *r = &d->w[k].sdo_last;
     uint32_t devtype = od_value(n, 0x1000, 0);
-    FZ_CHECK(d->w[k].sdo_count == 1u && r->data[0] == 0x43u && r->data[1] == 0x00u &&
-                 r->data[2] == 0x10u && r->data[3] == 0x00u && co_get_u32(&r->data[4]) == devtype,
-             "after a boot-up node-ID %u does not answer a read of 0x1000 (%u answers, last %02X %02X "
-             "%02X %02X %08X)",
-             n->node_id, d->w[k].sdo_count, r->data[0], r->data[1], r->data[2], r->data[3],
-             co_get_u32(&r->data[4]));
+    FZ_CHECK(
+        d->w[k].sdo_count == 1u && r->data[0] == 0x43u && r->data[1] == 0x00u &&
+            r->data[2] == 0x10u && r->data[3] == 0x00u && co_get_u32(&r->data[4]) == devtype,
+        "after a boot-up node-ID %u does not answer a read of 0x1000 (%u answers, last %02X %02X "
+        "%02X %02X %08X)",
+        n->node_id, d->w[k].sdo_count, r->data[0], r->data[1], r->data[2], r->data[3],
+        co_get_u32(&r->data[4]));
 }
 
 static void sample(dev_t *d)
@@ -558,7 +562,8 @@ static void power_cycle(dev_t *d)
 static void advance(dev_t *d, uint64_t us, bool sampled)
 {
     if (g_trace) {
-        fprintf(stderr, "advance %llu us%s\n", (unsigned long long)us, sampled ? "" : " (no samples)");
+        fprintf(stderr, "advance %llu us%s\n", (unsigned long long)us,
+                sampled ? "" : " (no samples)");
     }
     uint64_t end = d->now + us;
     for (;;) {
@@ -655,8 +660,9 @@ static void check_sets_after_cut(dev_t *d, sets_t old, sets_t new_)
                 dump("old", old[k][c], len);
                 dump("new", new_[k][c], len);
                 dump("now", now, len);
-                FZ_CHECK(false, "node %u class %s after a power cut is neither the old nor the new set",
-                         k, c == 0u ? "PARA" : "LSS");
+                FZ_CHECK(false,
+                         "node %u class %s after a power cut is neither the old nor the new set", k,
+                         c == 0u ? "PARA" : "LSS");
             }
         }
     }
@@ -767,12 +773,14 @@ static target_t pick_target(fz_t *in, co_node_t *n)
 
 static uint32_t pick_value(fz_t *in, co_node_t *n, const co_od_entry_t *e)
 {
-    static const uint32_t extremes[16] = {0u, 1u, 0x7Fu, 0x80u, 0xFFu, 0x100u, 0x7FFFu, 0x8000u,
-                                          0xFFFFu, 0x10000u, 0x7FFFFFFFu, 0x80000000u,
+    static const uint32_t extremes[16] = {0u,          1u,          0x7Fu,       0x80u,
+                                          0xFFu,       0x100u,      0x7FFFu,     0x8000u,
+                                          0xFFFFu,     0x10000u,    0x7FFFFFFFu, 0x80000000u,
                                           0xFFFFFFFFu, 0xFFFFFFFEu, 0x40000000u, 0x20000000u};
     static const uint32_t signatures[4] = {CO_SIG_SAVE, CO_SIG_LOAD, 0x55AAAA55u, 0u};
-    static const uint16_t bases[17] = {0x000, 0x080, 0x100, 0x180, 0x200, 0x280, 0x300, 0x380, 0x400,
-                                       0x480, 0x500, 0x580, 0x600, 0x6E0, 0x700, 0x7E4, 0x7E5};
+    static const uint16_t bases[17] = {0x000, 0x080, 0x100, 0x180, 0x200, 0x280,
+                                       0x300, 0x380, 0x400, 0x480, 0x500, 0x580,
+                                       0x600, 0x6E0, 0x700, 0x7E4, 0x7E5};
     uint8_t s = u8(in);
     bool numeric = e != NULL && e->type != CO_T_VSTR;
     switch (s % FZ_VAL_COUNT) {
@@ -913,7 +921,8 @@ static void gen_sdo_seg_write(fz_t *in, co_node_t *n, flist_t *l)
     bool sized = (sizes & 1u) == 0u;
     f->data[0] = sized ? 0x21u : 0x20u;
     put_mux(f, &t);
-    co_put_u32(&f->data[4], (sizes & 0x80u) != 0u ? sizes : len); /* the indicated size, maybe wrong */
+    co_put_u32(&f->data[4],
+               (sizes & 0x80u) != 0u ? sizes : len); /* the indicated size, maybe wrong */
     unsigned toggle = 0;
     unsigned pos = 0;
     do {
@@ -1012,7 +1021,8 @@ static void gen_sdo_blk_read(fz_t *in, co_node_t *n, flist_t *l)
         uint8_t next = u8(in);
         co_frame_t *a = add(l, sdo_id(n), 8);
         a->data[0] = 0xA2;
-        a->data[1] = (ack & 0x80u) != 0u ? (uint8_t)(ack & 0x7Fu) : (uint8_t)(segs < f->data[4] ? segs : f->data[4]);
+        a->data[1] = (ack & 0x80u) != 0u ? (uint8_t)(ack & 0x7Fu)
+                                         : (uint8_t)(segs < f->data[4] ? segs : f->data[4]);
         a->data[2] = (next & 0x80u) != 0u ? next : (uint8_t)(next % 127u + 1u);
     }
     add(l, sdo_id(n), 8)->data[0] = (flags & 0x40u) != 0u ? u8(in) : 0xA1u; /* the client's end */
@@ -1059,7 +1069,8 @@ static void gen_sync(fz_t *in, co_node_t *n, flist_t *l)
 static void gen_guard_rtr(fz_t *in, co_node_t *n, flist_t *l)
 {
     uint8_t s = u8(in);
-    co_frame_t *f = add(l, 0x700u + n->node_id, (s & 0x80u) != 0u ? (uint8_t)(s % 9u) : (uint8_t)(s & 1u));
+    co_frame_t *f = add(l, 0x700u + n->node_id,
+                        (s & 0x80u) != 0u ? (uint8_t)(s % 9u) : (uint8_t)(s & 1u));
     f->rtr = true;
 }
 
@@ -1067,7 +1078,8 @@ static void gen_pdo_rtr(fz_t *in, co_node_t *n, flist_t *l)
 {
     uint8_t s = u8(in);
     unsigned j = s % (CO_TPDO_MAX + 2u);
-    uint32_t id = j < CO_TPDO_MAX ? n->tpdo[j].cob_id : 0x180u + 0x100u * (j - CO_TPDO_MAX) + n->node_id;
+    uint32_t id = j < CO_TPDO_MAX ? n->tpdo[j].cob_id
+                                  : 0x180u + 0x100u * (j - CO_TPDO_MAX) + n->node_id;
     co_frame_t *f = add(l, id, (uint8_t)((s >> 4) % 9u));
     f->rtr = true;
 }
@@ -1214,8 +1226,8 @@ static void gen_frame(fz_t *in, co_node_t *n, flist_t *l)
     uint8_t flags = u8(in);
     if ((flags & 0x80u) != 0u) {
         /* One of the node's own services' identifiers. */
-        const uint32_t own[7] = {0x000u, 0x080u, sdo_id(n), 0x700u + n->node_id, 0x7E5u,
-                                 n->sync.cob_id, n->tpdo[0].cob_id};
+        const uint32_t own[7] = {0x000u, 0x080u,         sdo_id(n),        0x700u + n->node_id,
+                                 0x7E5u, n->sync.cob_id, n->tpdo[0].cob_id};
         id = (uint16_t)own[id % 7u];
     }
     co_frame_t *f = add(l, id, (uint8_t)(((unsigned)flags >> 1) % 9u));

@@ -32,8 +32,10 @@ static inline void fz_products_init(fz_products_t *p)
     for (unsigned i = 0; i < FZ_PRODUCT_COUNT; i++) {
         const product_t *prod = product_find(ids[i]);
         if (prod == NULL) {
-            fprintf(stderr, "fuzz: the seeds' product %s is gone: update fuzz_format.h and "
-                            "rewrite the seeds (tools/fuzz --seeds)\n", ids[i]);
+            fprintf(stderr,
+                    "fuzz: the seeds' product %s is gone: update fuzz_format.h and "
+                    "rewrite the seeds (tools/fuzz --seeds)\n",
+                    ids[i]);
             abort();
         }
         p->order[p->count++] = prod;
@@ -45,7 +47,8 @@ static inline void fz_products_init(fz_products_t *p)
         }
         if (!seeded) {
             if (p->count == FZ_PRODUCTS_MAX) {
-                fprintf(stderr, "fuzz: more than %u products: raise FZ_PRODUCTS_MAX\n", FZ_PRODUCTS_MAX);
+                fprintf(stderr, "fuzz: more than %u products: raise FZ_PRODUCTS_MAX\n",
+                        FZ_PRODUCTS_MAX);
                 abort();
             }
             p->order[p->count++] = product_list[n];

@@ -465,7 +465,8 @@ static void node_seeds(void)
         b8(&s, 0);
         b8(&s, 0);
         b8(&s, 28);
-        hex(&s, "43 6F 50 53 DE AD BE EF 01 00 00 00 01 00 00 00 02 00 00 03 00 00 00 00 0A 03 FF FF");
+        hex(&s,
+            "43 6F 50 53 DE AD BE EF 01 00 00 00 01 00 00 00 02 00 00 03 00 00 00 00 0A 03 FF FF");
         sdo(&s, 0, "40 00 10 00 00 00 00 00");
         nmt(&s, 0);
         ms(&s, 200);
@@ -536,11 +537,11 @@ static void flash_seeds(void)
         unsigned product, page, pages, contents;
         const char *name;
     } cfg[] = {
-        {P_X730_XY30, 4, 3, 0, "dst-1k-erased"},      {P_X730_XY30, 4, 7, 2, "dst-1k-records"},
-        {P_X710_XY10, 2, 3, 0, "dst-256-erased"},     {P_JD2, 5, 3, 0, "jd2-2k-erased"},
-        {P_JD2, 6, 9, 3, "jd2-4k-zeros"},             {P_INX, 4, 3, 2, "inx-1k-records"},
-        {P_GSH_RED, 4, 7, 0, "gsh-red-1k-erased"},    {P_GSH_RED, 2, 7, 2, "gsh-red-256-records"},
-        {P_JD1, 1, 3, 0, "jd1-128-too-small"},        {P_X730_Z360, 0, 3, 0, "dst-64-too-small"},
+        {P_X730_XY30, 4, 3, 0, "dst-1k-erased"},   {P_X730_XY30, 4, 7, 2, "dst-1k-records"},
+        {P_X710_XY10, 2, 3, 0, "dst-256-erased"},  {P_JD2, 5, 3, 0, "jd2-2k-erased"},
+        {P_JD2, 6, 9, 3, "jd2-4k-zeros"},          {P_INX, 4, 3, 2, "inx-1k-records"},
+        {P_GSH_RED, 4, 7, 0, "gsh-red-1k-erased"}, {P_GSH_RED, 2, 7, 2, "gsh-red-256-records"},
+        {P_JD1, 1, 3, 0, "jd1-128-too-small"},     {P_X730_Z360, 0, 3, 0, "dst-64-too-small"},
     };
     for (unsigned i = 0; i < COUNT(cfg); i++) {
         s.n = 0;

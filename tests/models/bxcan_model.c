@@ -116,7 +116,7 @@ void bxcan_reset(void)
     memcpy(fr, can.fr, sizeof(fr));
     bool stuck = can.stuck;
     memset(&can, 0, sizeof(can));
-    can.stuck = stuck; /* the bus is not part of the chip */
+    can.stuck = stuck;     /* the bus is not part of the chip */
     can.mcr = 0x00010002u; /* DBF, SLEEP */
     can.mode = STM_CAN_SLEEP;
     can.target = STM_CAN_SLEEP;
@@ -155,7 +155,8 @@ static void errors_changed(void)
 {
     uint32_t now = esr_flags();
     uint32_t rising = now & ~can.esr_seen;
-    uint32_t enabled = ((can.ier & IER_EWGIE) != 0u ? 1u : 0u) | ((can.ier & IER_EPVIE) != 0u ? 2u : 0u) |
+    uint32_t enabled = ((can.ier & IER_EWGIE) != 0u ? 1u : 0u) |
+                       ((can.ier & IER_EPVIE) != 0u ? 2u : 0u) |
                        ((can.ier & IER_BOFIE) != 0u ? 4u : 0u);
     if ((rising & enabled) != 0u) {
         can.msr_flags |= MSR_ERRI;
@@ -287,8 +288,9 @@ static int next_mailbox(void)
         }
         if (best < 0) {
             best = i;
-        } else if ((can.mcr & MCR_TXFP) != 0u ? can.tx[i].order < can.tx[best].order
-                                              : arbitration(can.tx[i].tir) < arbitration(can.tx[best].tir)) {
+        } else if ((can.mcr & MCR_TXFP) != 0u
+                       ? can.tx[i].order < can.tx[best].order
+                       : arbitration(can.tx[i].tir) < arbitration(can.tx[best].tir)) {
             best = i;
         }
     }
@@ -560,8 +562,8 @@ uint32_t bxcan_read(uint32_t off, bool peek)
         unsigned f = (off - 0x1B0u) / 0x10u;
         const fifo_t *q = &can.fifo[f];
         if (q->count == 0u && !peek) {
-            stm_violation("CAN: read of FIFO %u's output mailbox (offset 0x%03X) while it is empty", f,
-                          (unsigned)off);
+            stm_violation("CAN: read of FIFO %u's output mailbox (offset 0x%03X) while it is empty",
+                          f, (unsigned)off);
         }
         const rx_msg_t *m = &q->msg[0];
         const uint32_t regs[4] = {m->rir, m->rdtr, m->rdlr, m->rdhr};
@@ -577,8 +579,9 @@ uint32_t bxcan_read(uint32_t off, bool peek)
         if (!peek) {
             msr_tick();
         }
-        return (can.mode == STM_CAN_INIT ? MSR_INAK : 0u) | (can.mode == STM_CAN_SLEEP ? MSR_SLAK : 0u) |
-               can.msr_flags | (can.stuck ? 0u : (1u << 11)) /* RX: the bus level */;
+        return (can.mode == STM_CAN_INIT ? MSR_INAK : 0u) |
+               (can.mode == STM_CAN_SLEEP ? MSR_SLAK : 0u) | can.msr_flags |
+               (can.stuck ? 0u : (1u << 11)) /* RX: the bus level */;
     case 0x008u:
         return tsr_value();
     case 0x00Cu:
@@ -644,7 +647,8 @@ static void write_mailbox(unsigned i, unsigned reg, uint32_t v)
 static void write_filter_config(uint32_t *reg, const char *name, uint32_t v)
 {
     if ((can.fmr & 1u) == 0u) {
-        stm_violation("CAN_%s written while FINIT is clear (filter initialization mode needed)", name);
+        stm_violation("CAN_%s written while FINIT is clear (filter initialization mode needed)",
+                      name);
         return;
     }
     if ((v & ~BANK_MASK) != 0u) {
@@ -652,7 +656,8 @@ static void write_filter_config(uint32_t *reg, const char *name, uint32_t v)
     }
     uint32_t changed = (v ^ *reg) & can.fa1r & BANK_MASK;
     if (changed != 0u) {
-        stm_violation("CAN_%s: banks 0x%04X reconfigured while active (FACT set)", name, (unsigned)changed);
+        stm_violation("CAN_%s: banks 0x%04X reconfigured while active (FACT set)", name,
+                      (unsigned)changed);
     }
     *reg = v & BANK_MASK;
 }
@@ -664,7 +669,8 @@ void bxcan_write(uint32_t off, uint32_t v)
         return;
     }
     if (off >= 0x1B0u && off < 0x1D0u) {
-        stm_violation("CAN: write of receive mailbox register at 0x%03X (read-only)", (unsigned)off);
+        stm_violation("CAN: write of receive mailbox register at 0x%03X (read-only)",
+                      (unsigned)off);
         return;
     }
     if (off >= 0x240u && off < 0x240u + 8u * BANKS) {
@@ -718,8 +724,8 @@ void bxcan_write(uint32_t off, uint32_t v)
             q->count--;
         }
         if ((v & ~0x38u) != 0u) {
-            stm_violation("CAN_RF%uR: read-only or reserved bits written 0x%08X", (unsigned)(off - 0x00Cu) / 4u,
-                          (unsigned)v);
+            stm_violation("CAN_RF%uR: read-only or reserved bits written 0x%08X",
+                          (unsigned)(off - 0x00Cu) / 4u, (unsigned)v);
         }
         break;
     }
@@ -741,7 +747,8 @@ void bxcan_write(uint32_t off, uint32_t v)
         break;
     case 0x200u:
         if ((v & ~1u) != (FMR_RESET & ~1u)) {
-            stm_violation("CAN_FMR: reserved bits not kept at their reset value (0x%08X)", (unsigned)v);
+            stm_violation("CAN_FMR: reserved bits not kept at their reset value (0x%08X)",
+                          (unsigned)v);
         }
         can.fmr = (FMR_RESET & ~1u) | (v & 1u);
         break;

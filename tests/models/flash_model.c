@@ -189,7 +189,8 @@ uint32_t flash_reg_read(uint32_t off, bool peek)
         return fl.wrpr;
     default:
         if (!peek) {
-            stm_violation("FLASH: read of write-only or unmodelled register at offset 0x%02X", (unsigned)off);
+            stm_violation("FLASH: read of write-only or unmodelled register at offset 0x%02X",
+                          (unsigned)off);
         }
         return 0;
     }
@@ -202,7 +203,8 @@ static void write_cr(uint32_t v)
         return;
     }
     if ((fl.sr & SR_BSY) != 0u) {
-        stm_violation("FLASH_CR written while BSY (0x%08X): the procedure waits for BSY to clear", (unsigned)v);
+        stm_violation("FLASH_CR written while BSY (0x%08X): the procedure waits for BSY to clear",
+                      (unsigned)v);
     }
     if ((v & CR_PG) != 0u && (v & (CR_PER | CR_MER)) != 0u) {
         stm_violation("FLASH_CR: programming and erase selected together (0x%08X)", (unsigned)v);
@@ -238,11 +240,13 @@ void flash_reg_write(uint32_t off, uint32_t v)
     switch (off) {
     case 0x04u:
         if (fl.locked_out) {
-            stm_violation("FLASH_KEYR written after a wrong key sequence: bus error (HardFault), locked until reset");
+            stm_violation("FLASH_KEYR written after a wrong key sequence: bus error (HardFault), "
+                          "locked until reset");
             return;
         }
         if ((fl.cr & CR_LOCK) == 0u) {
-            stm_violation("FLASH_KEYR written while unlocked: a wrong sequence, bus error (HardFault)");
+            stm_violation(
+                "FLASH_KEYR written while unlocked: a wrong sequence, bus error (HardFault)");
             fl.locked_out = true;
             fl.cr |= CR_LOCK;
             return;
@@ -253,7 +257,8 @@ void flash_reg_write(uint32_t off, uint32_t v)
             fl.key_step = 0;
             fl.cr &= ~CR_LOCK;
         } else {
-            stm_violation("FLASH_KEYR: wrong key sequence (0x%08X): bus error (HardFault), locked until reset",
+            stm_violation("FLASH_KEYR: wrong key sequence (0x%08X): bus error (HardFault), locked "
+                          "until reset",
                           (unsigned)v);
             fl.key_step = 0;
             fl.locked_out = true;
@@ -273,7 +278,8 @@ void flash_reg_write(uint32_t off, uint32_t v)
         fl.ar = v;
         break;
     default:
-        stm_violation("FLASH: write of read-only or unmodelled register at offset 0x%02X", (unsigned)off);
+        stm_violation("FLASH: write of read-only or unmodelled register at offset 0x%02X",
+                      (unsigned)off);
         break;
     }
 }
@@ -297,12 +303,13 @@ uint32_t flash_mem_read(uint32_t off, unsigned size)
 void flash_mem_write(uint32_t off, uint32_t v, unsigned size)
 {
     if ((fl.cr & CR_PG) == 0u) {
-        stm_violation("FLASH: write to flash memory at offset 0x%05X without PG: bus error", (unsigned)off);
+        stm_violation("FLASH: write to flash memory at offset 0x%05X without PG: bus error",
+                      (unsigned)off);
         return;
     }
     if (size != 2u || (off & 1u) != 0u) {
-        stm_violation("FLASH: %u-byte write at offset 0x%05X: programming is by aligned half-words", size,
-                      (unsigned)off);
+        stm_violation("FLASH: %u-byte write at offset 0x%05X: programming is by aligned half-words",
+                      size, (unsigned)off);
         return;
     }
     if ((fl.sr & SR_BSY) != 0u) {
@@ -315,7 +322,8 @@ void flash_mem_write(uint32_t off, uint32_t v, unsigned size)
     }
     uint16_t now = (uint16_t)(fl.mem[off] | (fl.mem[off + 1u] << 8));
     if (now != 0xFFFFu && v != 0u) {
-        stm_violation("FLASH: programming 0x%04X over a half-word that is not erased (0x%04X) at offset 0x%05X",
+        stm_violation("FLASH: programming 0x%04X over a half-word that is not erased (0x%04X) at "
+                      "offset 0x%05X",
                       (unsigned)v, now, (unsigned)off);
         fl.sr |= SR_PGERR;
         return;

@@ -21,7 +21,7 @@
 #define A_EWLR 13u
 #define A_RXERR 14u
 #define A_TXERR 15u
-#define A_BUF 16u  /* 16..28: ACR/AMR (reset mode), TX buffer / RX window (operating) */
+#define A_BUF 16u /* 16..28: ACR/AMR (reset mode), TX buffer / RX window (operating) */
 #define A_RMC 29u
 #define A_RBSA 30u
 #define A_CDR 31u
@@ -57,8 +57,7 @@
 #define CDR_RESET_ONLY 0xE8u
 #define CDR_PELICAN 0x80u
 
-__attribute__((format(printf, 2, 3))) static void violation(sja_model_t *m, const char *fmt,
-                                                                ...)
+__attribute__((format(printf, 2, 3))) static void violation(sja_model_t *m, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -458,8 +457,7 @@ static void fifo_put(sja_model_t *m, uint8_t b)
     m->rx_bytes++;
 }
 
-bool sja_model_rx(sja_model_t *m, uint32_t id, bool ext, bool rtr, uint8_t dlc,
-                  const uint8_t *data)
+bool sja_model_rx(sja_model_t *m, uint32_t id, bool ext, bool rtr, uint8_t dlc, const uint8_t *data)
 {
     if (m->absent || !pelican(m) || in_reset(m) || m->bs) {
         return false; /* not on the bus */

@@ -66,10 +66,10 @@
 
 /* One frame the controller put on the bus. */
 typedef struct sja_model_sent {
-    uint32_t id;      /* 11 or 29 bits */
-    bool ext;         /* FI.FF */
-    bool rtr;         /* FI.RTR */
-    uint8_t dlc;      /* FI's DLC field as written (0..15) */
+    uint32_t id; /* 11 or 29 bits */
+    bool ext;    /* FI.FF */
+    bool rtr;    /* FI.RTR */
+    uint8_t dlc; /* FI's DLC field as written (0..15) */
     uint8_t data[8];
 } sja_model_sent_t;
 
@@ -84,8 +84,8 @@ typedef struct sja_model {
     bool basic_echo;      /* with basic_only: address 16 reads back what was
                            * last written to it (a BasicCAN buffer byte) */
     uint8_t basic16;
-    unsigned mode_lag;    /* a slow part: writes of MOD asking for another mode
-                           * (RM set or cleared) it ignores before it takes one */
+    unsigned mode_lag; /* a slow part: writes of MOD asking for another mode
+                        * (RM set or cleared) it ignores before it takes one */
 
     /* Registers (PeliCAN). */
     uint8_t mod, ier, btr0, btr1, ocr, ewlr, rxerr, txerr, cdr, rbsa;
@@ -103,10 +103,10 @@ typedef struct sja_model {
     /* What the model records. */
     sja_model_sent_t sent[SJA_MODEL_SENT_MAX];
     unsigned nsent;
-    unsigned taken;          /* sent[] entries the test has looked at (sja_model_next) */
-    unsigned reset_entries;  /* reset mode entered by a CPU write of MOD */
-    unsigned aborts;         /* transmissions aborted (CMR.AT) */
-    unsigned lost;           /* messages that did not fit into the FIFO */
+    unsigned taken;         /* sent[] entries the test has looked at (sja_model_next) */
+    unsigned reset_entries; /* reset mode entered by a CPU write of MOD */
+    unsigned aborts;        /* transmissions aborted (CMR.AT) */
+    unsigned lost;          /* messages that did not fit into the FIFO */
     unsigned reads, writes;
     unsigned violations;
     char last_violation[160];

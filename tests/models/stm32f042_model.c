@@ -20,8 +20,8 @@
 #define LOG_TEXT 200u
 
 static char vlog[LOG_MAX][LOG_TEXT];
-static unsigned vcount;    /* entries in vlog */
-static unsigned vdropped;  /* recorded beyond LOG_MAX (never taken) */
+static unsigned vcount;   /* entries in vlog */
+static unsigned vdropped; /* recorded beyond LOG_MAX (never taken) */
 
 void stm_violation(const char *fmt, ...)
 {
@@ -92,8 +92,9 @@ static void spin_check(uint32_t addr, uint32_t v)
     if (++spin_count < STM_SPIN_LIMIT) {
         return;
     }
-    stm_violation("hang: %u register reads and nothing written or changed (the last: 0x%08X = 0x%08X)",
-                  STM_SPIN_LIMIT, (unsigned)addr, (unsigned)v);
+    stm_violation(
+        "hang: %u register reads and nothing written or changed (the last: 0x%08X = 0x%08X)",
+        STM_SPIN_LIMIT, (unsigned)addr, (unsigned)v);
     spin_count = 0;
     if (hang_exit != NULL) {
         longjmp(*hang_exit, 1);
@@ -164,8 +165,9 @@ uint32_t stm_apb_hz(void)
 static void check_wait_states(void)
 {
     if (sysclk_hz() > 24000000u && (rcc.acr & 7u) == 0u) {
-        stm_violation("FLASH_ACR: zero wait states with SYSCLK at %u Hz (one is needed above 24 MHz)",
-                      (unsigned)sysclk_hz());
+        stm_violation(
+            "FLASH_ACR: zero wait states with SYSCLK at %u Hz (one is needed above 24 MHz)",
+            (unsigned)sysclk_hz());
     }
 }
 

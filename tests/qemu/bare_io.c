@@ -115,8 +115,9 @@ static void format(sink_t *s, const char *fmt, va_list ap)
         switch (*fmt) {
         case 'd':
         case 'i': {
-            long long v = longs == 2 ? va_arg(ap, long long)
-                          : longs == 1 ? va_arg(ap, long) : va_arg(ap, int);
+            long long v = longs == 2   ? va_arg(ap, long long)
+                          : longs == 1 ? va_arg(ap, long)
+                                       : va_arg(ap, int);
             neg = v < 0;
             u = neg ? 0ull - (unsigned long long)v : (unsigned long long)v;
             break;
@@ -124,8 +125,9 @@ static void format(sink_t *s, const char *fmt, va_list ap)
         case 'u':
         case 'x':
         case 'X':
-            u = longs == 2 ? va_arg(ap, unsigned long long)
-                : longs == 1 ? va_arg(ap, unsigned long) : va_arg(ap, unsigned);
+            u = longs == 2   ? va_arg(ap, unsigned long long)
+                : longs == 1 ? va_arg(ap, unsigned long)
+                             : va_arg(ap, unsigned);
             base = *fmt == 'u' ? 10u : 16u;
             break;
         case 'c':

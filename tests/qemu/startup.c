@@ -70,8 +70,8 @@ typedef void (*vector_t)(void);
 __attribute__((section(".isr_vector"), used)) static const vector_t vectors[16] = {
     (vector_t)(uintptr_t)&_estack, /* initial stack pointer */
     reset_handler,
-    fault_handler, /* NMI */
-    fault_handler, /* HardFault */
+    fault_handler,        /* NMI */
+    fault_handler,        /* HardFault */
     [11] = fault_handler, /* SVCall */
     [14] = fault_handler, /* PendSV */
     [15] = fault_handler, /* SysTick: never enabled */

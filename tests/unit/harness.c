@@ -35,8 +35,10 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
     if (p->ntx - p->rd >= FAKE_TX_MAX) {
         /* The oldest unread frame would be overwritten: a harness limit. */
         h_failures++;
-        fprintf(stderr, "fake port: more than %u frames sent and not read; "
-                        "drain in the test or raise FAKE_TX_MAX\n", FAKE_TX_MAX);
+        fprintf(stderr,
+                "fake port: more than %u frames sent and not read; "
+                "drain in the test or raise FAKE_TX_MAX\n",
+                FAKE_TX_MAX);
         p->rd++;
     }
     p->tx[p->ntx++ % FAKE_TX_MAX] = *frame;
@@ -161,7 +163,8 @@ void h_advance(h_dev_t *d, uint32_t us)
         for (unsigned i = 0; i < d->nnodes; i++) {
             delay = co_min_u32(delay, co_node_poll(d->nodes[i], d->now));
         }
-        uint32_t step = co_min_u32(co_time_until(d->now, end), co_time_until(d->now, d->next_sample));
+        uint32_t step = co_min_u32(co_time_until(d->now, end),
+                                   co_time_until(d->now, d->next_sample));
         step = co_min_u32(step, delay);
         if (step == 0u && !co_time_before(d->now, d->next_sample)) {
             d->prod->sample(d->mem, d->truth, d->fault);
@@ -268,7 +271,8 @@ void h_sdo(h_dev_t *d, const char *req, const char *resp, const char *file, int 
 long long h_read(h_dev_t *d, uint16_t index, uint8_t sub)
 {
     h_drain(d);
-    co_frame_t f = {.id = (uint16_t)(0x600u + d->node->node_id), .dlc = 8,
+    co_frame_t f = {.id = (uint16_t)(0x600u + d->node->node_id),
+                    .dlc = 8,
                     .data = {0x40, (uint8_t)index, (uint8_t)(index >> 8), sub}};
     h_rx_frame(d, &f);
     const co_frame_t *r;

@@ -22,32 +22,32 @@
 extern int h_failures;
 extern int h_checks;
 
-#define CHECK(cond)                                                                     \
-    do {                                                                                \
-        h_checks++;                                                                     \
-        if (!(cond)) {                                                                  \
-            h_failures++;                                                               \
-            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond);    \
-        }                                                                               \
+#define CHECK(cond)                                                                                \
+    do {                                                                                           \
+        h_checks++;                                                                                \
+        if (!(cond)) {                                                                             \
+            h_failures++;                                                                          \
+            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond);               \
+        }                                                                                          \
     } while (0)
 
 /* A check that fails where it is reached (a path that must not be taken), saying why. */
-#define FAIL(why)                                                                       \
-    do {                                                                                \
-        h_checks++;                                                                     \
-        h_failures++;                                                                   \
-        fprintf(stderr, "%s:%d: FAIL: %s\n", __FILE__, __LINE__, why);                  \
+#define FAIL(why)                                                                                  \
+    do {                                                                                           \
+        h_checks++;                                                                                \
+        h_failures++;                                                                              \
+        fprintf(stderr, "%s:%d: FAIL: %s\n", __FILE__, __LINE__, why);                             \
     } while (0)
 
-#define CHECK_EQ(a, b)                                                                  \
-    do {                                                                                \
-        long long a_ = (long long)(a), b_ = (long long)(b);                             \
-        h_checks++;                                                                     \
-        if (a_ != b_) {                                                                 \
-            h_failures++;                                                               \
-            fprintf(stderr, "%s:%d: %s == %lld, expected %s == %lld\n", __FILE__,       \
-                    __LINE__, #a, a_, #b, b_);                                          \
-        }                                                                               \
+#define CHECK_EQ(a, b)                                                                             \
+    do {                                                                                           \
+        long long a_ = (long long)(a), b_ = (long long)(b);                                        \
+        h_checks++;                                                                                \
+        if (a_ != b_) {                                                                            \
+            h_failures++;                                                                          \
+            fprintf(stderr, "%s:%d: %s == %lld, expected %s == %lld\n", __FILE__, __LINE__, #a,    \
+                    a_, #b, b_);                                                                   \
+        }                                                                                          \
     } while (0)
 
 /*
@@ -102,16 +102,16 @@ extern unsigned h_tx_high_water;
 
 typedef struct fake_port {
     co_frame_t tx[FAKE_TX_MAX]; /* ring of sent frames, index = count % FAKE_TX_MAX */
-    unsigned ntx;      /* frames sent */
-    unsigned rd;       /* frames consumed by h_next() */
-    bool tx_full;      /* co_port_can_send() refuses */
+    unsigned ntx;               /* frames sent */
+    unsigned rd;                /* frames consumed by h_next() */
+    bool tx_full;               /* co_port_can_send() refuses */
     uint8_t nvm[FAKE_NVM_SIZE];
-    long cut_after;    /* bytes that may still be written; -1 = no power cut */
+    long cut_after; /* bytes that may still be written; -1 = no power cut */
     unsigned nvm_writes;
     bool nvm_read_fails;
-    long reads_left;   /* NVM reads that still succeed; -1 = all (a read fault after that) */
+    long reads_left;      /* NVM reads that still succeed; -1 = all (a read fault after that) */
     unsigned read_faults; /* reads refused because reads_left ran out */
-    uint16_t kbps;     /* last co_port_can_bitrate() */
+    uint16_t kbps;        /* last co_port_can_bitrate() */
     unsigned bitrate_calls;
 } fake_port_t;
 
@@ -122,13 +122,13 @@ typedef struct h_dev {
     _Alignas(max_align_t) unsigned char mem[H_INST_MAX];
     const product_t *prod;
     fake_port_t port;
-    co_node_t *node;       /* node 0 (SDO helpers talk to it) */
+    co_node_t *node; /* node 0 (SDO helpers talk to it) */
     co_node_t *nodes[PRODUCT_MAX_NODES];
     unsigned nnodes;
-    uint32_t now;          /* virtual time, us */
-    uint32_t next_sample;  /* time of the next sensor sample */
-    int32_t truth[PRODUCT_MAX_INPUTS]; /* true inputs, milli-units */
-    uint32_t fault; /* bit i: the product's fault i */
+    uint32_t now;                          /* virtual time, us */
+    uint32_t next_sample;                  /* time of the next sensor sample */
+    int32_t truth[PRODUCT_MAX_INPUTS];     /* true inputs, milli-units */
+    uint32_t fault;                        /* bit i: the product's fault i */
     uint8_t factory_id[PRODUCT_MAX_NODES]; /* co_node_set_factory_id() at each boot; 0: none */
     uint32_t serial[PRODUCT_MAX_NODES];    /* co_node_set_serial() at each boot; 0: none */
 } h_dev_t;

@@ -170,41 +170,41 @@ int mcu_main_fixed(void); /* mcu_main_fixed.c: the X730 with the X710's fixed co
 #define TXQ_MAX 32u
 
 static struct board {
-    jmp_buf out;        /* where the endless loop is left */
+    jmp_buf out; /* where the endless loop is left */
     bool init_ok;
     bool bitrate_ok;
-    uint16_t kbps[4];   /* bit rates asked for */
+    uint16_t kbps[4]; /* bit rates asked for */
     unsigned nkbps;
     uint32_t now;
-    uint32_t end;       /* leave the loop once the clock gets here */
+    uint32_t end; /* leave the loop once the clock gets here */
     uint32_t max_sleep;
     unsigned sleeps;
     unsigned samples;
     uint32_t last_sample;
-    uint32_t max_gap;   /* longest time between two samples */
-    uint32_t min_gap;   /* shortest */
-    uint32_t x_change_at; /* x reads 20 deg from here on (relative to the start; 0: never) */
-    co_frame_t rx[RX_MAX]; /* frames to receive, in order ... */
+    uint32_t max_gap;       /* longest time between two samples */
+    uint32_t min_gap;       /* shortest */
+    uint32_t x_change_at;   /* x reads 20 deg from here on (relative to the start; 0: never) */
+    co_frame_t rx[RX_MAX];  /* frames to receive, in order ... */
     uint32_t rx_at[RX_MAX]; /* ... each at its time */
     unsigned nrx;
-    unsigned irx;       /* the next to receive */
-    uint32_t passive_from; /* board_can_state() reports error passive from ... */
+    unsigned irx;           /* the next to receive */
+    uint32_t passive_from;  /* board_can_state() reports error passive from ... */
     uint32_t passive_until; /* ... until here (relative to the start; equal: never) */
     uint32_t start;
-    unsigned state_calls; /* board_can_state() calls */
+    unsigned state_calls;        /* board_can_state() calls */
     unsigned unfiltered_bootups; /* boot-ups whose SDO request the filter stopped */
-    co_frame_t txq[TXQ_MAX]; /* frames the node queued, not yet sent ... */
+    co_frame_t txq[TXQ_MAX];     /* frames the node queued, not yet sent ... */
     unsigned ntxq;
     unsigned slept_queued; /* ... while the board went to sleep */
     co_frame_t tx[TX_MAX];
     uint32_t tx_at[TX_MAX];
     unsigned ntx;
-    unsigned leds;      /* board_leds() calls */
-    unsigned red_only;  /* of which (green off, red on) */
-    bool green_seen[2]; /* green off / on seen */
-    bool red_seen;      /* red on seen ... */
-    uint32_t red_first; /* ... first at this time */
-    unsigned red_limit; /* leave after this many red-only calls (0: never) */
+    unsigned leds;         /* board_leds() calls */
+    unsigned red_only;     /* of which (green off, red on) */
+    bool green_seen[2];    /* green off / on seen */
+    bool red_seen;         /* red on seen ... */
+    uint32_t red_first;    /* ... first at this time */
+    unsigned red_limit;    /* leave after this many red-only calls (0: never) */
     unsigned serial_calls; /* board_serial() calls */
     co_rx_id_t filter[2u * CO_NODE_RX_IDS_MAX]; /* the last board_can_filter() list */
     unsigned nfilter;
@@ -444,7 +444,7 @@ static void test_main_loop_runs_the_product(void)
     CHECK(bd.green_seen[0] && bd.green_seen[1]);
     CHECK_EQ(bd.red_only, 0);
     CHECK_EQ(sent_on(0x1FF, 0, start), 0); /* no PDO before NMT start */
-    CHECK_EQ(bd.slept_queued, 0); /* what a pass queued left before the core slept */
+    CHECK_EQ(bd.slept_queued, 0);          /* what a pass queued left before the core slept */
 }
 
 /* A board that filters (BOARD_RX_FILTER) gets the node's receive list after
@@ -623,8 +623,7 @@ static void test_main_loop_frames_of_one_pass(void)
     deliver((co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x2F, 0xF1, 0x20, 0x00, 0x06}},
             start + 100000u);
     deliver((co_frame_t){.id = 0x000, .dlc = 2, .data = {0x81, 0x7F}}, start + 200000u);
-    deliver((co_frame_t){.id = 0x606, .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}},
-            start + 200000u);
+    deliver((co_frame_t){.id = 0x606, .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}}, start + 200000u);
     if (setjmp(bd.out) == 0) {
         (void)mcu_main_any();
     }
@@ -699,7 +698,9 @@ static void test_main_loop_reset_between_frames(void)
     board_reset(true, true, 300000u);
     memset(nvm, 0xFF, sizeof(nvm));
     uint32_t start = bd.now;
-    deliver((co_frame_t){.id = 0x60A, .dlc = 8, .data = {0x23, 0x00, 0x23, 0x00, 0x55, 0xAA, 0xAA, 0x55}},
+    deliver((co_frame_t){.id = 0x60A,
+                         .dlc = 8,
+                         .data = {0x23, 0x00, 0x23, 0x00, 0x55, 0xAA, 0xAA, 0x55}},
             start + 100000u);
     deliver((co_frame_t){.id = 0x60A, .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}}, start + 100000u);
     if (setjmp(bd.out) == 0) {
@@ -716,7 +717,8 @@ static void test_main_loop_reset_between_frames(void)
         while (answer < bd.ntx && bd.tx[answer].id != 0x58A) {
             answer++;
         }
-        CHECK(answer < bd.ntx && bd.tx[answer].data[0] == 0x43 && bd.tx_at[answer] == bd.tx_at[boot]);
+        CHECK(answer < bd.ntx && bd.tx[answer].data[0] == 0x43 &&
+              bd.tx_at[answer] == bd.tx_at[boot]);
     }
 }
 

@@ -66,7 +66,8 @@ static bool signed_ok(int32_t n, int32_t d)
 
 static void test_unsigned_edges(void)
 {
-    static const uint32_t v[] = {1u, 2u, 3u, 7u, 10u, 1000u, 0x7FFFFFFFu, 0x80000000u,
+    static const uint32_t v[] = {1u,          2u,          3u,          7u,
+                                 10u,         1000u,       0x7FFFFFFFu, 0x80000000u,
                                  0x80000001u, 0xFFFFFFFEu, 0xFFFFFFFFu};
     for (unsigned i = 0; i < sizeof(v) / sizeof(v[0]); i++) {
         CHECK(unsigned_ok(0, v[i]));
@@ -81,8 +82,8 @@ static void test_unsigned_edges(void)
 
 static void test_signed_edges(void)
 {
-    static const int32_t v[] = {1, -1, 2, -2, 3, -3, 7, -7, 1000, -1000, INT32_MAX,
-                                INT32_MIN + 1, INT32_MIN};
+    static const int32_t v[] = {
+        1, -1, 2, -2, 3, -3, 7, -7, 1000, -1000, INT32_MAX, INT32_MIN + 1, INT32_MIN};
     for (unsigned i = 0; i < sizeof(v) / sizeof(v[0]); i++) {
         CHECK(signed_ok(0, v[i]));
         for (unsigned j = 0; j < sizeof(v) / sizeof(v[0]); j++) {

@@ -23,10 +23,10 @@ typedef struct model {
     const product_t *xy10, *xy30, *xy45, *xy90, *z360;
 } model_t;
 
-static const model_t x730 = {"DST X730", &dst_x730_xy10, &dst_x730_xy30, &dst_x730_xy45,
-                             &dst_x730_xy90, &dst_x730_z360};
-static const model_t x710 = {"DST X710", &dst_x710_xy10, &dst_x710_xy30, &dst_x710_xy45,
-                             &dst_x710_xy90, &dst_x710_z360};
+static const model_t x730 = {"DST X730",     &dst_x730_xy10, &dst_x730_xy30,
+                             &dst_x730_xy45, &dst_x730_xy90, &dst_x730_z360};
+static const model_t x710 = {"DST X710",     &dst_x710_xy10, &dst_x710_xy30,
+                             &dst_x710_xy45, &dst_x710_xy90, &dst_x710_z360};
 static const model_t *M = &x730;
 
 #define SAVE() SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00")
@@ -79,7 +79,7 @@ static void test_nmt_n1_to_n5(void)
     boot(M->xy30);
     SDO(d, "2B 17 10 00 E8 03 00 00", "60 17 10 00 00 00 00 00"); /* D11 */
     h_advance(d, 1000000);
-    EXPECT(d, 0x77F, "7F"); /* D2: heartbeat in pre-operational */
+    EXPECT(d, 0x77F, "7F");  /* D2: heartbeat in pre-operational */
     h_rx(d, 0x000, "01 7F"); /* N1 */
     CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
     h_drain(d);
@@ -210,7 +210,7 @@ static void test_e3_event_timer(void)
 {
     boot(M->xy30);
     SDO(d, "2B 00 18 05 14 00 00 00", "60 00 18 05 00 00 00 00"); /* E3.1/E3.2 */
-    SAVE();                                                        /* E3.3/E3.4 */
+    SAVE();                                                       /* E3.3/E3.4 */
     h_power_cycle(d);
     h_drain(d);
     h_rx(d, 0x000, "01 7F");
@@ -232,7 +232,7 @@ static void test_e4_autostart(void)
     EXPECT(d, 0x77F, "00"); /* boot-up first */
     CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
     h_advance(d, 1);
-    EXPECT(d, 0x1FF, "00 00 00 00 00 00 00 00"); /* TPDO without NMT start */
+    EXPECT(d, 0x1FF, "00 00 00 00 00 00 00 00");                  /* TPDO without NMT start */
     SDO(d, "2F 00 50 00 02 00 00 00", "80 00 50 00 31 00 09 06"); /* "Max. = 1" */
 }
 
@@ -245,7 +245,7 @@ static void test_e5_e6_preset_xy(void)
     operational_settled();
     EXPECT_TPDO("D2 04 0C FE 00 00 00 00");
     SDO(d, "2B 12 60 00 00 00 00 00", "60 12 60 00 00 00 00 00"); /* E5.1/E5.2 */
-    EXPECT_TPDO("00 00 0C FE 00 00 00 00");                      /* immediate */
+    EXPECT_TPDO("00 00 0C FE 00 00 00 00");                       /* immediate */
     /* E6.1: the manual prints CMD 28h, no SDO command; 2B is the 2-byte download. */
     SDO(d, "2B 22 60 00 00 00 00 00", "60 22 60 00 00 00 00 00");
     EXPECT_TPDO("00 00 00 00 00 00 00 00");
@@ -270,9 +270,9 @@ static void test_e7_e8_z_preset_and_direction(void)
     EXPECT_TPDO("00 00 00 00 00 00 00 00");
     d->truth[0] = 40000;
     h_advance(d, 3000000);
-    EXPECT_TPDO("E8 03 00 00 00 00 00 00"); /* +10.00 clockwise */
+    EXPECT_TPDO("E8 03 00 00 00 00 00 00");                       /* +10.00 clockwise */
     SDO(d, "2F 11 60 00 03 00 00 00", "60 11 60 00 00 00 00 00"); /* E8.1/E8.2 */
-    SAVE();                                                        /* E8.3/E8.4 */
+    SAVE();                                                       /* E8.3/E8.4 */
     /* Inverted: -m + offset where offset = -3000 from the preset: -7000. */
     EXPECT_TPDO("A8 E4 00 00 00 00 00 00");
 }
@@ -285,7 +285,7 @@ static void test_e9_resolution(void)
     EXPECT_TPDO("C8 00 00 00 00 00 00 00"); /* 10 deg at 0.05 = 200 (D18 style) */
     SDO(d, "2B 14 60 00 05 00 00 00", "60 14 60 00 00 00 00 00");
     SDO(d, "2B 00 60 00 0A 00 00 00", "60 00 60 00 00 00 00 00"); /* E9.1/E9.2 */
-    CHECK_EQ(h_read(d, 0x6014, 0), 0); /* offsets cleared */
+    CHECK_EQ(h_read(d, 0x6014, 0), 0);                            /* offsets cleared */
     SAVE();
     EXPECT_TPDO("E8 03 00 00 00 00 00 00"); /* 1000 at 0.01 */
     h_power_cycle(d);
@@ -326,7 +326,7 @@ static void test_e11_restore_defaults(void)
     h_power_cycle(d);
     EXPECT(d, 0x706, "00");
     h_drain(d);
-    h_rx(d, 0x606, "23 11 10 01 6C 6F 61 64"); /* E11.1 */
+    h_rx(d, 0x606, "23 11 10 01 6C 6F 61 64");   /* E11.1 */
     EXPECT(d, 0x586, "60 11 10 01 00 00 00 00"); /* E11.2 */
     h_rx(d, 0x606, "40 00 18 05 00 00 00 00");
     EXPECT(d, 0x586, "4B 00 18 05 14 00 00 00"); /* RAM unchanged until reset */
@@ -341,7 +341,7 @@ static void test_e12_event_timer_off(void)
 {
     boot(M->xy30);
     SDO(d, "2B 00 18 05 00 00 00 00", "60 00 18 05 00 00 00 00"); /* E12.1/E12.2 */
-    SAVE();                                                        /* E12.3/E12.4 */
+    SAVE();                                                       /* E12.3/E12.4 */
     h_rx(d, 0x000, "01 7F");
     h_drain(d);
     h_advance(d, 2000000);
@@ -352,7 +352,7 @@ static void test_e13_sync(void)
 {
     boot(M->xy30);
     SDO(d, "2F 00 18 02 01 00 00 00", "60 00 18 02 00 00 00 00"); /* E13.1/E13.2 */
-    SAVE();                                                        /* E13.3/E13.4 */
+    SAVE();                                                       /* E13.3/E13.4 */
     h_rx(d, 0x000, "01 7F");
     h_drain(d);
     h_advance(d, 500000);
@@ -402,7 +402,8 @@ static void test_derived_reads(void)
     SDO(d, "40 08 10 00 00 00 00 00", "47 08 10 00 47 49 42 00"); /* D6 */
     SDO(d, "40 09 10 00 00 00 00 00", "43 09 10 00 31 2E 30 30");
     SDO(d, "40 00 60 00 00 00 00 00", "4B 00 60 00 32 00 00 00"); /* D8 */
-    SDO(d, "40 00 1A 02 00 00 00 00", "43 00 1A 02 10 00 20 60"); /* D9: 16 bits, not the printed 0x20 */
+    SDO(d, "40 00 1A 02 00 00 00 00",
+        "43 00 1A 02 10 00 20 60"); /* D9: 16 bits, not the printed 0x20 */
     /* 3 entries where the manual prints 2: bytes 5-8 mapped as 2100h, 0. */
     SDO(d, "40 00 1A 00 00 00 00 00", "4F 00 1A 00 03 00 00 00");
     SDO(d, "40 00 1A 03 00 00 00 00", "43 00 1A 03 20 00 00 21");
@@ -481,12 +482,16 @@ static uint32_t sdo_answer(const uint8_t req[8], uint8_t ok)
     while ((r = h_next(d)) != NULL && r->id != 0x580u + d->node->node_id) {
     }
     CHECK(r != NULL && (r->data[0] == 0x80u || r->data[0] == ok));
-    return r == NULL ? 1u : r->data[0] == 0x80u ? co_get_u32(&r->data[4]) : r->data[0] == ok ? 0u : 1u;
+    return r == NULL             ? 1u
+           : r->data[0] == 0x80u ? co_get_u32(&r->data[4])
+           : r->data[0] == ok    ? 0u
+                                 : 1u;
 }
 
 /* len bytes at v into index/sub, expedited (segmented false) or as one
  * segmented download with the size indicated; the answer (sdo_answer). */
-static uint32_t write_as(uint16_t index, uint8_t sub, const uint8_t *v, unsigned len, bool segmented)
+static uint32_t write_as(uint16_t index, uint8_t sub, const uint8_t *v, unsigned len,
+                         bool segmented)
 {
     uint8_t req[8] = {0, (uint8_t)index, (uint8_t)(index >> 8), sub};
     if (!segmented) {
@@ -542,7 +547,8 @@ static void test_segmented_as_expedited(void)
                 after[way] = h_read(d, e->index, e->sub);
             }
             if (answer[0] != answer[1] || after[0] != after[1]) {
-                fprintf(stderr, "%s %04Xh/%u case %u: expedited %08lX -> %lld, segmented %08lX -> %lld\n",
+                fprintf(stderr,
+                        "%s %04Xh/%u case %u: expedited %08lX -> %lld, segmented %08lX -> %lld\n",
                         M->name, e->index, e->sub, c, (unsigned long)answer[0], after[0],
                         (unsigned long)answer[1], after[1]);
             }

@@ -17,11 +17,11 @@
 
 typedef struct sim_flash {
     uint8_t mem[PAGES * PAGE];
-    long steps_left;   /* flash operations before the power fails; -1: never */
+    long steps_left; /* flash operations before the power fails; -1: never */
     unsigned erases;
     unsigned programs;
-    unsigned refused;  /* programs of a non-erased half-word (must stay 0) */
-    unsigned calls;    /* erase and program calls, refused ones included */
+    unsigned refused; /* programs of a non-erased half-word (must stay 0) */
+    unsigned calls;   /* erase and program calls, refused ones included */
 } sim_flash_t;
 
 static sim_flash_t flash;
@@ -82,8 +82,10 @@ static void sim_read(void *ctx, uint32_t addr, void *buf, uint32_t len)
     memcpy(buf, &flash.mem[addr], len);
 }
 
-static const flash_ops_t sim_ops = {.erase = sim_erase, .program16 = sim_program16, .read = sim_read};
-static const flash_ee_t fe = {.ops = &sim_ops, .ctx = NULL, .base = 0, .page_size = PAGE, .pages = PAGES};
+static const flash_ops_t sim_ops = {
+    .erase = sim_erase, .program16 = sim_program16, .read = sim_read};
+static const flash_ee_t fe = {
+    .ops = &sim_ops, .ctx = NULL, .base = 0, .page_size = PAGE, .pages = PAGES};
 static const flash_ee_t *ee = &fe; /* the geometry the port uses */
 
 /* The port: CAN frames are kept for inspection, NVM is the flash. */
@@ -196,8 +198,8 @@ static void test_pages_and_alignment(void)
     CHECK(flash.mem[0] == 0x43 && flash.mem[PAGE] == 0x43); /* "CoPS" magic */
     CHECK_EQ(flash.mem[2u * PAGE], 0xFF);
     uint8_t two[2] = {1, 2};
-    CHECK(!flash_ee_write(&fe, 1, two, 2));   /* odd address */
-    CHECK(!flash_ee_write(&fe, 2, two, 1));   /* odd length */
+    CHECK(!flash_ee_write(&fe, 1, two, 2));                     /* odd address */
+    CHECK(!flash_ee_write(&fe, 2, two, 1));                     /* odd length */
     CHECK(!flash_ee_write(&fe, CO_STORE_SLOT - 2u, "abcd", 4)); /* across a slot */
     CHECK(!flash_ee_write(&fe, flash_ee_size(&fe), two, 2));    /* beyond the end */
     uint8_t b[4];
@@ -247,7 +249,8 @@ static void test_unusable_geometry(void)
     CHECK_EQ(flash.erases, 0);
     CHECK_EQ(flash.programs, 0);
     /* The usable one still is: 1024-byte pages, and exactly a slot. */
-    static const flash_ee_t exact = {.ops = &sim_ops, .base = 0, .page_size = CO_STORE_SLOT, .pages = 4};
+    static const flash_ee_t exact = {
+        .ops = &sim_ops, .base = 0, .page_size = CO_STORE_SLOT, .pages = 4};
     CHECK_EQ(flash_ee_size(&fe), PAGES * CO_STORE_SLOT);
     CHECK_EQ(flash_ee_size(&exact), 4u * CO_STORE_SLOT);
 }

@@ -161,7 +161,7 @@ static void test_e3_autostart_off(void)
 {
     boot(&gsh_a);
     SDO(d, "2F 00 50 00 00 00 00 00", "60 00 50 00 00 00 00 00"); /* E3-1/E3-2 */
-    CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);               /* unchanged by 0x5000 */
+    CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);             /* unchanged by 0x5000 */
     SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00"); /* E3-3/E3-4 */
     h_power_cycle(d);
     EXPECT_ID(d, 0x713, "00");
@@ -300,7 +300,7 @@ static void test_alarms_counter_checksum(void)
         uint16_t alarms;
     } v[] = {
         {100, 100, 0, 0},
-        {0, 50, 0, 0},      /* the ends of the stroke and of the field's range: no alarm */
+        {0, 50, 0, 0}, /* the ends of the stroke and of the field's range: no alarm */
         {GSH_STROKE_MM, 150, 0, 0},
         {-5, 100, 0, GSH_ALARM_UNDER_EXTENSION},
         {9000, 100, 0, GSH_ALARM_OVER_EXTENSION},

@@ -198,7 +198,7 @@ static void test_stored_values_pass_sdo_validation(void)
     h_advance(d, 1000);
     EXPECT_ID(d, 0x0FF, "00 10 00 00 40 00 00 00"); /* 0x4001 bit 6 + EMCY */
     CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
-    CHECK_EQ(h_read(d, 0x6000, 0), 50);  /* default */
+    CHECK_EQ(h_read(d, 0x6000, 0), 50);   /* default */
     CHECK_EQ(h_read(d, 0x1014, 0), 0xFF); /* default: 0x80 + node-ID */
     CHECK_EQ(h_read(d, 0x2001, 0), 0);
     CHECK_EQ(h_read(d, 0x1017, 0), 500); /* the good value stays */
@@ -295,7 +295,8 @@ static void test_every_default_passes_validation(void)
         for (unsigned n = 0; n < nodes; n++) {
             if (d->nodes[n]->store.status[CO_CLS_PARA] != CO_STORE_OK ||
                 d->nodes[n]->store.status[CO_CLS_LSS] == CO_STORE_CORRUPT) {
-                fprintf(stderr, "%s node %u: its defaults fail validation\n", product_list[i]->id, n);
+                fprintf(stderr, "%s node %u: its defaults fail validation\n", product_list[i]->id,
+                        n);
                 FAIL("a default fails validation");
             }
         }

@@ -7,8 +7,8 @@
  * 0/360 deg on the JD1, the LED and LSS "store" through 3000h/3001h.
  * Node 10 (0x70A, SDO 0x60A).
  */
-#include "jd.h"
 #include "harness.h"
+#include "jd.h"
 
 static h_dev_t dev;
 static h_dev_t *const d = &dev;
@@ -32,7 +32,7 @@ static void tilt(int32_t a, int32_t b)
 static void test_jd1_preset_and_wrap(void)
 {
     boot(&jd1xxx);
-    tilt(100000, 25000);                                           /* 100 deg */
+    tilt(100000, 25000);                                          /* 100 deg */
     SDO(d, "22 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00"); /* scaling on */
     SDO(d, "2B 00 26 00 B8 88 00 00", "60 00 26 00 00 00 00 00"); /* 35000 */
     SDO(d, "40 13 60 00 00 00 00 00", "4B 13 60 00 08 D5 00 00"); /* 25000 -> -11000 */
@@ -55,7 +55,7 @@ static void test_jd1_preset_and_wrap(void)
 static void test_jd2_lateral_preset_inverted(void)
 {
     boot(&jd2xxx);
-    tilt(0, 20000);                                                /* y = 20 deg */
+    tilt(0, 20000);                                               /* y = 20 deg */
     SDO(d, "22 21 60 00 03 00 00 00", "60 21 60 00 00 00 00 00"); /* invert, scaling */
     SDO(d, "2B 01 26 00 F4 01 00 00", "60 01 26 00 00 00 00 00"); /* 5.00 deg */
     SDO(d, "40 23 60 00 00 00 00 00", "4B 23 60 00 C4 09 00 00"); /* 500 + 2000 */
@@ -67,7 +67,8 @@ static void test_jd2_lateral_preset_inverted(void)
     SDO(d, "40 01 26 00 00 00 00 00", "4B 01 26 00 E8 03 00 00");
     SDO(d, "2B 01 26 00 29 23 00 00", "80 01 26 00 30 00 09 06"); /* 90.01 deg */
     SDO(d, "2B 01 26 00 D7 DC 00 00", "80 01 26 00 30 00 09 06"); /* -90.01 deg */
-    SDO(d, "2B 01 26 00 28 23 00 00", "60 01 26 00 00 00 00 00"); /* +-90.00 deg: the range's ends */
+    SDO(d, "2B 01 26 00 28 23 00 00",
+        "60 01 26 00 00 00 00 00"); /* +-90.00 deg: the range's ends */
     SDO(d, "2B 01 26 00 D8 DC 00 00", "60 01 26 00 00 00 00 00");
     SDO(d, "2B 01 26 00 E8 03 00 00", "60 01 26 00 00 00 00 00"); /* 10.00 deg again */
     SDO(d, "40 12 60 00 00 00 00 00", "4B 12 60 00 00 00 00 00"); /* X untouched */
@@ -184,10 +185,10 @@ static void test_gyro_rates(void)
         int16_t gx, gy;
     } v[] = {
         {0, 0, 0, 0},
-        {500, -250, 1000, -500},         /* 100.0 and -50.0 deg/s */
-        {3500, -3250, 5000, -5000},      /* 600 deg/s: the range's ends */
+        {500, -250, 1000, -500},    /* 100.0 and -50.0 deg/s */
+        {3500, -3250, 5000, -5000}, /* 600 deg/s: the range's ends */
         {179000, -179000, 5000, -5000},
-        {-179000, 179000, 4000, -4000},  /* across 180 deg: 2 deg the short way */
+        {-179000, 179000, 4000, -4000}, /* across 180 deg: 2 deg the short way */
         {-179000, 179000, 0, 0},
     };
     boot(&jd2xxx);
@@ -333,7 +334,7 @@ static void test_jd1_average_of_two(void)
 {
     static const struct {
         int32_t a, b, out; /* 6010h, 0.01 deg */
-    } v[] = {{359000, 1000, 0}, {1000, 359000, 0}, {10000, 160000, 8500},
+    } v[] = {{359000, 1000, 0},     {1000, 359000, 0},      {10000, 160000, 8500},
              {160000, 10000, 8500}, {10000, 190000, 10000}, {190000, 10000, 10000}};
     boot(&jd1xxx);
     jd_dev_t *j = h_inst(d);
@@ -438,11 +439,16 @@ static void test_tpdo_defaults(void)
         uint8_t sub;
         long long jd2, jd1;
     } v[] = {
-        {0x1800, 1, 0x18A, 0x18A},   {0x1801, 1, 0x28A, 0x28A},
-        {0x1800, 3, 0, 0},           {0x1801, 3, 1, 1},
-        {0x1A00, 0, 2, 1},           {0x1A01, 0, 2, 1},
-        {0x1A00, 1, 0x60100010, 0x60100010}, {0x1A01, 1, 0x60100010, 0x60100010},
-        {0x1A00, 2, 0x60200010, 0x60200010}, {0x1A01, 2, 0x60200010, 0x60200010},
+        {0x1800, 1, 0x18A, 0x18A},
+        {0x1801, 1, 0x28A, 0x28A},
+        {0x1800, 3, 0, 0},
+        {0x1801, 3, 1, 1},
+        {0x1A00, 0, 2, 1},
+        {0x1A01, 0, 2, 1},
+        {0x1A00, 1, 0x60100010, 0x60100010},
+        {0x1A01, 1, 0x60100010, 0x60100010},
+        {0x1A00, 2, 0x60200010, 0x60200010},
+        {0x1A01, 2, 0x60200010, 0x60200010},
     };
     const product_t *const p[2] = {&jd2xxx, &jd1xxx};
     for (unsigned k = 0; k < 2u; k++) {
@@ -718,8 +724,8 @@ static void test_accel_between_degrees(void)
         for (unsigned k = 0; k < sizeof(fracs) / sizeof(fracs[0]); k++) {
             int32_t a = deg * 1000 + fracs[k];
             int32_t want = lo + (hi - lo) * fracs[k] / 1000;
-            int32_t in[4][3] = {{a, 0, 25000}, {-a, 0, 25000}, {180000 - a, 0, 25000},
-                                {a - 180000, 0, 25000}};
+            int32_t in[4][3] = {
+                {a, 0, 25000}, {-a, 0, 25000}, {180000 - a, 0, 25000}, {a - 180000, 0, 25000}};
             int32_t sign[4] = {1, -1, 1, -1};
             for (unsigned m = 0; m < 4u; m++) {
                 d->prod->sample(j, in[m], 0);

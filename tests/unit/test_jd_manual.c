@@ -10,8 +10,8 @@
  * Frames the manual misprints are tested corrected and say so on their
  * line.
  */
-#include "jd.h"
 #include "harness.h"
+#include "jd.h"
 
 static h_dev_t dev;
 static h_dev_t *const d = &dev;
@@ -49,12 +49,12 @@ static void test_nmt_frames(void)
 static void test_a_event_timer_example(void)
 {
     boot(&jd2xxx);
-    h_rx(d, 0x000, "80 00");                                       /* A1 */
+    h_rx(d, 0x000, "80 00");                                      /* A1 */
     SDO(d, "22 00 18 05 64 00 00 00", "60 00 18 05 00 00 00 00"); /* A2, D-A2 */
     SDO(d, "40 01 18 05 00 00 00 00", "4B 01 18 05 64 00 00 00"); /* side effect on TPDO2 */
     SDO(d, "40 00 22 00 00 00 00 00", "4B 00 22 00 64 00 00 00"); /* and 2200h */
     SDO(d, "22 00 18 02 FE 00 00 00", "60 00 18 02 00 00 00 00"); /* A3, D-A3 */
-    h_rx(d, 0x000, "01 00");                                       /* A4 */
+    h_rx(d, 0x000, "01 00");                                      /* A4 */
     h_drain(d);
     h_advance(d, 1000000 - 1);
     unsigned n1 = 0;
@@ -65,7 +65,7 @@ static void test_a_event_timer_example(void)
         n2 += f->id == 0x28A;
     }
     CHECK_EQ(n1, 9); /* D-A5: every 100 ms; the first went out with the start, drained */
-    CHECK_EQ(n2, 0);  /* TPDO2 is type 1: only on SYNC */
+    CHECK_EQ(n2, 0); /* TPDO2 is type 1: only on SYNC */
     h_rx(d, 0x080, "");
     f = h_next(d);
     CHECK(f != NULL && f->id == 0x28A && f->dlc == 4);
@@ -82,7 +82,8 @@ static void test_b_tpdo2_mapping_example(void)
 {
     boot(&jd2xxx);
     SDO(d, "22 01 18 01 00 00 00 80", "60 01 18 01 00 00 00 00"); /* B1, D-B1 */
-    SDO(d, "22 01 1A 00 00 00 00 80", "60 01 1A 00 00 00 00 00"); /* B2 as printed: its stray 80 is beyond the 1-byte object */
+    SDO(d, "22 01 1A 00 00 00 00 80",
+        "60 01 1A 00 00 00 00 00"); /* B2 as printed: its stray 80 is beyond the 1-byte object */
     /* B3 as printed writes sub 0 (meant: sub 1) with 0x10 entries: entry 3 names no
      * object (the mapping has two), CiA 301's 0x06020000. */
     SDO(d, "22 01 1A 00 10 00 00 34", "80 01 1A 00 00 00 02 06");
@@ -114,8 +115,8 @@ static void test_c_node_number_example(void)
     SDO(d, "22 00 30 00 31 00 00 00", "60 00 30 00 00 00 00 00"); /* D-C1 */
     SDO(d, "22 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00"); /* C2 */
     h_drain(d);
-    h_rx(d, 0x000, "81 0A"); /* D-C3a */
-    EXPECT(d, 0x732, "00");  /* D-C3b: node 50 */
+    h_rx(d, 0x000, "81 0A");                                      /* D-C3a */
+    EXPECT(d, 0x732, "00");                                       /* D-C3b: node 50 */
     SDO(d, "22 00 30 00 7F 00 00 00", "80 00 30 00 31 00 09 06"); /* > 0x7E */
     SDO(d, "22 00 30 00 1F 00 00 00", "60 00 30 00 00 00 00 00"); /* T2 */
     h_power_cycle(d);
@@ -134,7 +135,7 @@ static void test_d_bitrate_save_with_reset(void)
     h_rx(d, 0x60A, "22 00 23 00 55 AA AA 55");
     EXPECT(d, 0x58A, "60 00 23 00 00 00 00 00"); /* D-D2 */
     h_advance(d, 1);
-    EXPECT(d, 0x70A, "00"); /* D-D3: boot-up (at 500 kbit/s) */
+    EXPECT(d, 0x70A, "00");      /* D-D3: boot-up (at 500 kbit/s) */
     CHECK_EQ(d->port.kbps, 500); /* the board was told before the boot-up */
     SDO(d, "40 01 30 00 00 00 00 00", "4F 01 30 00 05 00 00 00");
     SDO(d, "22 00 23 00 55 AA AA 56", "80 00 23 00 20 00 00 08");
@@ -167,7 +168,8 @@ static void test_t1_inhibit_only_while_invalid(void)
     SDO(d, "22 00 18 03 E8 03 00 00", "60 00 18 03 00 00 00 00");
     SDO(d, "22 00 18 01 8A 01 00 00", "60 00 18 01 00 00 00 00");
     SDO(d, "40 00 18 03 00 00 00 00", "4B 00 18 03 E8 03 00 00");
-    SDO(d, "40 01 18 03 00 00 00 00", "4B 01 18 03 01 00 00 00"); /* TPDO2 default 1, as printed (8.9.2) */
+    SDO(d, "40 01 18 03 00 00 00 00",
+        "4B 01 18 03 01 00 00 00"); /* TPDO2 default 1, as printed (8.9.2) */
     /* Valid is bit 31 clear, whatever the CAN-ID: an odd one too. */
     SDO(d, "22 00 18 01 A1 01 00 80", "60 00 18 01 00 00 00 00");
     SDO(d, "22 00 18 01 A1 01 00 00", "60 00 18 01 00 00 00 00");
@@ -220,7 +222,7 @@ static void test_s8_guarding_and_life_guard(void)
     co_led_pattern_t g;
     co_led_pattern_t r;
     co_node_led_patterns(d->node, &g, &r);
-    CHECK(r == CO_LED_FLASH2 && g == CO_LED_OFF); /* guard event; only red shown */
+    CHECK(r == CO_LED_FLASH2 && g == CO_LED_OFF);                 /* guard event; only red shown */
     SDO(d, "40 03 10 00 00 00 00 00", "4F 03 10 00 01 00 00 00"); /* in 1003h */
     SDO(d, "40 03 10 01 00 00 00 00", "43 03 10 01 30 81 00 00");
     h_rx_frame(d, &rtr); /* the error ends; a second one comes */
@@ -438,7 +440,7 @@ static void test_can_error_emcy(void)
     boot(&jd2xxx);
     h_drain(d);
     co_node_set_can_state(d->node, CO_CAN_PASSIVE);
-    EXPECT(d, 0x08A, "20 81 11 00 00 00 00 00"); /* CiA 301's 8120h */
+    EXPECT(d, 0x08A, "20 81 11 00 00 00 00 00");                  /* CiA 301's 8120h */
     SDO(d, "2B 17 10 00 64 00 00 00", "60 17 10 00 00 00 00 00"); /* heartbeat 100 ms */
     h_drain(d);
     co_node_set_can_state(d->node, CO_CAN_BUSOFF);

@@ -9,10 +9,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "can_port.h"
 #include "co_port.h"
 #include "dst.h"
 #include "jd.h"
-#include "can_port.h"
 
 #include "harness.h"
 
@@ -173,8 +173,10 @@ static void test_eeprom_link_to_nothing(void)
     log_start();
     CHECK_EQ(lp_nvm_open(&n, "--nvm-dir D:", link, mem, sizeof(mem), err, sizeof(err)), -2);
     char want[800];
-    snprintf(want, sizeof(want), "--nvm-dir D: %s: a symbolic link to %s, which does not exist "
-             "(create the file, or give the path without the link)", link, to);
+    snprintf(want, sizeof(want),
+             "--nvm-dir D: %s: a symbolic link to %s, which does not exist "
+             "(create the file, or give the path without the link)",
+             link, to);
     if (strcmp(err, want) != 0) {
         FAIL(err);
     }

@@ -130,8 +130,8 @@ static void test_verb_table(void)
     for (const char *p = text; *p != '\0'; p += strcspn(p, "\n") + 1u) {
         CHECK(strcspn(p, "\n") <= 79u);
         if (p[0] == ' ' && p[1] == ' ' && p[2] != ' ') {
-            CHECK(rows < cmd_nverbs && strncmp(p + 2, cmd_verbs[rows].name,
-                                               strlen(cmd_verbs[rows].name)) == 0);
+            CHECK(rows < cmd_nverbs &&
+                  strncmp(p + 2, cmd_verbs[rows].name, strlen(cmd_verbs[rows].name)) == 0);
             rows++;
         }
         if (p[strcspn(p, "\n")] == '\0') {
@@ -310,12 +310,22 @@ static void test_serial_line_verbs(void)
 static void test_serial_line_answers(void)
 {
     static const char *const lines[] = {
-        "set x=12.5 y=-3", "fault sensor on", "fault sensor maybe", "fault motor on", "get",
-        "get x", "can passive", "can active", "can bus-off 2", "can off", "can bus-off 1 2",
-        "fault sensor off", "set y=0.25", "get",
+        "set x=12.5 y=-3",
+        "fault sensor on",
+        "fault sensor maybe",
+        "fault motor on",
+        "get",
+        "get x",
+        "can passive",
+        "can active",
+        "can bus-off 2",
+        "can off",
+        "can bus-off 1 2",
+        "fault sensor off",
+        "set y=0.25",
+        "get",
     };
-    static const char *const errors_only[] = {"set x=1 y=banana", "set z=1", "set",
-                                              "set x=3601"};
+    static const char *const errors_only[] = {"set x=1 y=banana", "set z=1", "set", "set x=3601"};
     make((const product_t *const[]){&dst_x730_xy30, NULL});
     serial_link_t s;
     serial_link_init(&s, &dst_x730_xy30);
@@ -336,7 +346,8 @@ static void test_serial_line_answers(void)
         CHECK(starts(serial_ask(&s, errors_only[k]), "error: "));
     }
     CHECK(starts(ask("set x=3601"), "error: "));
-    CHECK(is(serial_ask(&s, "can bus-off 61"), "error: '61': not a number of seconds within 0..60"));
+    CHECK(
+        is(serial_ask(&s, "can bus-off 61"), "error: '61': not a number of seconds within 0..60"));
     CHECK(is(ask("can bus-off 61"), "ok")); /* the program's limit is 1800 s */
     /* Unknown and absent verbs: the same start, the serial line's verbs. */
     CHECK(is(serial_ask(&s, "tilt 5"), "error: unknown command 'tilt' (set, fault, can, get)"));

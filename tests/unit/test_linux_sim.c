@@ -120,11 +120,11 @@ static void test_ramp_rejected(void)
     CHECK_EQ(s.values[0], 6000);
     sim_motion_t before = s.motion[0];
     static const char *const bad[] = {
-        "ramp x=30 in 0s",     "ramp x=30 in 0ms",   "ramp x=30 in 5",      "ramp x=30 in 5min",
-        "ramp x=30 5s",        "ramp x=30 in",       "ramp x=30 in 5s now", "ramp q=1 in 1s",
-        "ramp x in 1s",        "ramp x=1e9 in 1s",   "ramp x=nan in 1s",    "ramp x=30 in -1s",
-        "ramp x=30 in 100000s", "ramp x=30 in 0.0001ms", "ramp x=30 in nans", "ramp",
-        "ramp x=3601 in 1s",   "ramp x= in 1s",
+        "ramp x=30 in 0s",      "ramp x=30 in 0ms",      "ramp x=30 in 5",      "ramp x=30 in 5min",
+        "ramp x=30 5s",         "ramp x=30 in",          "ramp x=30 in 5s now", "ramp q=1 in 1s",
+        "ramp x in 1s",         "ramp x=1e9 in 1s",      "ramp x=nan in 1s",    "ramp x=30 in -1s",
+        "ramp x=30 in 100000s", "ramp x=30 in 0.0001ms", "ramp x=30 in nans",   "ramp",
+        "ramp x=3601 in 1s",    "ramp x= in 1s",
     };
     for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
         char err[200] = "";
@@ -179,10 +179,17 @@ static void test_sine(void)
     /* Rejected: nothing changes. */
     sim_motion_t before = s.motion[0];
     static const char *const bad[] = {
-        "sine x amp=5",          "sine x period=2s",       "sine x amp=-1 period=2s",
-        "sine x amp=5 period=0s", "sine x amp=5 period=2",  "sine x=1 amp=5 period=2s",
-        "sine q amp=5 period=2s", "sine x amp=5 period=2s y", "sine x amp=x period=2s",
-        "sine x amp=3600 period=2s", "sine",
+        "sine x amp=5",
+        "sine x period=2s",
+        "sine x amp=-1 period=2s",
+        "sine x amp=5 period=0s",
+        "sine x amp=5 period=2",
+        "sine x=1 amp=5 period=2s",
+        "sine q amp=5 period=2s",
+        "sine x amp=5 period=2s y",
+        "sine x amp=x period=2s",
+        "sine x amp=3600 period=2s",
+        "sine",
     };
     for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
         char err[200] = "";
@@ -312,8 +319,8 @@ static void test_noise_composes(void)
     }
     CHECK(at_limit > 30u && at_limit < 70u);
     /* Malformed noise lines. */
-    static const char *const bad[] = {"noise x",         "noise x sd=-1", "noise x sd=abc",
-                                      "noise x sd=1 y", "noise q sd=1",  "noise x=1 sd=1",
+    static const char *const bad[] = {"noise x",        "noise x sd=-1",  "noise x sd=abc",
+                                      "noise x sd=1 y", "noise q sd=1",   "noise x=1 sd=1",
                                       "noise x amp=1",  "noise x sd=3601"};
     for (size_t k = 0; k < sizeof(bad) / sizeof(bad[0]); k++) {
         err[0] = '\0';
@@ -326,8 +333,7 @@ static void test_noise_composes(void)
 }
 
 /* A file in dir with this text; its path in path. */
-static void write_file(const char *dir, const char *name, const char *text, char *path,
-                       size_t len)
+static void write_file(const char *dir, const char *name, const char *text, char *path, size_t len)
 {
     snprintf(path, len, "%s/%s", dir, name);
     FILE *f = fopen(path, "w");
@@ -341,7 +347,7 @@ static void write_file(const char *dir, const char *name, const char *text, char
 /* Remove dir and the files the tests wrote into it. */
 static void remove_files(const char *dir, char *path, size_t len)
 {
-    static const char *const files[] = {"a.csv", "b.csv", "c.csv",  "d.csv",
+    static const char *const files[] = {"a.csv", "b.csv",   "c.csv",  "d.csv",
                                         "e.csv", "bad.csv", "bom.csv"};
     for (size_t k = 0; k < sizeof(files) / sizeof(files[0]); k++) {
         snprintf(path, len, "%s/%s", dir, files[k]);
@@ -563,8 +569,10 @@ static void test_replay_limits_bom_and_where(void)
     sim_t before = s;
     CHECK(!sim_command(&s, line, err, sizeof(err)));
     char want[600];
-    snprintf(want, sizeof(want), "replay %s: 262145 bytes, more than the 262144 a replay file "
-             "may have (it is read while every node waits)", path);
+    snprintf(want, sizeof(want),
+             "replay %s: 262145 bytes, more than the 262144 a replay file "
+             "may have (it is read while every node waits)",
+             path);
     if (strcmp(err, want) != 0) {
         FAIL(err);
     }
@@ -581,8 +589,10 @@ static void test_replay_limits_bom_and_where(void)
     char cwd[256];
     CHECK(getcwd(cwd, sizeof(cwd)) != NULL);
     CHECK(!sim_command(&s, "replay no-such-file.csv", err, sizeof(err)));
-    snprintf(want, sizeof(want), "replay no-such-file.csv: No such file or directory (in %s, "
-             "the program's working directory)", cwd);
+    snprintf(want, sizeof(want),
+             "replay no-such-file.csv: No such file or directory (in %s, "
+             "the program's working directory)",
+             cwd);
     if (strcmp(err, want) != 0) {
         FAIL(err);
     }

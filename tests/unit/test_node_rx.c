@@ -6,8 +6,8 @@
  * drops it loses nothing); again after the SYNC COB-ID, a TPDO COB-ID, the
  * heartbeat consumer and the node-ID (LSS) changed.
  */
-#include "harness.h"
 #include "dst.h"
+#include "harness.h"
 #include "jd.h"
 #include "pf.h"
 
@@ -64,7 +64,9 @@ static unsigned dropped_frames_unused(co_node_t *node)
                 continue;
             }
             for (unsigned l = 0; l < sizeof(lens); l++) {
-                co_frame_t f = {.id = id, .rtr = r != 0u, .dlc = lens[l],
+                co_frame_t f = {.id = id,
+                                .rtr = r != 0u,
+                                .dlc = lens[l],
                                 .data = {0x01, 0x40, 0x05, 0, 0, 0, 0, 0}};
                 if (id == 0x000u) {
                     f.data[1] = 0; /* NMT to all nodes (in the list anyway) */
@@ -237,8 +239,8 @@ static void test_rx_ids_follow_changes(void)
     unsigned n = list(d->node, ids);
     CHECK(has(ids, n, 0x080, false));
     CHECK(has(ids, n, 0x60A, false));
-    CHECK(has(ids, n, 0x70A, true));  /* guarding: remote frames only */
-    CHECK(has(ids, n, 0x18A, true));  /* TPDO 1 on request */
+    CHECK(has(ids, n, 0x70A, true)); /* guarding: remote frames only */
+    CHECK(has(ids, n, 0x18A, true)); /* TPDO 1 on request */
     CHECK(!passes(ids, n, 0x18A, false));
     CHECK(!passes(ids, n, 0x705, false));
     SDO(d, "23 05 10 00 81 00 00 00", "60 05 10 00 00 00 00 00"); /* SYNC on 0x081 */

@@ -50,6 +50,7 @@ typedef struct n_dev {
 #define MAPW CO_EXT(.write = co_tpdo_write_map)
 #define COBW CO_EXT(.write = co_tpdo_write_cobid)
 
+/* clang-format off */
 static const co_od_entry_t n_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x0000019Au},
     {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_read_register)},
@@ -86,8 +87,10 @@ static const co_od_entry_t n_entries[] = {
     {.index = 0x2001, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW | CO_A_PDO, V(b), .def = 0x5566u},
     {.index = 0x2002, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, P(c), .def = 0x7788u},
 };
+/* clang-format on */
 
-static const co_od_t n_od = {.entries = n_entries, .count = sizeof(n_entries) / sizeof(n_entries[0])};
+static const co_od_t n_od = {.entries = n_entries,
+                             .count = sizeof(n_entries) / sizeof(n_entries[0])};
 
 static void n_state(co_node_t *n, co_nmt_state_t old)
 {
@@ -106,8 +109,8 @@ static void n_reset(co_node_t *n, co_reset_t kind)
     }
 }
 
-static const co_node_ops_t n_ops = {.state = n_state, .can_state = co_emcy_can_state,
-                                    .reset = n_reset};
+static const co_node_ops_t n_ops = {
+    .state = n_state, .can_state = co_emcy_can_state, .reset = n_reset};
 
 static const co_service_t *const n_services[] = {&co_guard_service, &co_hbc_service,
                                                  &co_lss_service, &co_rtr_service, NULL};
@@ -140,6 +143,7 @@ static const co_node_cfg_t n_comm_id_cfg = {
  * COB-ID (the default 80h + node-ID), an error history with no field,
  * a guard time without a life time factor, a consumer time kept nowhere,
  * no identity. */
+/* clang-format off */
 static const co_od_entry_t n_min_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x0000019Au},
     {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_read_register)},
@@ -150,6 +154,7 @@ static const co_od_entry_t n_min_entries[] = {
     /* A consumer time kept nowhere (no RAM): fixed at its default. */
     {.index = 0x1016, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, .def = 0, CO_EXT(.write = co_hbc_write_time)},
 };
+/* clang-format on */
 
 static const co_od_t n_min_od = {.entries = n_min_entries,
                                  .count = sizeof(n_min_entries) / sizeof(n_min_entries[0])};
@@ -176,8 +181,9 @@ static void n_create(const product_t *p, void *mem, void *const ports[], co_node
     const n_variant_t *v = p->variant;
     bool no_lss = v != NULL && v->no_lss;
     const co_node_cfg_t *cfg = v != NULL ? v->cfg : &n_cfg;
-    void *const ram[CO_CLS_COUNT] = {NULL, cfg->ram_size[CO_CLS_VOL] != 0u ? &t->vol : NULL,
-                                     &t->para, no_lss || !co_cfg_has_service(cfg, &co_lss_service) ? NULL : &t->lss};
+    void *const ram[CO_CLS_COUNT] = {
+        NULL, cfg->ram_size[CO_CLS_VOL] != 0u ? &t->vol : NULL, &t->para,
+        no_lss || !co_cfg_has_service(cfg, &co_lss_service) ? NULL : &t->lss};
     co_node_init(&t->node, cfg, ports[0], t, ram, 0);
     nodes[0] = &t->node;
 }
@@ -192,20 +198,33 @@ static void n_sample(void *mem, const int32_t v[], uint32_t fault)
 static const n_variant_t n_no_lss = {.no_lss = true, .cfg = &n_cfg};
 static const n_variant_t n_min = {.no_lss = true, .cfg = &n_min_cfg};
 static const n_variant_t n_comm_id = {.no_lss = false, .cfg = &n_comm_id_cfg};
-static const product_t n_prod = {.id = "services", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
-                                  .inst_size = sizeof(n_dev_t), .create = n_create,
-                                  .sample = n_sample};
-static const product_t n_prod_no_lss = {.id = "services-no-lss", .inputs = {{NULL, NULL, 0, 0}},
-                                         .nodes = 1, .inst_size = sizeof(n_dev_t),
-                                         .create = n_create, .sample = n_sample,
-                                         .variant = &n_no_lss};
+static const product_t n_prod = {.id = "services",
+                                 .inputs = {{NULL, NULL, 0, 0}},
+                                 .nodes = 1,
+                                 .inst_size = sizeof(n_dev_t),
+                                 .create = n_create,
+                                 .sample = n_sample};
+static const product_t n_prod_no_lss = {.id = "services-no-lss",
+                                        .inputs = {{NULL, NULL, 0, 0}},
+                                        .nodes = 1,
+                                        .inst_size = sizeof(n_dev_t),
+                                        .create = n_create,
+                                        .sample = n_sample,
+                                        .variant = &n_no_lss};
 static const product_t n_prod_comm_id = {.id = "services-comm-id",
-                                          .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
-                                          .inst_size = sizeof(n_dev_t), .create = n_create,
-                                          .sample = n_sample, .variant = &n_comm_id};
-static const product_t n_prod_min = {.id = "services-min", .inputs = {{NULL, NULL, 0, 0}},
-                                      .nodes = 1, .inst_size = sizeof(n_dev_t),
-                                      .create = n_create, .sample = n_sample, .variant = &n_min};
+                                         .inputs = {{NULL, NULL, 0, 0}},
+                                         .nodes = 1,
+                                         .inst_size = sizeof(n_dev_t),
+                                         .create = n_create,
+                                         .sample = n_sample,
+                                         .variant = &n_comm_id};
+static const product_t n_prod_min = {.id = "services-min",
+                                     .inputs = {{NULL, NULL, 0, 0}},
+                                     .nodes = 1,
+                                     .inst_size = sizeof(n_dev_t),
+                                     .create = n_create,
+                                     .sample = n_sample,
+                                     .variant = &n_min};
 
 static h_dev_t dev;
 static h_dev_t *const d = &dev;
@@ -254,7 +273,7 @@ static void test_lss_store_in_lss_set(void)
     EXPECT_NONE(d);
     LSS("17 00 00 00 00 00 00 00", "17 00 00 00 00 00 00 00");
     LSS("5E 00 00 00 00 00 00 00", "5E 40 00 00 00 00 00 00"); /* still the active one */
-    LSS("04 00 00 00 00 00 00 00", NULL); /* configured node: no reset */
+    LSS("04 00 00 00 00 00 00 00", NULL);                      /* configured node: no reset */
     h_rx(d, 0x000, "82 40");
     EXPECT(d, 0x725, "00"); /* active from reset communication (CiA 305) */
     h_power_cycle(d);
@@ -395,13 +414,13 @@ static void test_lss_fastscan_ignored_requests(void)
     LSS("4C 00 00 00 00 00 00 00", "50 00 00 00 00 00 00 00");
     LSS("51 78 56 34 12 00 00 00", NULL); /* no restart yet */
     LSS("51 00 00 00 00 80 00 00", "4F 00 00 00 00 00 00 00");
-    LSS("51 00 00 00 00 20 00 00", NULL); /* bit 32 */
-    LSS("51 00 00 00 00 1F 04 00", NULL); /* sub 4 */
-    LSS("51 00 00 00 00 1F 01 00", NULL); /* sub 1 before sub 0 */
+    LSS("51 00 00 00 00 20 00 00", NULL);                      /* bit 32 */
+    LSS("51 00 00 00 00 1F 04 00", NULL);                      /* sub 4 */
+    LSS("51 00 00 00 00 1F 01 00", NULL);                      /* sub 1 before sub 0 */
     LSS("51 00 00 00 00 1F 00 00", "4F 00 00 00 00 00 00 00"); /* bit 31 of 0x12345678: 0 */
-    LSS("51 00 00 00 80 1F 00 00", NULL); /* a 1 there: not us */
+    LSS("51 00 00 00 80 1F 00 00", NULL);                      /* a 1 there: not us */
     LSS("51 78 56 34 12 00 00 01", "4F 00 00 00 00 00 00 00"); /* vendor confirmed */
-    LSS("51 78 56 34 12 00 00 01", NULL); /* sub 0 is done */
+    LSS("51 78 56 34 12 00 00 01", NULL);                      /* sub 0 is done */
     /* In configuration state Fastscan is not for this node. */
     LSS("04 01 00 00 00 00 00 00", NULL);
     LSS("51 00 00 00 00 80 00 00", NULL);
@@ -492,7 +511,7 @@ static void test_life_guard_starts_with_a_request(void)
     h_advance(d, 1000000);
     EXPECT_NONE(d);
     SDO(d, "2F 0D 10 00 02 00 00 00", "60 0D 10 00 00 00 00 00"); /* x 2 */
-    CHECK(co_store_save(d->node, CO_CLS_PARA) == CO_OK); /* kept over the reset */
+    CHECK(co_store_save(d->node, CO_CLS_PARA) == CO_OK);          /* kept over the reset */
     h_drain(d);
     h_rx_frame(d, &rtr);
     EXPECT(d, 0x740, "FF");
@@ -692,10 +711,10 @@ static void test_cia303_led_mapping(void)
     co_node_led_patterns(d->node, &g, &r);
     CHECK(g == CO_LED_OFF);
     /* The names the Linux program logs. */
-    static const char *const names[] = {"off", "on", "flickering", "blinking", "single flash",
-                                        "double flash"};
-    static const co_led_pattern_t pats[] = {CO_LED_OFF, CO_LED_ON, CO_LED_FLICKER, CO_LED_BLINK,
-                                            CO_LED_FLASH1, CO_LED_FLASH2};
+    static const char *const names[] = {"off",      "on",           "flickering",
+                                        "blinking", "single flash", "double flash"};
+    static const co_led_pattern_t pats[] = {CO_LED_OFF,   CO_LED_ON,     CO_LED_FLICKER,
+                                            CO_LED_BLINK, CO_LED_FLASH1, CO_LED_FLASH2};
     for (unsigned i = 0; i < 6u; i++) {
         CHECK(strcmp(co_led_pattern_name(pats[i]), names[i]) == 0);
     }

@@ -95,7 +95,8 @@ static bool receive_one(const stm_can_frame_t *in, co_frame_t *out)
 static bool same_frame(const co_frame_t *a, const stm_can_frame_t *b)
 {
     unsigned n = b->dlc > 8u ? 8u : b->dlc;
-    return a->id == b->id && a->rtr == b->rtr && a->dlc == n && (b->rtr || memcmp(a->data, b->data, n) == 0);
+    return a->id == b->id && a->rtr == b->rtr && a->dlc == n &&
+           (b->rtr || memcmp(a->data, b->data, n) == 0);
 }
 
 static co_frame_t co_frame(uint16_t id, uint8_t dlc, uint8_t seed)
@@ -123,8 +124,8 @@ static uint32_t btr_rate(uint32_t btr, uint32_t *sample_permille)
 /* The bxCAN registers a bit-rate change may touch, as a debugger sees them. */
 static void can_snapshot(uint32_t regs[12])
 {
-    const uint32_t addr[12] = {CAN_MCR, CAN_IER, CAN_FMR, CAN_FM1R, CAN_FS1R, CAN_FFA1R,
-                               CAN_FA1R, CAN_F0R1, CAN_F0R2, CAN_BTR, CAN_TSR, CAN_RF0R};
+    const uint32_t addr[12] = {CAN_MCR,  CAN_IER,  CAN_FMR,  CAN_FM1R, CAN_FS1R, CAN_FFA1R,
+                               CAN_FA1R, CAN_F0R1, CAN_F0R2, CAN_BTR,  CAN_TSR,  CAN_RF0R};
     for (unsigned i = 0; i < 12u; i++) {
         regs[i] = stm_peek32(addr[i]);
     }
@@ -274,19 +275,19 @@ static void test_board_init(void)
     stm_chip_new();
     CHECK(board_init());
     CLEAN();
-    CHECK_EQ(stm_peek32(FLASH_ACR) & 7u, 1);            /* one wait state ... */
-    CHECK_EQ((stm_peek32(RCC_CFGR) >> 2) & 3u, 3);      /* ... before HSI48 is SYSCLK */
-    CHECK_EQ(stm_apb_hz(), 48000000u);                  /* bxCAN's clock */
+    CHECK_EQ(stm_peek32(FLASH_ACR) & 7u, 1);       /* one wait state ... */
+    CHECK_EQ((stm_peek32(RCC_CFGR) >> 2) & 3u, 3); /* ... before HSI48 is SYSCLK */
+    CHECK_EQ(stm_apb_hz(), 48000000u);             /* bxCAN's clock */
     CHECK_EQ(stm_peek32(RCC_APB1ENR) & RCC_APB1ENR_CAN, RCC_APB1ENR_CAN);
     uint32_t moder_a = stm_peek32(GPIO_MODER(GPIOA_BASE));
-    CHECK_EQ((moder_a >> 22) & 0xFu, 0xA);              /* PA11, PA12 alternate */
-    CHECK_EQ(moder_a >> 26, 0x28000000u >> 26);         /* SWD pins PA13, PA14 kept */
+    CHECK_EQ((moder_a >> 22) & 0xFu, 0xA);      /* PA11, PA12 alternate */
+    CHECK_EQ(moder_a >> 26, 0x28000000u >> 26); /* SWD pins PA13, PA14 kept */
     CHECK_EQ((stm_peek32(GPIO_AFRH(GPIOA_BASE)) >> 12) & 0xFFu, 0x44); /* AF4: CAN */
     CHECK_EQ((stm_peek32(GPIO_MODER(GPIOB_BASE)) >> 6) & 0xFu, 0x5);   /* PB3, PB4 out */
-    CHECK_EQ(stm_peek32(SYST_RVR), 47999);              /* 1 ms at 48 MHz */
+    CHECK_EQ(stm_peek32(SYST_RVR), 47999);                             /* 1 ms at 48 MHz */
     CHECK_EQ(stm_peek32(SYST_CSR) & 7u, 7);
-    CHECK_EQ(stm_peek32(NVIC_ISER), 1u << 30);          /* CEC_CAN */
-    CHECK_EQ(stm_can_mode(), STM_CAN_SLEEP);            /* bxCAN left for the bit rate */
+    CHECK_EQ(stm_peek32(NVIC_ISER), 1u << 30); /* CEC_CAN */
+    CHECK_EQ(stm_can_mode(), STM_CAN_SLEEP);   /* bxCAN left for the bit rate */
 }
 
 /* ---- bit timing ------------------------------------------------------------ */
@@ -301,8 +302,8 @@ static void test_bit_timing_every_product_rate(void)
         uint32_t sp;
         CHECK_EQ(btr_rate(btr, &sp), kbps * 1000u);
         CHECK(sp >= 750u && sp <= 900u);
-        CHECK_EQ(btr & 0xC0000000u, 0);                     /* no silent or loop-back mode */
-        CHECK((btr >> 24 & 3u) <= ((btr >> 20) & 7u));     /* SJW <= TS2 */
+        CHECK_EQ(btr & 0xC0000000u, 0);                /* no silent or loop-back mode */
+        CHECK((btr >> 24 & 3u) <= ((btr >> 20) & 7u)); /* SJW <= TS2 */
         CHECK_EQ(stm_peek32(CAN_MCR) & CAN_MCR_ABOM, CAN_MCR_ABOM);
         CHECK_EQ(stm_peek32(CAN_IER), CAN_IER_FMPIE0);
         if (sp < 750u || sp > 900u || btr_rate(btr, &sp) != kbps * 1000u) {
@@ -328,8 +329,8 @@ static void test_bit_rate_accepted_or_refused(void)
             uint32_t sp;
             uint32_t rate = btr_rate(stm_peek32(CAN_BTR), &sp);
             if (rate != k * 1000u || k > 1000u || sp < 750u || sp > 900u) {
-                printf("     %u kbit/s accepted: %u bit/s, sample point %u/1000\n", (unsigned)k, (unsigned)rate,
-                       (unsigned)sp);
+                printf("     %u kbit/s accepted: %u bit/s, sample point %u/1000\n", (unsigned)k,
+                       (unsigned)rate, (unsigned)sp);
                 FAIL("an accepted bit rate that the controller cannot run exactly");
             }
             CHECK_EQ(stm_can_mode(), STM_CAN_NORMAL);
@@ -362,10 +363,10 @@ static void test_bit_rate_change_on_the_bus(void)
     stm_can_frame_t in1 = frame(0x181, 8, 1);
     stm_can_frame_t in2 = frame(0x182, 2, 2);
     CHECK_EQ(stm_can_bus_send(&in1), STM_CAN_FIFO0);
-    CHECK_EQ(irq(), 1);                               /* in the board's queue */
-    CHECK_EQ(stm_can_bus_send(&in2), STM_CAN_FIFO0);  /* in the FIFO, no interrupt yet */
+    CHECK_EQ(irq(), 1);                              /* in the board's queue */
+    CHECK_EQ(stm_can_bus_send(&in2), STM_CAN_FIFO0); /* in the FIFO, no interrupt yet */
     co_frame_t out = co_frame(0x701, 1, 5);
-    CHECK(co_port_can_send(NULL, &out));              /* pending in a mailbox */
+    CHECK(co_port_can_send(NULL, &out)); /* pending in a mailbox */
     const uint16_t next[] = {500, 125, 1000, 10, 250};
     for (unsigned i = 0; i < sizeof(next) / sizeof(next[0]); i++) {
         CHECK(board_can_bitrate(next[i]));
@@ -785,7 +786,8 @@ static void test_time_sleep_leds(void)
             CHECK_EQ(faults, 0);
             for (unsigned i = 0; i < PRODUCT_MAX_INPUTS && p->inputs[i].name != NULL; i++) {
                 int64_t d = (int64_t)values[i] - p->inputs[i].initial;
-                CHECK(d >= -100 * (int64_t)p->inputs[i].limit && d <= 100 * (int64_t)p->inputs[i].limit);
+                CHECK(d >= -100 * (int64_t)p->inputs[i].limit &&
+                      d <= 100 * (int64_t)p->inputs[i].limit);
                 moved = moved || d != 0;
             }
             for (unsigned k = 0; k < 250u; k++) {

@@ -8,8 +8,8 @@
  * precise "too low" (0x06090032) / "too high" (0x06090031), as for every
  * product of this firmware; other rejected values 0x06090030.
  */
-#include "pf.h"
 #include "harness.h"
+#include "pf.h"
 
 static h_dev_t dev;
 static h_dev_t *const d = &dev;
@@ -47,7 +47,7 @@ static void test_v1_to_v7_boot_and_nmt(void)
     renumber(9);
     CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP); /* never operational by itself (6.1) */
     h_power_cycle(d);
-    EXPECT(d, 0x709, "00"); /* V1 */
+    EXPECT(d, 0x709, "00");  /* V1 */
     h_rx(d, 0x000, "01 09"); /* V4 */
     CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
     h_rx(d, 0x000, "80 09"); /* V2 */
@@ -242,7 +242,8 @@ static void test_v19_v20_guarding_d22_d24(void)
     h_rx_frame(d, &rtr);
     h_drain(d);
     h_advance(d, 310000);
-    EXPECT(d, 0x081, "30 81 11 00 00 00 00 00"); /* CiA 301's 8130h, where the manual prints 3081h */
+    EXPECT(d, 0x081,
+           "30 81 11 00 00 00 00 00"); /* CiA 301's 8130h, where the manual prints 3081h */
     CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
     h_rx_frame(d, &rtr);
     EXPECT(d, 0x701, "FF"); /* next guard answer: pre-operational */

@@ -581,7 +581,8 @@ static void test_saved_set_independent_of_memory(void)
     for (size_t i = 0; product_list[i] != NULL; i++) {
         for (unsigned k = 0; k < 2u; k++) {
             (void)power_on_answers(product_list[i], k == 0u ? 0x00 : 0xA5, scratch.saved.out);
-            co_frame_t f = {.id = (uint16_t)(0x600u + d->node->node_id), .dlc = 8,
+            co_frame_t f = {.id = (uint16_t)(0x600u + d->node->node_id),
+                            .dlc = 8,
                             .data = {0x23, 0x10, 0x10, 0x01, 0x73, 0x61, 0x76, 0x65}};
             h_drain(d);
             co_node_receive(d->node, &f, d->now);

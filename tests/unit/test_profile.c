@@ -117,8 +117,9 @@ static void test_incl_limit_edges(void)
     static const struct {
         int32_t in, out;
         bool beyond;
-    } cases[] = {{-45000, -4500, false}, {45000, 4500, false}, {-45001, -4500, true},
-                 {45001, 4500, true}, {-45100, -4500, true}, {45100, 4500, true}, {0, 0, false}};
+    } cases[] = {{-45000, -4500, false}, {45000, 4500, false},  {-45001, -4500, true},
+                 {45001, 4500, true},    {-45100, -4500, true}, {45100, 4500, true},
+                 {0, 0, false}};
     for (unsigned i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
         co_incl_t in;
         co_incl_init(&in, &p, 2, 45000, false);
@@ -307,7 +308,8 @@ static void test_incl_output_fits(void)
     CHECK_EQ(co_incl_output(30000, sc, 2000, 1000, i16), 32767);
     CHECK_EQ(co_incl_output(30000, sc, 2000, 1000, i32), 33000);
     CHECK_EQ(co_incl_output(-30000, sc, -2000, -1000, i16), -32768);
-    CHECK_EQ(co_incl_output(1, sc, INT32_MAX, INT32_MAX, i32), INT32_MAX); /* exact sum, saturated */
+    CHECK_EQ(co_incl_output(1, sc, INT32_MAX, INT32_MAX, i32),
+             INT32_MAX); /* exact sum, saturated */
     CHECK_EQ(co_incl_output(-1, sc, INT32_MIN, INT32_MIN, i32), INT32_MIN);
     CHECK_EQ(co_incl_output(5, sc, INT32_MAX, INT32_MIN, i32), 4);
     /* Circular: modulo the turn, 0..turn-1, whatever the offsets hold. */
@@ -527,22 +529,14 @@ static void test_led_cycles(void)
         bool on;
         uint32_t next;
     } cases[] = {
-        {CO_LED_FLASH2, 1600000, true, 200000},
-        {CO_LED_FLICKER, 50000, false, 50000},
-        {CO_LED_FLICKER, 100000, true, 50000},
-        {CO_LED_FLASH2, 1800000, false, 200000},
-        {CO_LED_FLICKER, 149999, true, 1},
-        {CO_LED_FLICKER, 150000, false, 50000},
-        {CO_LED_FLASH2, 2000000, true, 200000},
-        {CO_LED_BLINK, 400000, true, 200000},
-        {CO_LED_BLINK, 600000, false, 200000},
-        {CO_LED_FLASH2, 2200000, false, 1000000},
-        {CO_LED_BLINK, 4399999, false, 1},
-        {CO_LED_FLASH2, 161599999, false, 1},
-        {CO_LED_FLASH1, 1200000, true, 200000},
-        {CO_LED_FLASH1, 1400000, false, 1000000},
-        {CO_LED_FLASH2, 1000000, false, 600000},
-        {CO_LED_FLASH1, 15799999, true, 1},
+        {CO_LED_FLASH2, 1600000, true, 200000},  {CO_LED_FLICKER, 50000, false, 50000},
+        {CO_LED_FLICKER, 100000, true, 50000},   {CO_LED_FLASH2, 1800000, false, 200000},
+        {CO_LED_FLICKER, 149999, true, 1},       {CO_LED_FLICKER, 150000, false, 50000},
+        {CO_LED_FLASH2, 2000000, true, 200000},  {CO_LED_BLINK, 400000, true, 200000},
+        {CO_LED_BLINK, 600000, false, 200000},   {CO_LED_FLASH2, 2200000, false, 1000000},
+        {CO_LED_BLINK, 4399999, false, 1},       {CO_LED_FLASH2, 161599999, false, 1},
+        {CO_LED_FLASH1, 1200000, true, 200000},  {CO_LED_FLASH1, 1400000, false, 1000000},
+        {CO_LED_FLASH2, 1000000, false, 600000}, {CO_LED_FLASH1, 15799999, true, 1},
     };
     for (unsigned i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
         uint32_t next = 0;

@@ -27,6 +27,7 @@ typedef struct e_dev {
 #define P(f) CO_AT(CO_CLS_PARA, e_para_t, f)
 #define HIST CO_EXT(.read = co_emcy_read_hist)
 
+/* clang-format off */
 static const co_od_entry_t e_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x00000191u},
     {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_read_register)},
@@ -58,12 +59,15 @@ static const co_od_entry_t e_entries[] = {
     /* A string of one whole segment. */
     {.index = 0x200C, .sub = 0, CO_TYPE_STR("7 bytes"), .attr = CO_A_R},
 };
+/* clang-format on */
 
-static const co_od_t e_od = {.entries = e_entries, .count = sizeof(e_entries) / sizeof(e_entries[0])};
+static const co_od_t e_od = {.entries = e_entries,
+                             .count = sizeof(e_entries) / sizeof(e_entries[0])};
 
 static const co_node_cfg_t e_cfg = {
     .od = &e_od,
-    .sdo_segmented = co_sdo_segmented, .sdo_block = co_sdo_block,
+    .sdo_segmented = co_sdo_segmented,
+    .sdo_block = co_sdo_block,
     .ram_size = {0, 0, sizeof(e_para_t), 0},
     .default_node_id = 0x20,
 };
@@ -85,9 +89,12 @@ static void e_sample(void *mem, const int32_t v[], uint32_t fault)
     (void)fault;
 }
 
-static const product_t e_prod = {.id = "sdo-edge", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
-                                  .inst_size = sizeof(e_dev_t), .create = e_create,
-                                  .sample = e_sample};
+static const product_t e_prod = {.id = "sdo-edge",
+                                 .inputs = {{NULL, NULL, 0, 0}},
+                                 .nodes = 1,
+                                 .inst_size = sizeof(e_dev_t),
+                                 .create = e_create,
+                                 .sample = e_sample};
 
 static h_dev_t dev;
 static h_dev_t *const d = &dev;
@@ -383,8 +390,10 @@ static void test_block_download_segments(void)
      * string refuses the write, and the node runs on. */
     SDO(d, "C2 0A 20 00 40 00 00 00", "A4 0A 20 00 0A 00 00 00"); /* no CRC */
     for (unsigned k = 1; k <= 10u; k++) {
-        co_frame_t f = {.id = 0x620, .dlc = 8, .data = {(uint8_t)(k | (k == 10u ? 0x80u : 0u)),
-                                                        0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF}};
+        co_frame_t f = {.id = 0x620,
+                        .dlc = 8,
+                        .data = {(uint8_t)(k | (k == 10u ? 0x80u : 0u)), 0xFF, 0xFF, 0xFF, 0xFF,
+                                 0xFF, 0xFF, 0xFF}};
         h_rx_frame(d, &f);
     }
     EXPECT(d, 0x5A0, "A2 0A 0A 00 00 00 00 00");
@@ -621,12 +630,14 @@ static void test_od_api_checks(void)
  * after sub 0, a one-entry object followed by one with a hole (its sub 2
  * sits where the one-entry object's sub 2 would be), an object without
  * sub 0, and a record with holes at both ends of its sub-indices. */
+/* clang-format off */
 #define F(i, s) {.index = (i), .sub = (s), CO_TYPE_U8, .attr = CO_A_R}
 static const co_od_entry_t f_entries[] = {
     F(0x1000, 0), F(0x1000, 2), F(0x1001, 0), F(0x1002, 0), F(0x1002, 2), F(0x1002, 3),
     F(0x1004, 1), F(0x1004, 2), F(0x1005, 0), F(0x1006, 0), F(0x1006, 1), F(0x1006, 3),
     F(0x1006, 5), F(0x1007, 0),
 };
+/* clang-format on */
 
 /* co_od_find on every prefix of that table (each a table of its own, so
  * the search meets every shape at every place) finds exactly the entries
@@ -661,14 +672,16 @@ static void test_od_find_every_shape(void)
 /* co_od_defaults sets every entry of the class whose index lies in
  * [lo, hi], both ends included, the table's first entry too, and no
  * other entry. A node of its own on a table of three PARA objects. */
+/* clang-format off */
 static const co_od_entry_t g_entries[] = {
     {.index = 0x2000, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, P(u32), .def = 100},
     {.index = 0x2001, .sub = 0, CO_TYPE_U16, .attr = CO_A_R, P(ro), .def = 7},
     {.index = 0x2003, .sub = 0, CO_TYPE_I8, .attr = CO_A_RW, P(i8), .def = (uint32_t)-3},
 };
+/* clang-format on */
 static const co_od_t g_od = {.entries = g_entries, .count = 3};
-static const co_node_cfg_t g_cfg = {.od = &g_od, .ram_size = {0, 0, sizeof(e_para_t), 0},
-                                    .default_node_id = 0x21};
+static const co_node_cfg_t g_cfg = {
+    .od = &g_od, .ram_size = {0, 0, sizeof(e_para_t), 0}, .default_node_id = 0x21};
 
 static void test_od_defaults_range(void)
 {

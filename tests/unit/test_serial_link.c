@@ -72,7 +72,7 @@ static void test_frames_in(void)
     CHECK_EQ(FEED("t60A84000100000000000\r", &f), 1);
     CHECK(f.id == 0x60A && f.dlc == 8 && !f.rtr && f.data[0] == 0x40 && f.data[1] == 0x00 &&
           f.data[2] == 0x10);
-    CHECK_EQ(out[0], '\0'); /* frames are not answered */
+    CHECK_EQ(out[0], '\0');               /* frames are not answered */
     CHECK_EQ(FEED("t0002810a\n", &f), 1); /* lower-case hex, LF ends a line too */
     CHECK(f.id == 0 && f.dlc == 2 && f.data[0] == 0x81 && f.data[1] == 0x0A);
     CHECK_EQ(FEED("r70A0\r", &f), 1);
@@ -126,10 +126,10 @@ static void test_set(void)
     CHECK_EQ(s.values[0], 3600000);
     CHECK_EQ(s.values[1], -3600000);
     /* Rejected whole: nothing of the line changes anything. */
-    static const char *const bad[] = {"set x=1 y=3600.001", "set x=1 y=abc", "set x=1 q=2",
-                                      "set x=1 y", "set x=1 y=", "set x=1 y=1.2345",
-                                      "set x=99999999999999", "set x=1 y=-", "set x=1 y=.",
-                                      "set x=1 y=1e3", "set x=1 =5"};
+    static const char *const bad[] = {
+        "set x=1 y=3600.001", "set x=1 y=abc",        "set x=1 q=2", "set x=1 y",   "set x=1 y=",
+        "set x=1 y=1.2345",   "set x=99999999999999", "set x=1 y=-", "set x=1 y=.", "set x=1 y=1e3",
+        "set x=1 =5"};
     for (unsigned i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
         char line[64];
         size_t n = length(bad[i]);
@@ -223,8 +223,8 @@ static void test_get_and_commands_not_here(void)
     serial_link_init(&s, &gsh_a);
     CHECK_EQ(FEED("get\r", &f), 0);
     CHECK(starts(out, "ok length="));
-    static const char *const lines[] = {"ramp x=30 in 5s", "sine x amp=1 period=1s",
-                                        "noise x sd=1", "replay a.csv", "quit"};
+    static const char *const lines[] = {"ramp x=30 in 5s", "sine x amp=1 period=1s", "noise x sd=1",
+                                        "replay a.csv", "quit"};
     static const char *const answers[] = {
         "error: 'ramp' is not on this target (set, fault, can, get)\r",
         "error: 'sine' is not on this target (set, fault, can, get)\r",
@@ -272,8 +272,9 @@ static void test_can_state_and_bitrate(void)
     CHECK_EQ(FEED("t0002010A\r", &f), 0); /* bus-off: no frame received */
     CHECK_EQ(serial_link_can_state(&s, 1408), CO_CAN_ACTIVE);
     CHECK_EQ(FEED("t0002010A\r", &f), 1); /* back on the bus */
-    static const char *const bad[] = {"can bus-off 61", "can bus-off -1", "can passive 1",
-                                      "can nothing", "can", "can bus-off 1 2"};
+    static const char *const bad[] = {
+        "can bus-off 61", "can bus-off -1", "can passive 1", "can nothing", "can",
+        "can bus-off 1 2"};
     for (unsigned i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
         char line[32];
         size_t n = length(bad[i]);
@@ -451,7 +452,10 @@ static void test_get_digits_and_fault_usage(void)
  * and forces within the lists. */
 static const product_t full = {
     .id = "test-full",
-    .inputs = {{"a", "u", 1500, 10}, {"b", "u", -2000, 10}, {"c", "u", 3, 10}, {"d", "u", 4000, 10}},
+    .inputs = {{"a", "u", 1500, 10},
+               {"b", "u", -2000, 10},
+               {"c", "u", 3, 10},
+               {"d", "u", 4000, 10}},
     .faults = {"f0", "f1", "f2", "f3"},
     .nodes = 1,
 };

@@ -179,8 +179,8 @@ static void test_model_catches_violations(void)
     }
     CHECK(!sja_model_rx(&m, 5, false, false, 8, d));
     CHECK(sja_model_rx(&m, 6, false, false, 6, d)); /* 9 bytes fit */
-    CHECK_EQ(sja_model_read(&m, 2) & 0x03, 0x03);  /* RBS DOS */
-    CHECK_EQ(sja_model_read(&m, 3) & 0x08, 0x08);  /* DOI */
+    CHECK_EQ(sja_model_read(&m, 2) & 0x03, 0x03);   /* RBS DOS */
+    CHECK_EQ(sja_model_read(&m, 3) & 0x08, 0x08);   /* DOI */
     sja_model_write(&m, 1, 0x08);
     CHECK_EQ(sja_model_read(&m, 2) & 0x02, 0x00);
     /* reset mode empties the FIFO and counts the entry */
@@ -355,8 +355,8 @@ static bool check_timing(uint32_t clk, uint16_t kbps, bool in_window_expected)
     CHECK_EQ(n, nq);           /* and of those, the most quanta */
     bool in_window = 100u * (1u + t1) >= 85u * n && 100u * (1u + t1) <= 90u * n;
     if (in_window != in_window_expected) {
-        fprintf(stderr, "%u Hz %u kbit/s: %u quanta, sample point %u/%u\n", (unsigned)clk, kbps,
-                n, 1u + t1, n);
+        fprintf(stderr, "%u Hz %u kbit/s: %u quanta, sample point %u/%u\n", (unsigned)clk, kbps, n,
+                1u + t1, n);
     }
     CHECK_EQ(in_window, in_window_expected);
     return true;
@@ -457,8 +457,8 @@ static void test_timing_every_rate_and_refusals(void)
     uint8_t b0 = 0xEE, b1 = 0xDD;
     CHECK(!sja1000_timing(16000000u, 0, &b0, &b1));
     CHECK(!sja1000_timing(0, 125, &b0, &b1));
-    CHECK(!sja1000_timing(16000000u, 1, &b0, &b1));   /* 8000 = 64 x 125: too slow */
-    CHECK(!sja1000_timing(16000000u, 7, &b0, &b1));   /* not a divisor */
+    CHECK(!sja1000_timing(16000000u, 1, &b0, &b1));    /* 8000 = 64 x 125: too slow */
+    CHECK(!sja1000_timing(16000000u, 7, &b0, &b1));    /* not a divisor */
     CHECK(!sja1000_timing(16000000u, 1600, &b0, &b1)); /* 5 clocks a bit */
     CHECK(b0 == 0xEE && b1 == 0xDD);
 }
@@ -495,13 +495,13 @@ static void test_init(void)
     up_at(16000000u, 250u);
     uint8_t b0 = 0, b1 = 0;
     CHECK(sja1000_timing(16000000u, 250, &b0, &b1));
-    CHECK_EQ(m.cdr & 0x80, 0x80);    /* PeliCAN */
-    CHECK_EQ(m.mod & 0x01, 0x00);    /* operating mode */
-    CHECK_EQ(m.mod & 0x16, 0x00);    /* not listen-only, self-test or sleep */
-    CHECK(m.reset_entries <= 1u);    /* BasicCAN after a hardware reset: in reset mode already */
+    CHECK_EQ(m.cdr & 0x80, 0x80); /* PeliCAN */
+    CHECK_EQ(m.mod & 0x01, 0x00); /* operating mode */
+    CHECK_EQ(m.mod & 0x16, 0x00); /* not listen-only, self-test or sleep */
+    CHECK(m.reset_entries <= 1u); /* BasicCAN after a hardware reset: in reset mode already */
     CHECK_EQ(m.btr0, b0);
     CHECK_EQ(m.btr1, b1);
-    CHECK_EQ(m.ocr, 0x1A);           /* normal output mode, TX0 push-pull */
+    CHECK_EQ(m.ocr, 0x1A); /* normal output mode, TX0 push-pull */
     /* receive, transmit, error warning, data overrun, error passive; not
      * bus error or arbitration lost (nor wake-up: sleep is never used) */
     CHECK_EQ(m.ier & 0xEFu, 0x2F);
@@ -989,8 +989,8 @@ static void test_filter_two_nodes_and_long_lists(void)
     }
     CHECK_EQ(check_list(cl, 16, false), 16); /* each cluster its filter: the fewest */
     /* two clusters of 8 each, their IDs mixed, the first not 0: the same */
-    static const uint16_t mixed_a[] = {0x5EE, 0x5EC, 0x5EB, 0x5EA, 0x606, 0x5ED, 0x607, 0x5E9,
-                                       0x602, 0x5EF, 0x605, 0x5E8, 0x600, 0x604};
+    static const uint16_t mixed_a[] = {0x5EE, 0x5EC, 0x5EB, 0x5EA, 0x606, 0x5ED, 0x607,
+                                       0x5E9, 0x602, 0x5EF, 0x605, 0x5E8, 0x600, 0x604};
     static const uint16_t mixed_b[] = {0x0FA, 0x551, 0x556, 0x557, 0x552, 0x555, 0x550, 0x0F9,
                                        0x553, 0x0FD, 0x554, 0x0FE, 0x0FF, 0x0FB, 0x0FC, 0x0F8};
     co_rx_id_t mixed[16];
@@ -1007,15 +1007,15 @@ static void test_filter_two_nodes_and_long_lists(void)
     /* Nodes 3 and 2 (guarding, an RPDO each, node 3 consuming node 2's
      * heartbeat, TPDO 1 by remote request on node 2): 22 CAN-IDs pass,
      * the fewest two filters can (the first of the splits of least cost). */
-    static const co_rx_id_t nodes_32[] = {
-        {0x000, false}, {0x080, false}, {0x603, false}, {0x703, true}, {0x203, false},
-        {0x702, false}, {0x602, false}, {0x182, true}, {0x282, false}};
+    static const co_rx_id_t nodes_32[] = {{0x000, false}, {0x080, false}, {0x603, false},
+                                          {0x703, true},  {0x203, false}, {0x702, false},
+                                          {0x602, false}, {0x182, true},  {0x282, false}};
     CHECK_EQ(check_list(nodes_32, sizeof nodes_32 / sizeof nodes_32[0], false), 22);
     /* 13 entries, 12 CAN-IDs (0x72C both kinds: guarding and a heartbeat
      * consumed on it): the exact choice, as for any 12 CAN-IDs. */
     static const co_rx_id_t nodes_12[] = {
         {0x000, false}, {0x080, false}, {0x7E5, false}, {0x62C, false}, {0x72C, true},
-        {0x1AC, true}, {0x2AC, false}, {0x709, false}, {0x63E, false}, {0x73E, true},
+        {0x1AC, true},  {0x2AC, false}, {0x709, false}, {0x63E, false}, {0x73E, true},
         {0x23E, false}, {0x73D, false}, {0x72C, false}};
     CHECK_EQ(check_list(nodes_12, sizeof nodes_12 / sizeof nodes_12[0], false), 480);
     /* the same, the doubled one first (after another list) */
@@ -1028,13 +1028,13 @@ static void test_filter_two_nodes_and_long_lists(void)
     /* Two nodes with PDOs and heartbeat consumers, 15 and 13 CAN-IDs: the
      * greedy choice no worse than now (the fewest: 768 and 1024). */
     static const co_rx_id_t nodes_a[] = {
-        {0x000, false}, {0x080, false}, {0x7E5, false},
-        {0x659, false}, {0x759, true}, {0x1D9, true}, {0x259, false}, {0x754, false}, {0x2D9, false},
-        {0x657, false}, {0x757, true}, {0x1D7, true}, {0x257, false}, {0x751, false}, {0x2D7, false}};
+        {0x000, false}, {0x080, false}, {0x7E5, false}, {0x659, false}, {0x759, true},
+        {0x1D9, true},  {0x259, false}, {0x754, false}, {0x2D9, false}, {0x657, false},
+        {0x757, true},  {0x1D7, true},  {0x257, false}, {0x751, false}, {0x2D7, false}};
     static const co_rx_id_t nodes_b[] = {
-        {0x000, false}, {0x080, false}, {0x7E5, false},
-        {0x635, false}, {0x735, true}, {0x1B5, true}, {0x235, false}, {0x72D, false}, {0x2B5, false},
-        {0x646, false}, {0x746, true}, {0x1C6, true}, {0x73B, false}};
+        {0x000, false}, {0x080, false}, {0x7E5, false}, {0x635, false}, {0x735, true},
+        {0x1B5, true},  {0x235, false}, {0x72D, false}, {0x2B5, false}, {0x646, false},
+        {0x746, true},  {0x1C6, true},  {0x73B, false}};
     CHECK(check_list(nodes_a, sizeof nodes_a / sizeof nodes_a[0], false) <= 768u);
     CHECK(check_list(nodes_b, sizeof nodes_b / sizeof nodes_b[0], false) <= 1280u);
     /* one more: the filter opens, nothing is dropped */

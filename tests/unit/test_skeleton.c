@@ -4,8 +4,8 @@
  * with the family's fixed config and table sizes (unit.fixed.skel_cfg.*),
  * and on the emulated Cortex-M0 (qemu.*), like every family's tests.
  */
-#include "skeleton.h"
 #include "harness.h"
+#include "skeleton.h"
 
 static h_dev_t dev;
 static h_dev_t *const d = &dev;
@@ -16,7 +16,7 @@ static void test_boot_and_identity(void)
     h_boot(d, &skel_incl, false);
     EXPECT(d, 0x720, "00");
     CHECK_EQ(co_node_nmt_state(d->node), CO_NMT_PREOP);
-    CHECK_EQ(d->port.kbps, 250); /* the default bit-rate code 3 */
+    CHECK_EQ(d->port.kbps, 250);                       /* the default bit-rate code 3 */
     CHECK_EQ(co_node_poll(d->node, d->now), CO_NEVER); /* nothing due: no poll asked for */
     SDO(d, "40 00 10 00 00 00 00 00", "43 00 10 00 9A 01 00 00"); /* device type: CiA 410 */
     SDO(d, "40 18 10 02 00 00 00 00", "43 18 10 02 01 00 00 00"); /* product code */
@@ -106,7 +106,7 @@ static void test_store(void)
     h_power_cycle(d);
     CHECK_EQ(h_read(d, 0x1017, 0), 500);
     SDO(d, "23 11 10 01 6C 6F 61 64", "60 11 10 01 00 00 00 00"); /* "load" */
-    CHECK_EQ(h_read(d, 0x1017, 0), 500); /* until the next reset */
+    CHECK_EQ(h_read(d, 0x1017, 0), 500);                          /* until the next reset */
     h_power_cycle(d);
     CHECK_EQ(h_read(d, 0x1017, 0), 0);
 }
@@ -121,14 +121,14 @@ static void test_dictionary_defaults(void)
         uint8_t sub;
         long long value; /* -1: absent */
     } objs[] = {
-        {0x1000, 0, 0x19A},      {0x1001, 0, 0},          {0x1010, 0, 1},  {0x1010, 1, 1},
-        {0x1010, 2, -1},         {0x1011, 0, 1},          {0x1011, 1, 1},  {0x1011, 2, -1},
-        {0x1017, 0, 0},          {0x1018, 0, 4},          {0x1018, 1, 0},  {0x1018, 2, 1},
-        {0x1018, 3, 0x00010000}, {0x1018, 4, 0},          {0x1018, 5, -1}, {0x1800, 0, 5},
-        {0x1800, 1, 0x1A0},      {0x1800, 2, 254},        {0x1800, 3, -1}, {0x1800, 4, -1},
-        {0x1800, 5, 0},          {0x1A00, 0, 1},          {0x1A00, 1, 0x60100010},
-        {0x1A00, 2, -1},         {0x6000, 0, 10},         {0x6010, 0, 0},  {0x6011, 0, 0},
-        {0x6012, 0, 0},          {0x6013, 0, 0},          {0x6014, 0, 0},  {0x6015, 0, -1},
+        {0x1000, 0, 0x19A},      {0x1001, 0, 0},   {0x1010, 0, 1},          {0x1010, 1, 1},
+        {0x1010, 2, -1},         {0x1011, 0, 1},   {0x1011, 1, 1},          {0x1011, 2, -1},
+        {0x1017, 0, 0},          {0x1018, 0, 4},   {0x1018, 1, 0},          {0x1018, 2, 1},
+        {0x1018, 3, 0x00010000}, {0x1018, 4, 0},   {0x1018, 5, -1},         {0x1800, 0, 5},
+        {0x1800, 1, 0x1A0},      {0x1800, 2, 254}, {0x1800, 3, -1},         {0x1800, 4, -1},
+        {0x1800, 5, 0},          {0x1A00, 0, 1},   {0x1A00, 1, 0x60100010}, {0x1A00, 2, -1},
+        {0x6000, 0, 10},         {0x6010, 0, 0},   {0x6011, 0, 0},          {0x6012, 0, 0},
+        {0x6013, 0, 0},          {0x6014, 0, 0},   {0x6015, 0, -1},
     };
     h_boot(d, &skel_incl, false);
     for (unsigned i = 0; i < sizeof(objs) / sizeof(objs[0]); i++) {
@@ -168,7 +168,7 @@ static void test_resolution(void)
     SDO(d, "2B 00 60 00 64 00 00 00", "80 00 60 00 22 00 00 08"); /* scaling off */
     SDO(d, "2F 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00");
     SDO(d, "2B 12 60 00 00 00 00 00", "60 12 60 00 00 00 00 00"); /* preset 0 */
-    CHECK_EQ((int16_t)h_read(d, 0x6013, 0), -1235); /* 0 - 12.345 deg in 0.01 */
+    CHECK_EQ((int16_t)h_read(d, 0x6013, 0), -1235);               /* 0 - 12.345 deg in 0.01 */
     static const char *const refused[] = {"2B 00 60 00 00 00 00 00", "2B 00 60 00 02 00 00 00",
                                           "2B 00 60 00 09 00 00 00", "2B 00 60 00 0B 00 00 00",
                                           "2B 00 60 00 65 00 00 00", "2B 00 60 00 E9 03 00 00"};

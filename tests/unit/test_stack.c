@@ -39,6 +39,7 @@ typedef struct t_dev {
 #define V(f) CO_AT(CO_CLS_VOL, t_vol_t, f)
 #define TPW CO_EXT(.write = co_tpdo_write_comm)
 
+/* clang-format off */
 static const co_od_entry_t t_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0x12345678u},
     {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_read_register)},
@@ -76,15 +77,18 @@ static const co_od_entry_t t_entries[] = {
     {.index = 0x2002, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, V(scratch), .def = 7},
     {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, V(counter), .def = 0},
 };
+/* clang-format on */
 
-static const co_od_t t_od = {.entries = t_entries, .count = sizeof(t_entries) / sizeof(t_entries[0])};
+static const co_od_t t_od = {.entries = t_entries,
+                             .count = sizeof(t_entries) / sizeof(t_entries[0])};
 
 static const co_service_t *const t_services[] = {&co_guard_service, &co_rtr_service, NULL};
 
 static const co_node_cfg_t t_cfg = {
     .od = &t_od,
     .services = t_services,
-    .sdo_segmented = co_sdo_segmented, .sdo_block = co_sdo_block,
+    .sdo_segmented = co_sdo_segmented,
+    .sdo_block = co_sdo_block,
     .ram_size = {0, sizeof(t_vol_t), sizeof(t_para_t), sizeof(co_lss_para_t)},
     .default_node_id = 0x10,
 };
@@ -106,8 +110,11 @@ static void t_sample(void *mem, const int32_t v[], uint32_t fault)
     ((t_dev_t *)mem)->vol.counter++;
 }
 
-static const product_t t_prod = {.id = "test", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
-                                 .inst_size = sizeof(t_dev_t), .create = t_create,
+static const product_t t_prod = {.id = "test",
+                                 .inputs = {{NULL, NULL, 0, 0}},
+                                 .nodes = 1,
+                                 .inst_size = sizeof(t_dev_t),
+                                 .create = t_create,
                                  .sample = t_sample};
 
 static h_dev_t dev;
@@ -461,8 +468,8 @@ static void test_reset_comm_keeps_application(void)
     SDO(d, "2B 01 20 00 03 00 00 00", "60 01 20 00 00 00 00 00"); /* PARA, app area */
     h_rx(d, 0x000, "82 10");
     EXPECT(d, 0x710, "00");
-    CHECK_EQ(h_read(d, 0x1017, 0), 0);   /* communication: back to stored */
-    CHECK_EQ(h_read(d, 0x2002, 0), 9);   /* application: untouched */
+    CHECK_EQ(h_read(d, 0x1017, 0), 0); /* communication: back to stored */
+    CHECK_EQ(h_read(d, 0x2002, 0), 9); /* application: untouched */
     CHECK_EQ(h_read(d, 0x2001, 0), 3);
     h_rx(d, 0x000, "81 10");
     EXPECT(d, 0x710, "00");
@@ -666,7 +673,7 @@ static void test_contract_broken_changes_nothing(void)
     memcpy(&before, n, sizeof(before));
     unsigned seen = h_asserts;
     h_expect_assert(9);
-    co_node_set_id(n, 0x20);        /* pre-operational: not in a reset */
+    co_node_set_id(n, 0x20); /* pre-operational: not in a reset */
     co_node_set_bitrate(n, 1);
     co_node_set_autostart(n, true);
     co_tpdo_set_msb_first(n, CO_TPDO_MAX, true);
@@ -769,7 +776,7 @@ static void test_node_guarding(void)
     CHECK_EQ(h_read(d, 0x1001, 0), 0x11);
     h_drain(d);
     h_rx_frame(d, &rtr);
-    EXPECT(d, 0x710, "7F"); /* toggles on from the answer before the loss */
+    EXPECT(d, 0x710, "7F");                     /* toggles on from the answer before the loss */
     EXPECT(d, 0x90, "00 00 00 00 00 00 00 00"); /* error reset */
     CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP); /* no way back by itself */
     /* With the heartbeat on, guard requests get no answer (CiA 301). */
@@ -1133,10 +1140,10 @@ static void test_tpdo_cobid_and_mapping_rules(void)
 }
 
 /* The next sent frame has this CAN-ID (its data vary with the clock). */
-#define NEXT_IS(id_)                                                                    \
-    do {                                                                                \
-        const co_frame_t *f_ = h_next(d);                                               \
-        CHECK(f_ != NULL && f_->id == (id_));                                           \
+#define NEXT_IS(id_)                                                                               \
+    do {                                                                                           \
+        const co_frame_t *f_ = h_next(d);                                                          \
+        CHECK(f_ != NULL && f_->id == (id_));                                                      \
     } while (0)
 
 /* Let time pass without sensor samples (long spans: hours of virtual time
@@ -1334,8 +1341,8 @@ static void test_emcy_cobid_restricted_and_as_written(void)
  */
 typedef struct b_vol {
     uint32_t counter;
-    uint8_t type3;  /* 0x1802 sub 2 */
-    uint8_t count3; /* 0x1A02 sub 0 */
+    uint8_t type3;    /* 0x1802 sub 2 */
+    uint8_t count3;   /* 0x1A02 sub 0 */
     uint32_t map3[3]; /* 0x1A02 sub 1..3 */
     uint32_t w[2];    /* 0x2300, 0x2301 */
 } b_vol_t;
@@ -1345,6 +1352,7 @@ typedef struct b_dev {
     b_vol_t vol;
 } b_dev_t;
 
+/* clang-format off */
 static const co_od_entry_t b_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
     {.index = 0x1001, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, CO_EXT(.read = co_emcy_read_register)},
@@ -1365,8 +1373,10 @@ static const co_od_entry_t b_entries[] = {
     {.index = 0x2200, .sub = 1, CO_TYPE_U8, .attr = CO_A_R | CO_A_PDO, .def = 0x11},
     {.index = 0x2200, .sub = 2, CO_TYPE_U16, .attr = CO_A_R | CO_A_PDO, .def = 0x2233},
 };
+/* clang-format on */
 
-static const co_od_t b_od = {.entries = b_entries, .count = sizeof(b_entries) / sizeof(b_entries[0])};
+static const co_od_t b_od = {.entries = b_entries,
+                             .count = sizeof(b_entries) / sizeof(b_entries[0])};
 
 static const co_service_t *const b_services[] = {&co_guard_service, NULL};
 
@@ -1394,9 +1404,13 @@ static void b_sample(void *mem, const int32_t v[], uint32_t fault)
     ((b_dev_t *)mem)->vol.counter++;
 }
 
-static const product_t b_prod = {.id = "bare", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
-                                 .inst_size = sizeof(b_dev_t), .create = b_create,
-                                 .sample = b_sample, .cfg = &b_cfg};
+static const product_t b_prod = {.id = "bare",
+                                 .inputs = {{NULL, NULL, 0, 0}},
+                                 .nodes = 1,
+                                 .inst_size = sizeof(b_dev_t),
+                                 .create = b_create,
+                                 .sample = b_sample,
+                                 .cfg = &b_cfg};
 
 static void test_bare_node_defaults(void)
 {
@@ -1438,6 +1452,7 @@ static void test_bare_node_defaults(void)
  * more than the 1 ms co_node_cfg_t allows, so it counts as 1 ms. TPDO2
  * maps eight objects, the most a PDO holds.
  */
+/* clang-format off */
 static const co_od_entry_t c_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
     {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, .def = 0x80, CO_EXT(.write = co_sync_write_cobid)},
@@ -1469,8 +1484,10 @@ static const co_od_entry_t c_entries[] = {
     {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, counter)},
     {.index = 0x2101, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_PDO, .def = 0x5A},
 };
+/* clang-format on */
 
-static const co_od_t c_od = {.entries = c_entries, .count = sizeof(c_entries) / sizeof(c_entries[0])};
+static const co_od_t c_od = {.entries = c_entries,
+                             .count = sizeof(c_entries) / sizeof(c_entries[0])};
 
 static const co_node_cfg_t c_cfg = {
     .od = &c_od,
@@ -1479,9 +1496,13 @@ static const co_node_cfg_t c_cfg = {
     .inhibit_unit_us = 5000, /* counts as 1000 (co_node_cfg_t) */
 };
 
-static const product_t c_prod = {.id = "constants", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
-                                 .inst_size = sizeof(b_dev_t), .create = b_create,
-                                 .sample = b_sample, .cfg = &c_cfg};
+static const product_t c_prod = {.id = "constants",
+                                 .inputs = {{NULL, NULL, 0, 0}},
+                                 .nodes = 1,
+                                 .inst_size = sizeof(b_dev_t),
+                                 .create = b_create,
+                                 .sample = b_sample,
+                                 .cfg = &c_cfg};
 
 static void test_constant_parameters_refuse_writes(void)
 {
@@ -1645,6 +1666,7 @@ static void test_tpdo_unusable_default_mapping_after_reset(void)
 /* A mapping without its communication parameters (no 0x1800) is no TPDO,
  * nor is one whose default mapping holds more than 8 bytes (TPDO2: 9):
  * nothing is sent on an event, a SYNC or a remote request. */
+/* clang-format off */
 static const co_od_entry_t m_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
     {.index = 0x1801, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 2},
@@ -1659,8 +1681,10 @@ static const co_od_entry_t m_entries[] = {
     {.index = 0x2100, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, counter)},
     {.index = 0x2101, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_PDO, .def = 0x5A},
 };
+/* clang-format on */
 
-static const co_od_t m_od = {.entries = m_entries, .count = sizeof(m_entries) / sizeof(m_entries[0])};
+static const co_od_t m_od = {.entries = m_entries,
+                             .count = sizeof(m_entries) / sizeof(m_entries[0])};
 
 static const co_service_t *const m_services[] = {&co_rtr_service, NULL};
 
@@ -1671,9 +1695,13 @@ static const co_node_cfg_t m_cfg = {
     .default_node_id = 0x20,
 };
 
-static const product_t m_prod = {.id = "mapping only", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
-                                 .inst_size = sizeof(b_dev_t), .create = b_create,
-                                 .sample = b_sample, .cfg = &m_cfg};
+static const product_t m_prod = {.id = "mapping only",
+                                 .inputs = {{NULL, NULL, 0, 0}},
+                                 .nodes = 1,
+                                 .inst_size = sizeof(b_dev_t),
+                                 .create = b_create,
+                                 .sample = b_sample,
+                                 .cfg = &m_cfg};
 
 static void test_mapping_without_tpdo(void)
 {
@@ -1748,6 +1776,7 @@ static void test_tpdo_big_endian_values(void)
 /* Two TPDOs of eight data bytes, two U32 objects: TPDO1 sent at a SYNC
  * when its data changed (type 0), TPDO2 sampled at a SYNC and sent on
  * request (type 252). Every byte counts, the eighth too. */
+/* clang-format off */
 static const co_od_entry_t e_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
     {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 2},
@@ -1765,8 +1794,10 @@ static const co_od_entry_t e_entries[] = {
     {.index = 0x2300, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, w[0])},
     {.index = 0x2301, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_PDO, CO_AT(CO_CLS_VOL, b_vol_t, w[1])},
 };
+/* clang-format on */
 
-static const co_od_t e_od = {.entries = e_entries, .count = sizeof(e_entries) / sizeof(e_entries[0])};
+static const co_od_t e_od = {.entries = e_entries,
+                             .count = sizeof(e_entries) / sizeof(e_entries[0])};
 
 static const co_service_t *const e_services[] = {&co_rtr_service, NULL};
 
@@ -1777,9 +1808,13 @@ static const co_node_cfg_t e_cfg = {
     .default_node_id = 0x20,
 };
 
-static const product_t e_prod = {.id = "eight bytes", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
-                                 .inst_size = sizeof(b_dev_t), .create = b_create,
-                                 .sample = b_sample, .cfg = &e_cfg};
+static const product_t e_prod = {.id = "eight bytes",
+                                 .inputs = {{NULL, NULL, 0, 0}},
+                                 .nodes = 1,
+                                 .inst_size = sizeof(b_dev_t),
+                                 .create = b_create,
+                                 .sample = b_sample,
+                                 .cfg = &e_cfg};
 
 static void test_tpdo_eighth_byte(void)
 {
@@ -1824,6 +1859,7 @@ static void test_tpdo_every_240th_sync(void)
 /* The RTR service passes on every frame that is not a remote request for
  * one of its TPDOs: listed first, it leaves node guarding its requests and
  * the heartbeat consumer its heartbeats (here producer 5, 100 ms). */
+/* clang-format off */
 static const co_od_entry_t r_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
     {.index = 0x100C, .sub = 0, CO_TYPE_U16, .attr = CO_A_R | CO_A_CONST, .def = 0},
@@ -1837,8 +1873,10 @@ static const co_od_entry_t r_entries[] = {
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0x21010008u},
     {.index = 0x2101, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_PDO, .def = 0x5A},
 };
+/* clang-format on */
 
-static const co_od_t r_od = {.entries = r_entries, .count = sizeof(r_entries) / sizeof(r_entries[0])};
+static const co_od_t r_od = {.entries = r_entries,
+                             .count = sizeof(r_entries) / sizeof(r_entries[0])};
 
 static const co_service_t *const r_services[] = {&co_rtr_service, &co_guard_service,
                                                  &co_hbc_service, NULL};
@@ -1850,9 +1888,13 @@ static const co_node_cfg_t r_cfg = {
     .default_node_id = 0x20,
 };
 
-static const product_t r_prod = {.id = "rtr first", .inputs = {{NULL, NULL, 0, 0}}, .nodes = 1,
-                                 .inst_size = sizeof(b_dev_t), .create = b_create,
-                                 .sample = b_sample, .cfg = &r_cfg};
+static const product_t r_prod = {.id = "rtr first",
+                                 .inputs = {{NULL, NULL, 0, 0}},
+                                 .nodes = 1,
+                                 .inst_size = sizeof(b_dev_t),
+                                 .create = b_create,
+                                 .sample = b_sample,
+                                 .cfg = &r_cfg};
 
 static void test_rtr_service_passes_other_frames_on(void)
 {
@@ -1865,7 +1907,7 @@ static void test_rtr_service_passes_other_frames_on(void)
     rtr.id = 0x720;
     h_rx_frame(d, &rtr);
     EXPECT(d, 0x720, "05"); /* guarded */
-    h_rx(d, 0x705, "05"); /* producer 5's heartbeat: the consumer runs */
+    h_rx(d, 0x705, "05");   /* producer 5's heartbeat: the consumer runs */
     h_advance(d, 99000);
     CHECK_EQ(d->node->nmt.state, CO_NMT_OPERATIONAL);
     h_advance(d, 2000);

@@ -103,7 +103,7 @@ static void test_corrupt_image_reported(void)
     CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
     h_advance(d, 1000);
     EXPECT(d, 0xFF, "00 10 00 00 40 00 00 00"); /* 0x4001 bit 6 + EMCY */
-    CHECK_EQ(h_read(d, 0x1017, 0), 0); /* defaults in use */
+    CHECK_EQ(h_read(d, 0x1017, 0), 0);          /* defaults in use */
     CHECK_EQ(h_read(d, 0x4001, 0), DST_ERR_CHECKSUM);
     /* A good save clears it (EMCY error reset), and so does the next boot. */
     SAVE_OK();
@@ -169,7 +169,8 @@ static void test_write_limit(void)
     SAVE_OK(); /* the 100,000th */
     h_advance(d, 1000);
     EXPECT(d, 0xFF, "00 10 00 00 20 00 00 00"); /* bit 5: flash limit reached */
-    SDO(d, "23 10 10 01 73 61 76 65", "80 10 10 01 20 00 00 08"); /* refused at the limit (a decision) */
+    SDO(d, "23 10 10 01 73 61 76 65",
+        "80 10 10 01 20 00 00 08"); /* refused at the limit (a decision) */
     SDO(d, "2F F0 20 00 05 00 00 00", "60 F0 20 00 00 00 00 00");
     SDO(d, "2F F1 20 00 05 00 00 00", "80 F1 20 00 20 00 00 08");
     h_power_cycle(d);

@@ -17,11 +17,12 @@ typedef struct s_dev {
     co_node_t node;
     uint8_t para[32];
     co_lss_para_t lss;
-    unsigned stored;  /* calls of the "stored" op */
-    uint32_t sig;     /* its last signature */
+    unsigned stored; /* calls of the "stored" op */
+    uint32_t sig;    /* its last signature */
 } s_dev_t;
 
 #define PARA(o) .cls = CO_CLS_PARA, .off = (o)
+/* clang-format off */
 #define SAVE(s, fn) {.index = 0x1010, .sub = (s), CO_TYPE_U32, .attr = CO_A_RW, .def = 1, CO_EXT(.write = fn)}
 #define LOAD(s, fn) {.index = 0x1011, .sub = (s), CO_TYPE_U32, .attr = CO_A_RW, .def = 1, CO_EXT(.write = fn)}
 
@@ -48,8 +49,10 @@ static const co_od_entry_t s_entries[] = {
     {.index = 0x9FFF, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, PARA(30), .def = 0},
     {.index = 0xA000, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, PARA(31), .def = 0}, /* in no group */
 };
+/* clang-format on */
 
-static const co_od_t s_od = {.entries = s_entries, .count = sizeof(s_entries) / sizeof(s_entries[0])};
+static const co_od_t s_od = {.entries = s_entries,
+                             .count = sizeof(s_entries) / sizeof(s_entries[0])};
 
 static void s_stored(co_node_t *n, uint32_t sig)
 {
@@ -87,9 +90,12 @@ static void s_sample(void *mem, const int32_t v[], uint32_t fault)
     (void)fault;
 }
 
-static const product_t s_prod = {.id = "store-faults", .inputs = {{NULL, NULL, 0, 0}},
-                                  .nodes = 1, .inst_size = sizeof(s_dev_t),
-                                  .create = s_create, .sample = s_sample};
+static const product_t s_prod = {.id = "store-faults",
+                                 .inputs = {{NULL, NULL, 0, 0}},
+                                 .nodes = 1,
+                                 .inst_size = sizeof(s_dev_t),
+                                 .create = s_create,
+                                 .sample = s_sample};
 
 static h_dev_t dev;
 static h_dev_t *const d = &dev;
@@ -494,12 +500,14 @@ typedef struct one_dev {
     uint8_t para;
 } one_dev_t;
 
+/* clang-format off */
 static const co_od_entry_t one_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
     {.index = 0x1010, .sub = 0, CO_TYPE_U8, .attr = CO_A_R, .def = 1},
     SAVE(1, co_store_write_save),
     {.index = 0x2000, .sub = 0, CO_TYPE_U8, .attr = CO_A_RW, PARA(0), .def = 7},
 };
+/* clang-format on */
 
 static const co_od_t one_od = {.entries = one_entries,
                                .count = sizeof(one_entries) / sizeof(one_entries[0])};
@@ -520,9 +528,12 @@ static void one_create(const product_t *p, void *mem, void *const ports[], co_no
     nodes[0] = &t->node;
 }
 
-static const product_t one_prod = {.id = "one byte", .inputs = {{NULL, NULL, 0, 0}},
-                                   .nodes = 1, .inst_size = sizeof(one_dev_t),
-                                   .create = one_create, .sample = s_sample};
+static const product_t one_prod = {.id = "one byte",
+                                   .inputs = {{NULL, NULL, 0, 0}},
+                                   .nodes = 1,
+                                   .inst_size = sizeof(one_dev_t),
+                                   .create = one_create,
+                                   .sample = s_sample};
 
 /* The same with its node-ID object named as 0x1000, a constant: a broken
  * contract (co_node_cfg_t.id_index names a PARA object). */
@@ -543,9 +554,12 @@ static void bad_id_create(const product_t *p, void *mem, void *const ports[], co
     nodes[0] = &t->node;
 }
 
-static const product_t bad_id_prod = {.id = "bad id object", .inputs = {{NULL, NULL, 0, 0}},
-                                      .nodes = 1, .inst_size = sizeof(one_dev_t),
-                                      .create = bad_id_create, .sample = s_sample};
+static const product_t bad_id_prod = {.id = "bad id object",
+                                      .inputs = {{NULL, NULL, 0, 0}},
+                                      .nodes = 1,
+                                      .inst_size = sizeof(one_dev_t),
+                                      .create = bad_id_create,
+                                      .sample = s_sample};
 
 static void test_one_byte_set(void)
 {
@@ -591,9 +605,12 @@ static void end_create(const product_t *p, void *mem, void *const ports[], co_no
     nodes[0] = &t->node;
 }
 
-static const product_t end_prod = {.id = "at the end", .inputs = {{NULL, NULL, 0, 0}},
-                                   .nodes = 1, .inst_size = sizeof(end_dev_t),
-                                   .create = end_create, .sample = s_sample};
+static const product_t end_prod = {.id = "at the end",
+                                   .inputs = {{NULL, NULL, 0, 0}},
+                                   .nodes = 1,
+                                   .inst_size = sizeof(end_dev_t),
+                                   .create = end_create,
+                                   .sample = s_sample};
 
 static void test_records_at_the_end_of_the_eeprom(void)
 {
@@ -754,9 +771,12 @@ static void r_create(const product_t *p, void *mem, void *const ports[], co_node
     nodes[0] = &t->node;
 }
 
-static const product_t r_prod = {.id = "emcy 6300h", .inputs = {{NULL, NULL, 0, 0}},
-                                 .nodes = 1, .inst_size = sizeof(s_dev_t),
-                                 .create = r_create, .sample = s_sample};
+static const product_t r_prod = {.id = "emcy 6300h",
+                                 .inputs = {{NULL, NULL, 0, 0}},
+                                 .nodes = 1,
+                                 .inst_size = sizeof(s_dev_t),
+                                 .create = r_create,
+                                 .sample = s_sample};
 
 static void test_corrupt_set_emcy_after_stopped(void)
 {
@@ -827,7 +847,9 @@ static void expect_slot(unsigned at, const char *hex, int line)
         }
     }
 }
+/* clang-format off */
 #define EXPECT_SLOT(k, hex) expect_slot((k) * CO_STORE_SLOT, (hex), __LINE__)
+/* clang-format on */
 
 /*
  * The record format (co_store.h) is what a device in the field holds: a
@@ -842,7 +864,7 @@ static void expect_slot(unsigned at, const char *hex, int line)
 static void test_record_bytes(void)
 {
     static const char s[] = "123456789";
-    CHECK_EQ(co_crc32(0, s, 9), 0xCBF43926u); /* the CRC-32 check value */
+    CHECK_EQ(co_crc32(0, s, 9), 0xCBF43926u);                     /* the CRC-32 check value */
     CHECK_EQ(co_crc32(co_crc32(0, s, 4), s + 4, 5), 0xCBF43926u); /* chained */
     CHECK_EQ(co_crc32(0x12345678u, s, 0), 0x12345678u);
     boot();
