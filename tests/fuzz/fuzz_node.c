@@ -239,7 +239,7 @@ static void check_frame(dev_t *d, unsigned k, const co_frame_t *f)
     bool id_ok = has_id(n);
     bool sdo = id_ok && f->id == 0x580u + n->node_id;
     bool ec = id_ok && f->id == 0x700u + n->node_id;
-    bool lss = co_cfg(n)->lss && f->id == 0x7E4u;
+    bool lss = co_cfg_has_service(co_cfg(n), &co_lss_service) && f->id == 0x7E4u;
     FZ_CHECK(id_ok || lss, "frame %03X from a node without node-ID (%02X)", f->id, n->node_id);
     FZ_CHECK(!restricted(f->id) || sdo || ec || lss, "frame on restricted COB-ID %03X (node-ID %u)",
              f->id, n->node_id);
