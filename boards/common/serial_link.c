@@ -91,13 +91,19 @@ bool serial_link_bitrate(serial_link_t *s, uint16_t kbps, serial_put_fn put)
 
 co_can_state_t serial_link_can_state(serial_link_t *s, uint32_t now)
 {
+    uint32_t recovery_us = (RECOVERY_BITS * 1000u + s->kbps - 1u) / s->kbps;
     if (s->busoff_pending) {
         s->busoff_pending = false;
-        uint32_t recovery_us = (RECOVERY_BITS * 1000u + s->kbps - 1u) / s->kbps;
         s->busoff_end = now + s->busoff_hold_ms * 1000u + recovery_us;
     }
+    if (s->busoff_cut) {
+        s->busoff_cut = false;
+        if (co_time_before(now + recovery_us, s->busoff_end)) {
+            s->busoff_end = now + recovery_us;
+        }
+    }
     if (s->can_state == CO_CAN_BUSOFF && !co_time_before(now, s->busoff_end)) {
-        s->can_state = CO_CAN_ACTIVE;
+        s->can_state = s->back_state;
     }
     return (co_can_state_t)s->can_state;
 }
@@ -302,7 +308,13 @@ static bool cmd_can(serial_link_t *s, tokens_t *t, serial_put_fn put)
         return fail(put, "usage: can bus-off [SECONDS] | can passive | can warning | can active",
                     "", "");
     }
+    if (s->can_state == CO_CAN_BUSOFF && states[k].state != CO_CAN_BUSOFF) {
+        s->back_state = states[k].state; /* back after the recovery alone, in this state */
+        s->busoff_cut = true;
+        return true;
+    }
     s->can_state = states[k].state;
+    s->back_state = CO_CAN_ACTIVE;
     s->busoff_pending = states[k].state == CO_CAN_BUSOFF;
     s->busoff_hold_ms = (uint32_t)hold_ms;
     return true;

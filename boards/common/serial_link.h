@@ -59,6 +59,8 @@ typedef struct serial_link {
     bool busoff_pending;                /* bus-off commanded, not yet timed */
     uint32_t busoff_hold_ms;            /* its hold time */
     uint32_t busoff_end;                /* bus-off lasts until then (us) */
+    uint8_t back_state;                 /* the state it comes back in */
+    bool busoff_cut;                    /* another state commanded: the hold ends */
     uint16_t kbps;                      /* bit rate, for the recovery time */
     char line[SERIAL_LINE_MAX + 1u];
     uint8_t len;

@@ -204,6 +204,7 @@ void lp_sim_can(lp_port_t *p, co_can_state_t s, uint32_t now, uint32_t hold_us,
 {
     if (s == CO_CAN_BUSOFF) {
         p->sim_state = CO_CAN_BUSOFF;
+        p->sim_back = CO_CAN_ACTIVE;
         /* hold + recovery can exceed half the 32-bit clock: cap it there */
         uint64_t off = (uint64_t)hold_us + recovery_us;
         p->sim_recover_at = now + (uint32_t)(off < 0x7FFFFFFFu ? off : 0x7FFFFFFFu);
@@ -215,9 +216,10 @@ void lp_sim_can(lp_port_t *p, co_can_state_t s, uint32_t now, uint32_t hold_us,
         if (co_time_before(now + recovery_us, p->sim_recover_at)) {
             p->sim_recover_at = now + recovery_us;
         }
+        p->sim_back = (int)s;
         lp_log("node %u: simulated CAN controller: bus usable again, back from bus-off in "
-               "%u.%03u ms",
-               p->node, recovery_us / 1000u, recovery_us % 1000u);
+               "%u.%03u ms, %s",
+               p->node, recovery_us / 1000u, recovery_us % 1000u, state_names[s]);
     } else {
         p->sim_state = (int)s;
         lp_log("node %u: simulated CAN controller %s", p->node, state_names[s]);
@@ -260,8 +262,9 @@ uint32_t lp_poll(lp_port_t *p, uint32_t now)
     }
     if (p->sim_state == CO_CAN_BUSOFF) {
         if (!co_time_before(now, p->sim_recover_at)) {
-            p->sim_state = CO_CAN_ACTIVE;
-            lp_log("node %u: simulated CAN controller back from bus-off: error active", p->node);
+            p->sim_state = p->sim_back;
+            lp_log("node %u: simulated CAN controller back from bus-off: %s", p->node,
+                   state_names[p->sim_back]);
         } else {
             next = co_min_u32(next, co_time_until(now, p->sim_recover_at));
         }

@@ -83,7 +83,8 @@ typedef struct lp_port {
     /* CAN controller */
     int ctrl_state;          /* co_can_state_t from the kernel's error frames */
     int sim_state;           /* co_can_state_t of the simulated controller */
-    uint32_t sim_recover_at; /* simulated bus-off: back to error active then */
+    uint32_t sim_recover_at; /* simulated bus-off: back on the bus then */
+    int sim_back;            /* the state it comes back in (error active unless told) */
     /* received frames: a batch read in one call, served one by one */
     struct can_frame rxb[LP_RXB];
     uint8_t rxlen[LP_RXB];     /* bytes each message had (a classic frame: 16) */
@@ -130,9 +131,10 @@ co_can_state_t lp_can_state(const lp_port_t *p);
 /*
  * The simulated controller: s = bus-off enters bus-off; the bus then stays
  * unusable for hold_us, after which the controller is back after
- * recovery_us (128 x 11 bits at its bit rate). Warning and passive stay
- * until changed; active ends them, and shortens a bus-off's hold to the
- * recovery alone.
+ * recovery_us (128 x 11 bits at its bit rate), error active. Warning and
+ * passive stay until changed; active ends them. During a bus-off, any
+ * other state ends the hold: the controller is back after the recovery
+ * alone, in that state (the emulated boards' serial line does the same).
  */
 void lp_sim_can(lp_port_t *p, co_can_state_t s, uint32_t now, uint32_t hold_us,
                 uint32_t recovery_us);
