@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "cmd.h"
+#include "control.h"
 #include "eds.h"
 #include "log.h"
 #include "products_json.h"
@@ -351,9 +352,14 @@ int cli_parse(int argc, char **argv, options_t *o)
         case 'D':
             o->nvm_dir = optarg;
             break;
-        case 'C':
+        case 'C': {
+            char err[200];
+            if (!ctl_spec_ok(optarg, err, sizeof(err))) {
+                return USAGE_ERROR("%s", err);
+            }
             o->control = optarg;
             break;
+        }
         case 'N': {
             int rc = parse_node(o, optarg);
             if (rc != CLI_GO_ON) {

@@ -45,14 +45,40 @@ static int unix_path_free(const char *path, char *err, size_t errlen)
     return 0;
 }
 
+/* PORT of tcp:PORT, 1..65535 (decimal digits only), or 0. */
+static long tcp_port(const char *port)
+{
+    size_t digits = strspn(port, "0123456789"); /* no sign, no blanks */
+    long p = digits == 0u || digits > 5u || port[digits] != '\0' ? 0 : strtol(port, NULL, 10);
+    return p >= 1 && p <= 65535 ? p : 0;
+}
+
+bool ctl_spec_ok(const char *spec, char *err, size_t errlen)
+{
+    struct sockaddr_un sa;
+    if (strncmp(spec, "unix:", 5) == 0) {
+        const char *path = spec + 5;
+        if (path[0] == '\0' || strlen(path) >= sizeof(sa.sun_path)) {
+            snprintf(err, errlen, "--control unix:%s: empty or longer than %zu bytes", path,
+                     sizeof(sa.sun_path) - 1u);
+            return false;
+        }
+        return true;
+    }
+    if (strncmp(spec, "tcp:", 4) == 0) {
+        if (tcp_port(spec + 4) == 0) {
+            snprintf(err, errlen, "--control tcp:%s: not a port 1..65535", spec + 4);
+            return false;
+        }
+        return true;
+    }
+    snprintf(err, errlen, "--control %s: give unix:PATH or tcp:PORT", spec);
+    return false;
+}
+
 static int open_unix(ctl_t *c, const char *path, char *err, size_t errlen)
 {
     struct sockaddr_un sa = {.sun_family = AF_UNIX};
-    if (path[0] == '\0' || strlen(path) >= sizeof(sa.sun_path)) {
-        snprintf(err, errlen, "--control unix:%s: empty or longer than %zu bytes", path,
-                 sizeof(sa.sun_path) - 1u);
-        return -2;
-    }
     int r = unix_path_free(path, err, errlen);
     if (r != 0) {
         return r;
@@ -70,12 +96,7 @@ static int open_unix(ctl_t *c, const char *path, char *err, size_t errlen)
 
 static int open_tcp(ctl_t *c, const char *port, char *err, size_t errlen)
 {
-    size_t digits = strspn(port, "0123456789"); /* no sign, no blanks */
-    long p = digits == 0u || digits > 5u || port[digits] != '\0' ? 0 : strtol(port, NULL, 10);
-    if (p < 1 || p > 65535) {
-        snprintf(err, errlen, "--control tcp:%s: not a port 1..65535", port);
-        return -2;
-    }
+    long p = tcp_port(port);
     struct sockaddr_in sa = {.sin_family = AF_INET, .sin_port = htons((uint16_t)p)};
     sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK); /* localhost only: no password */
     c->fd = socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
@@ -95,14 +116,11 @@ int ctl_open(ctl_t *c, const char *spec, char *err, size_t errlen)
     for (unsigned k = 0; k < CTL_CLIENTS; k++) {
         c->cl[k].fd = -1;
     }
-    if (strncmp(spec, "unix:", 5) == 0) {
-        return open_unix(c, spec + 5, err, errlen);
+    if (!ctl_spec_ok(spec, err, errlen)) {
+        return -2;
     }
-    if (strncmp(spec, "tcp:", 4) == 0) {
-        return open_tcp(c, spec + 4, err, errlen);
-    }
-    snprintf(err, errlen, "--control %s: give unix:PATH or tcp:PORT", spec);
-    return -2;
+    return strncmp(spec, "unix:", 5) == 0 ? open_unix(c, spec + 5, err, errlen)
+                                          : open_tcp(c, spec + 4, err, errlen);
 }
 
 /* One answer line; a client that cannot take it at once is dropped. */

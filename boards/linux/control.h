@@ -55,6 +55,11 @@ typedef struct ctl {
  */
 int ctl_open(ctl_t *c, const char *spec, char *err, size_t errlen);
 
+/* Whether spec has one of ctl_open's forms (unix:PATH with a PATH that
+ * fits a socket address, tcp:PORT with PORT 1..65535): checked with the
+ * command line, before anything opens. false with the cause in err. */
+bool ctl_spec_ok(const char *spec, char *err, size_t errlen);
+
 /* The listening socket's fd (for epoll), -1 when closed. */
 static inline int ctl_fd(const ctl_t *c)
 {

@@ -304,3 +304,16 @@ def test_log_time_stamps(tmp_path):
     assert before <= when <= before + datetime.timedelta(seconds=5)
     one_line(run("--product", "jd2xxx", "--iface", "vcan0", "--log-time", "boot"), 2,
              "--log-time takes start or wall, not 'boot'")
+
+
+@pytest.mark.parametrize("spec,text", [
+    ("foo:1", "--control foo:1: give unix:PATH or tcp:PORT"),
+    ("tcp:99999", "--control tcp:99999: not a port 1..65535"),
+    ("tcp:0", "--control tcp:0: not a port 1..65535"),
+    ("unix:", "--control unix:: empty or longer than 107 bytes"),
+    ("unix:" + "d/" * 60, "empty or longer than 107 bytes"),
+])
+def test_control_form_checked_with_the_command_line(spec, text):
+    """A --control that has neither form is a wrong command line (2), found
+    before anything opens: the same answer with or without CAN."""
+    one_line(run("--product", "jd2xxx", "--iface", "vcan0", "--control", spec), 2, text)
