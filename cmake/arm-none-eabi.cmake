@@ -11,8 +11,8 @@ set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 # (about 1 % less flash here).
 # CO_M0_SIZE_OPT: -Os passes that cost flash on Thumb-1, whose 8 low
 # registers make every value kept live across a loop or a branch a spill
-# (measured on the DST X730 Nucleo image, 10148 -> 9880 bytes; the
-# instruction counts of tools/bench fall or stay): hoisting loop invariants
+# (measured on the DST X730 Nucleo image: smaller, and the instruction
+# counts of tools/bench fall or stay): hoisting loop invariants
 # and common code out of loops and branches (-fno-move-loop-invariants,
 # -fno-tree-loop-im, -fno-code-hoisting; -fira-loop-pressure lets the
 # allocator weigh that pressure), aggregates split into scalars that then
@@ -20,10 +20,10 @@ set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 # and branches turned into conditional moves, which Thumb-1 lacks
 # (-fno-tree-forwprop, -fno-ssa-phiopt), and case tables (the small
 # switches here are shorter as compares than as a table with libgcc's
-# __gnu_thumb1_case_uqi). -fno-tree-ccp and -fno-tree-tail-merge: 4 bytes
-# each on the same image, which the DSTs' segmented download had taken
-# 8 bytes past its target (10248 -> 10240). Not -fno-inline-functions-called-once: 32 bytes
-# less, but the idle poll then takes 23 instructions (target 20).
+# __gnu_thumb1_case_uqi). -fno-tree-ccp and -fno-tree-tail-merge: a few
+# bytes each on the same image, which keep it within its 10 KB target. Not
+# -fno-inline-functions-called-once: smaller, but the idle poll then takes
+# more instructions than its target.
 # Given as directory options, not in the cached CMAKE_C_FLAGS: a build
 # directory configured before gets them at its next configure too.
 set(CO_M0_SIZE_OPT "-fno-move-loop-invariants -fno-tree-loop-im -fno-code-hoisting -fira-loop-pressure -fno-tree-sra -fno-tree-forwprop -fno-ssa-phiopt -fno-jump-tables -fno-tree-ccp -fno-tree-tail-merge")

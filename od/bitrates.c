@@ -13,15 +13,15 @@ uint16_t product_kbps(const product_t *p, uint8_t code)
     return (table != NULL && code < 16u) ? table[code] : 0u;
 }
 
+const uint16_t product_eds_kbps[8] = {10, 20, 50, 125, 250, 500, 800, 1000};
+
 uint8_t product_eds_bitrates(const product_t *p)
 {
-    /* The rates of the PRODUCT_BR_* bits, bit 0 first (CiA 306 BaudRate_x). */
-    static const uint16_t eds_kbps[8] = {10, 20, 50, 125, 250, 500, 800, 1000};
     uint8_t bits = 0;
     for (uint8_t code = 0; code < 16u; code++) {
         uint16_t kbps = product_kbps(p, code);
         for (unsigned i = 0; i < 8u; i++) {
-            if (kbps == eds_kbps[i]) {
+            if (kbps == product_eds_kbps[i]) {
                 bits |= (uint8_t)(1u << i);
             }
         }

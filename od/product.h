@@ -104,6 +104,10 @@ extern const uint16_t product_kbps_pf[16];  /* 1 = 125, 2 = 250, 4 = 500, 8 = 10
  * 0 if the code means nothing or p has no config or table. */
 uint16_t product_kbps(const product_t *p, uint8_t code);
 
+/* The rates of the PRODUCT_BR_* bits, bit 0 first: CiA 306's BaudRate_x
+ * keys, kbit/s. */
+extern const uint16_t product_eds_kbps[8];
+
 /* The PRODUCT_BR_* bits of the rates p's codes give (product_kbps()): the
  * bit rates its EDS declares. A rate CiA 306 has no key for (100 kbit/s)
  * is left out; 0 without a config or table. */

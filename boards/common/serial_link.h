@@ -18,8 +18,15 @@
  * what an image cannot carry: ramp, sine, noise, replay and quit are
  * answered "error: 'WORD' is not on this target (set, fault, can, get)"
  * (why: serial_link.c, absent[]); selectors are not taken (an image is one
- * product); `get` has no "nmt=" word. The answers of the verbs it has are
- * the program's.
+ * product); `get` has no "nmt=" word. The verbs it has take the same
+ * lines and give the same answers, but for what an image's integer
+ * parser and its missing texts cannot carry: numbers are plain decimals
+ * with at most three places (the program also takes exponents, and rounds
+ * more places to thousandths); a bad `set` argument and a fault on a
+ * product without faults are answered without the input list, units or
+ * product ID; a bus-off hold is at most 60 s (the program's 1800 s).
+ * tests/unit/test_linux_cmd.c checks both the agreement and each
+ * difference.
  *
  * Each input line is answered on the line with "ok" or "error: <cause>"
  * (python-can's slcan ignores lines that are not frames; an answer holds

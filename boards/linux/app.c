@@ -229,5 +229,8 @@ void app_shut_down(app_t *a)
         lp_close(p);
     }
     lp_tx_close(&a->tx);
+    for (unsigned k = 0; k < a->ninst; k++) {
+        lp_nvm_unlock(&a->inst[k].nvm); /* the EEPROM files free for the next user */
+    }
     lp_log("stopped");
 }

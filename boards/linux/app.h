@@ -22,6 +22,11 @@
 /* Nodes in one process at most: one bus holds 127 node-IDs. */
 #define APP_MAX_NODES 127u
 
+/* Replay tables one line may load: one per product it names. */
+#define APP_REPLAY_TABLES                                                                          \
+    (sizeof((const product_t *const[]){PRODUCT_REGISTRY_ROWS PRODUCT_REGISTRY_EXAMPLES}) /         \
+     sizeof(const product_t *))
+
 /* One product instance: its nodes are app_t.nodes[first .. first +
  * prod->nodes - 1]; its own inputs (sim), its own EEPROM file (both nodes
  * of a two-node product share it, as they share the device). */
@@ -47,9 +52,9 @@ struct app {
     uint8_t last_id[APP_MAX_NODES]; /* active node-IDs last looked at (app_log_states) */
     const char *ifn[APP_MAX_NODES]; /* each node's interface */
     app_inst_t inst[APP_MAX_NODES];
-    bool quit;           /* stop the loop: `quit`, a signal, the end of input */
-    lp_tx_t tx;          /* the one sending socket (can_port.h) */
-    sim_replay_t replay; /* the table a `replay` line loads (cmd.c) */
+    bool quit;                              /* stop the loop: `quit`, a signal, the end of input */
+    lp_tx_t tx;                             /* the one sending socket (can_port.h) */
+    sim_replay_t replay[APP_REPLAY_TABLES]; /* a `replay` line's tables (cmd.c) */
 };
 
 /*

@@ -9,7 +9,7 @@
  *    pull, shown as bus-off until the interface is back (looked for every
  *    LP_LINK_POLL_US, and re-bound when it was deleted and re-created);
  *  - the kernel's error frames (a real controller: warning, passive, bus-off);
- *  - the simulated controller (standard input `can bus-off|passive|...`),
+ *  - the simulated controller (the line language's `can`, cmd.h),
  *    which recovers from bus-off by itself after 128 x 11 recessive bits.
  * While the state is bus-off the port transmits nothing and discards what
  * it receives, as a controller off the bus does.

@@ -124,13 +124,16 @@ void cli_usage_error(const char *fmt, ...)
     vsnprintf(msg, sizeof(msg), fmt, ap);
     va_end(ap);
     fprintf(stderr, "canopen-sensor: %s (see --help)\n", msg);
+    if (lp_log_is_file()) { /* a wrong command line found once --log is open */
+        lp_log("error: %s", msg);
+    }
 }
 
 /* A failure at start: one line on stderr, and in the log when it is a file. */
-int cli_start_failure(bool log_file, int rc, const char *msg)
+int cli_start_failure(int rc, const char *msg)
 {
     fprintf(stderr, "canopen-sensor: %s\n", msg);
-    if (log_file) {
+    if (lp_log_is_file()) {
         lp_log("error: %s", msg);
     }
     return rc;

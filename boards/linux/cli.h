@@ -84,7 +84,8 @@ void cli_usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)))
 #define USAGE_ERROR(...) ((void)cli_usage_error(__VA_ARGS__), CLI_USAGE)
 
 /* A failure at start: one line on stderr, and in the log when it is a
- * file (log_file); returns rc. */
-int cli_start_failure(bool log_file, int rc, const char *msg);
+ * file (--log); returns rc. A wrong command line found at start
+ * (cli_usage_error) goes to the log the same way. */
+int cli_start_failure(int rc, const char *msg);
 
 #endif /* LINUX_CLI_H */

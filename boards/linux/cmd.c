@@ -14,12 +14,14 @@
 #include "sim.h"
 
 /* What a line is served with: the program, the time, and the replay
- * table the line loaded (read once per product, not once per instance:
- * @all on 127 nodes read it 254 times, every node held up meanwhile). */
+ * tables the line loaded, one per product (a->replay[t] is table_of[t]'s):
+ * the file is read once for all the instances of a product, while every
+ * node waits, and each instance takes what was read and checked. */
 struct cmd_ctx {
     app_t *a;
     uint32_t now;
-    const product_t *loaded; /* a->replay holds this product's table, or NULL */
+    unsigned ntables;
+    const product_t *table_of[APP_REPLAY_TABLES];
 };
 
 /* ---- Line assembly ------------------------------------------------------ */
@@ -317,14 +319,18 @@ static bool parse_replay(cmd_ctx_t *c, unsigned k, char **save, cmd_args_t *args
         snprintf(err, errlen, "usage: replay FILE.csv (no spaces in FILE)");
         return false;
     }
-    if (c->loaded != p) {
-        c->loaded = NULL;
-        if (!replay_csv_load(p, file, &c->a->replay, err, (unsigned)errlen)) {
+    unsigned t = 0;
+    while (t < c->ntables && c->table_of[t] != p) {
+        t++;
+    }
+    if (t == c->ntables) { /* the product's first instance: read the file */
+        if (t == APP_REPLAY_TABLES ||
+            !replay_csv_load(p, file, &c->a->replay[t], err, (unsigned)errlen)) {
             return false;
         }
-        c->loaded = p;
+        c->table_of[c->ntables++] = p;
     }
-    args->table = &c->a->replay;
+    args->table = &c->a->replay[t];
     return true;
 }
 
@@ -656,14 +662,13 @@ static bool run_verb(cmd_ctx_t *c, const cmd_verb_t *verb, const char *cmd, unsi
     char err[600];
     cmd_args_t args;
     for (int pass = 0; pass < 2; pass++) { /* 0: check all; 1: carry out */
-        c->loaded = NULL;
         for (unsigned k = k0; k <= k1; k++) {
+            /* Pass 1 parses what pass 0 accepted, on instances the line
+             * has not changed yet (replay takes pass 0's tables): it
+             * succeeds as it did. */
             if (!parse_for(c, verb, cmd, k, &args, err, sizeof(err))) {
                 const char *id = a->inst[k].prod->id;
-                snprintf(reply, len, "error: %s%s%s%s", k1 > k0 ? id : "", k1 > k0 ? ": " : "", err,
-                         pass == 1 ? " (it changed meanwhile: the instances before took "
-                                     "the former)"
-                                   : "");
+                snprintf(reply, len, "error: %s%s%s", k1 > k0 ? id : "", k1 > k0 ? ": " : "", err);
                 return false;
             }
             if (pass == 1 && verb->scope == CMD_NODES) {

@@ -160,10 +160,9 @@ int eds_write(FILE *f, const product_t *p)
             p->vendor, vendor != NULL ? (unsigned long)vendor->def : 0ul, p->summary,
             ident != NULL ? (unsigned long)ident->def : 0ul,
             rev != NULL ? (unsigned long)rev->def : 0ul, p->id);
-    static const unsigned rates[8] = {10, 20, 50, 125, 250, 500, 800, 1000};
     unsigned bitrates = product_eds_bitrates(p);
     for (unsigned i = 0; i < 8u; i++) {
-        fprintf(f, "BaudRate_%u=%d\n", rates[i], (bitrates >> i) & 1u);
+        fprintf(f, "BaudRate_%u=%u\n", (unsigned)product_eds_kbps[i], (bitrates >> i) & 1u);
     }
     fprintf(f,
             "SimpleBootUpMaster=0\nSimpleBootUpSlave=1\nGranularity=%d\n"

@@ -21,6 +21,11 @@ void lp_log_open(FILE *f)
     log_file = f;
 }
 
+bool lp_log_is_file(void)
+{
+    return log_file != NULL;
+}
+
 void lp_log_start(void)
 {
     clock_gettime(CLOCK_MONOTONIC, &log_t0);

@@ -27,6 +27,8 @@ typedef struct lp_rate {
  * UTC wall clock ("[2026-11-25 01:05:12.345] "). */
 void lp_log(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 void lp_log_open(FILE *f);
+/* Whether the log is a file (--log), not standard error. */
+bool lp_log_is_file(void);
 /* The log's time zero (call first thing), and its clock (lp_log). */
 void lp_log_start(void);
 void lp_log_clock(bool wall);

@@ -72,7 +72,7 @@ static bool former_nvm_name(const options_t *o, unsigned k, uint8_t id, char *bu
  * there now, renamed by rename_former_nvm() once the whole start has
  * worked (a failed start changes nothing on disk). *former tells.
  */
-static int open_inst_nvm(app_t *a, const options_t *o, unsigned k, bool logf, bool *former)
+static int open_inst_nvm(app_t *a, const options_t *o, unsigned k, bool *former)
 {
     app_inst_t *in = &a->inst[k];
     char err[600];
@@ -104,7 +104,7 @@ static int open_inst_nvm(app_t *a, const options_t *o, unsigned k, bool logf, bo
     int r = lp_nvm_open(&in->nvm, opt, path, in->nvm_mem,
                         (uint32_t)(in->prod->nodes * CO_STORE_NVM_SIZE), err, sizeof(err));
     if (r != 0) {
-        return cli_start_failure(logf, r == -2 ? 2 : 1, err);
+        return cli_start_failure(r == -2 ? 2 : 1, err);
     }
     if (*former) { /* held and saved under the new name from now (same directory) */
         char *slash = strrchr(in->nvm.real, '/');
@@ -124,7 +124,7 @@ static int open_inst_nvm(app_t *a, const options_t *o, unsigned k, bool logf, bo
     }
     r = lp_nvm_lock(&in->nvm, opt, path, err, sizeof(err));
     if (r != 0) {
-        return cli_start_failure(logf, r == -2 ? 2 : 1, err);
+        return cli_start_failure(r == -2 ? 2 : 1, err);
     }
     return CLI_GO_ON;
 }
@@ -151,7 +151,7 @@ static void rename_former_nvm(const options_t *o, unsigned k, uint8_t id)
 }
 
 /* Open the sockets and LEDs of instance k's nodes. Returns CLI_GO_ON or 1. */
-static int open_inst_ports(app_t *a, const options_t *o, unsigned k, bool logf, uint32_t t)
+static int open_inst_ports(app_t *a, const options_t *o, unsigned k, uint32_t t)
 {
     app_inst_t *in = &a->inst[k];
     char err[600];
@@ -170,22 +170,22 @@ static int open_inst_ports(app_t *a, const options_t *o, unsigned k, bool logf, 
             } else {
                 snprintf(msg, sizeof(msg), "--iface %s: %s: %s", given, a->ifn[g], err);
             }
-            return cli_start_failure(logf, 1, msg);
+            return cli_start_failure(1, msg);
         }
         if (leds_open(&a->leds[g], g == 0 ? o->led_chip : NULL, o->led_green, o->led_red, err,
                       sizeof(err)) != 0) {
-            return cli_start_failure(logf, 1, err);
+            return cli_start_failure(1, err);
         }
     }
     return CLI_GO_ON;
 }
 
 /* Instance k of the command line, created (not started). */
-static int add_inst(app_t *a, const options_t *o, unsigned k, bool logf)
+static int add_inst(app_t *a, const options_t *o, unsigned k)
 {
     const node_spec_t *n = &o->spec[k];
     if (app_add(a, n->prod, n->ifn, n->id, o->serial) < 0) {
-        return cli_start_failure(logf, CLI_FAILED, "product instance too large");
+        return cli_start_failure(CLI_FAILED, "product instance too large");
     }
     sim_seed(&a->inst[k].sim, o->seed + k); /* each instance its own noise */
     return CLI_GO_ON;
@@ -202,7 +202,6 @@ int setup_run(app_t *a, loop_t *l, const options_t *o)
         }
         lp_log_open(lf);
     }
-    bool logf = o->log_path != NULL;
     struct stat in_st;
     if (fstat(STDIN_FILENO, &in_st) == 0 && S_ISDIR(in_st.st_mode)) {
         /* read() would fail (EISDIR) at once: an end of input nobody meant */
@@ -216,7 +215,7 @@ int setup_run(app_t *a, loop_t *l, const options_t *o)
         }
     }
     for (unsigned k = 0; k < o->nspec; k++) {
-        int r = add_inst(a, o, k, logf);
+        int r = add_inst(a, o, k);
         if (r != CLI_GO_ON) {
             return r;
         }
@@ -227,14 +226,14 @@ int setup_run(app_t *a, loop_t *l, const options_t *o)
     }
     bool former[APP_MAX_NODES] = {false};
     for (unsigned k = 0; k < a->ninst; k++) {
-        rc = open_inst_nvm(a, o, k, logf, &former[k]);
+        rc = open_inst_nvm(a, o, k, &former[k]);
         if (rc != CLI_GO_ON) {
             return rc;
         }
     }
     uint32_t t = loop_now_us();
     for (unsigned k = 0; k < a->ninst; k++) {
-        rc = open_inst_ports(a, o, k, logf, t);
+        rc = open_inst_ports(a, o, k, t);
         if (rc != CLI_GO_ON) {
             return rc;
         }
@@ -242,11 +241,11 @@ int setup_run(app_t *a, loop_t *l, const options_t *o)
     /* Every node sends through one socket (can_port.h, lp_tx_t). */
     char err[600];
     if (lp_tx_open(&a->tx, err, sizeof(err)) != 0) {
-        return cli_start_failure(logf, CLI_FAILED, err);
+        return cli_start_failure(CLI_FAILED, err);
     }
     int r = loop_open(l, a, o->control, o->quit_on_eof, err, sizeof(err));
     if (r != 0) {
-        return r == -2 ? USAGE_ERROR("%s", err) : cli_start_failure(logf, CLI_FAILED, err);
+        return r == -2 ? USAGE_ERROR("%s", err) : cli_start_failure(CLI_FAILED, err);
     }
     /* Nothing can fail the start any more: the former names go now. */
     for (unsigned k = 0; k < a->ninst; k++) {

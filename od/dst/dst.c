@@ -55,8 +55,8 @@ co_res_t dst_write_event(co_node_t *n, const co_od_entry_t *e, uint32_t v)
 }
 
 /* Node-ID / bit rate: a value is committed when both copies agree; the
- * committed pair is written to EEPROM at once (no "save" needed, B-44) and
- * becomes active at the next reset. */
+ * committed pair is written to EEPROM at once (no "save": the manual's
+ * node-ID example has no save step) and becomes active at the next reset. */
 static co_res_t commit_pair(co_node_t *n, uint8_t *copies, unsigned which, uint8_t v,
                             uint8_t *committed)
 {
@@ -147,12 +147,13 @@ static void dst_reset(co_node_t *n, co_reset_t kind)
         co_node_set_bitrate(n, d->lss.bitrate);
         co_store_mark_corrupt(n, CO_CLS_LSS);
     }
-    /* Both copies read the active values after a reset (B-46). */
+    /* Both copies read the active values after a reset (decision: the
+     * manual only says that copies which differ leave the old node-ID). */
     d->vol.id[0] = d->vol.id[1] = co_node_id(n);
     d->vol.br[0] = d->vol.br[1] = d->lss.bitrate;
     /* Big-endian PDOs only where 0x5001 exists and says so (the X710 has none). */
     co_tpdo_set_msb_first(n, 0, co_node_entry(n, 0x5001, 0) != NULL && d->para.pdo_coding == 0u);
-    co_node_set_autostart(n, d->para.autostart == 1u); /* B-11: after any reset */
+    co_node_set_autostart(n, d->para.autostart == 1u); /* decision: after any reset */
     apply_filter(d);
     /* Errors are re-evaluated and re-reported after every boot-up. */
     d->reported = 0;

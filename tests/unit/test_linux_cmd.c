@@ -6,6 +6,7 @@
  */
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "app.h"
 #include "cmd.h"
@@ -348,11 +349,24 @@ static void test_serial_line_answers(void)
         CHECK(starts(serial_ask(&s, errors_only[k]), "error: "));
     }
     CHECK(starts(ask("set x=3601"), "error: "));
+    /* Numbers: the image takes plain decimals of three places at most. */
+    static const char *const numbers[] = {"set x=1e1", "set x=1.2345", "can bus-off 1e1"};
+    for (unsigned k = 0; k < sizeof(numbers) / sizeof(numbers[0]); k++) {
+        CHECK(is(ask(numbers[k]), "ok"));
+        CHECK(starts(serial_ask(&s, numbers[k]), "error: "));
+    }
+    CHECK(is(ask("set x=1.234"), "ok"));
+    CHECK(is(serial_ask(&s, "set x=1.234"), "ok"));
     CHECK(
         is(serial_ask(&s, "can bus-off 61"), "error: '61': not a number of seconds within 0..60"));
     CHECK(is(ask("can bus-off 61"), "ok")); /* the program's limit is 1800 s */
     /* Unknown and absent verbs: the same start, the serial line's verbs. */
     CHECK(is(serial_ask(&s, "tilt 5"), "error: unknown command 'tilt' (set, fault, can, get)"));
+    /* A product without faults: the image names no product ID. */
+    make((const product_t *const[]){&jd1xxx, NULL});
+    serial_link_init(&s, &jd1xxx);
+    CHECK(is(ask("fault sensor on"), "error: jd1xxx has no simulated faults"));
+    CHECK(starts(serial_ask(&s, "fault sensor on"), "error: "));
     for (unsigned i = 0; serial_link_absent_verb(i) != NULL; i++) {
         char want[96];
         snprintf(want, sizeof(want), "error: '%s' is not on this target (set, fault, can, get)",
@@ -393,6 +407,40 @@ static void test_bus_off_ended_by_another_state(void)
     CHECK_EQ(serial_link_can_state(&s, back + 5632u), CO_CAN_ACTIVE);
 }
 
+/* `@all replay FILE` over two products: each instance takes its product's
+ * table; a file one product cannot take (an input it lacks) is refused for
+ * all, and nothing changes. */
+static void test_replay_all_or_none(void)
+{
+    make((const product_t *const[]){&dst_x730_xy30, &jd2xxx, &dst_x730_xy30, NULL});
+    char path[] = "/tmp/test_linux_cmd_XXXXXX";
+    int fd = mkstemp(path);
+    CHECK(fd >= 0);
+    static const char both[] = "t,x\n0,1\n1,3\n";
+    CHECK(write(fd, both, sizeof(both) - 1u) == (ssize_t)(sizeof(both) - 1u));
+    close(fd);
+    char line[64];
+    snprintf(line, sizeof(line), "@all replay %s", path);
+    for (unsigned k = 0; k < 3u; k++) {
+        sim_step(&app.inst[k].sim, 0);
+    }
+    CHECK(is(ask(line), "ok"));
+    for (unsigned k = 0; k < 3u; k++) {
+        CHECK_EQ(app.inst[k].sim.motion[0].kind, SIM_REPLAY);
+        sim_step(&app.inst[k].sim, 500000u);
+        CHECK_EQ(app.inst[k].sim.values[0], 2000); /* halfway from 1 to 3 */
+    }
+    /* temp is the JD2's alone: the DSTs refuse the file, the JD2 too. */
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    fputs("t,temp\n0,30\n", f);
+    fclose(f);
+    CHECK(starts(ask(line), "error: dst-x730-xy30: "));
+    CHECK_EQ(app.inst[1].sim.motion[2].kind, SIM_HOLD);
+    CHECK_EQ(app.inst[1].sim.values[2], 25000);
+    remove(path);
+}
+
 int main(void)
 {
     RUN(test_set_fault_get);
@@ -403,5 +451,6 @@ int main(void)
     RUN(test_serial_line_verbs);
     RUN(test_serial_line_answers);
     RUN(test_bus_off_ended_by_another_state);
+    RUN(test_replay_all_or_none);
     return h_finish();
 }

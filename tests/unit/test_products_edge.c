@@ -104,7 +104,7 @@ static void test_dst_values(void)
     SDO(d, "23 14 10 00 00 00 00 80", "60 14 10 00 00 00 00 00");
 }
 
-/* B-44: the pair is written to EEPROM when both copies agree on a new
+/* The pair is written to EEPROM when both copies agree on a new
  * value; agreeing on the active one costs no write cycle. */
 static void test_dst_node_id_pair_unchanged(void)
 {
@@ -121,8 +121,8 @@ static void test_dst_node_id_pair_unchanged(void)
     EXPECT(d, 0x720, "00");
 }
 
-/* Each copy of the pair reads what was written to it (B-43): one copy
- * alone commits nothing, and the other keeps the active value (B-46). */
+/* Each copy of the pair reads what was written to it (each write answered on its own): one copy
+ * alone commits nothing, and the other keeps the active value. */
 static void test_dst_pair_copies_are_their_own(void)
 {
     boot_dst();

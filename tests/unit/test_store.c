@@ -128,7 +128,7 @@ static void test_lss_checksum_bit(void)
     /* LSS slots are 2 and 3; only slot 0 of the class was written. */
     d->port.nvm[2 * CO_STORE_SLOT + CO_STORE_HDR] ^= 0xFF;
     h_power_cycle(d);
-    EXPECT(d, 0x77F, "00"); /* back on the default ID 0x7F (B-31) */
+    EXPECT(d, 0x77F, "00"); /* back on the default ID 0x7F (decision: a bad LSS checksum) */
     CHECK_EQ(d->node->store.status[CO_CLS_LSS], CO_STORE_CORRUPT);
     h_advance(d, 1000);
     EXPECT(d, 0xFF, "00 10 00 00 40 00 00 00");
