@@ -7,8 +7,13 @@
  */
 #include <stdlib.h>
 
+#include <string.h>
+
+#include "dst.h"
 #include "eds.h"
 #include "gsh.h"
+#include "jd.h"
+#include "pf.h"
 #include "product_eds.h"
 
 #include "harness.h"
@@ -140,6 +145,30 @@ static void test_wrong_overrides_are_counted(void)
     free(eds);
 }
 
+/* [DeviceInfo] BaudRate_x: 1 exactly for the rates one of the product's
+ * bit-rate codes gives (the manuals' tables: the CiA order on the DST and
+ * GSH-A, code 0 = 1000 kbit/s; ifm's on the JD, code 0 = 20 kbit/s). */
+static void test_baud_rates_are_the_codes(void)
+{
+    static const struct {
+        const product_t *p;
+        const char *want;
+    } cases[] = {
+        {&dst_x730_xy30, "BaudRate_10=0\nBaudRate_20=1\nBaudRate_50=1\nBaudRate_125=1\n"
+                         "BaudRate_250=1\nBaudRate_500=1\nBaudRate_800=1\nBaudRate_1000=1\n"},
+        {&jd2xxx, "BaudRate_10=0\nBaudRate_20=1\nBaudRate_50=1\nBaudRate_125=1\n"
+                  "BaudRate_250=1\nBaudRate_500=1\nBaudRate_800=1\nBaudRate_1000=1\n"},
+        {&pf_inx360d, "BaudRate_10=0\nBaudRate_20=0\nBaudRate_50=0\nBaudRate_125=1\n"
+                      "BaudRate_250=1\nBaudRate_500=1\nBaudRate_800=0\nBaudRate_1000=1\n"},
+    };
+    for (unsigned k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
+        int unused = 0;
+        char *text = eds_text(cases[k].p, &unused);
+        CHECK(text != NULL && strstr(text, cases[k].want) != NULL);
+        free(text);
+    }
+}
+
 int main(void)
 {
     RUN(test_every_product_applies_its_overrides);
@@ -147,5 +176,6 @@ int main(void)
     RUN(test_no_override_keeps_the_device_value);
     RUN(test_live_values_and_node_relative_default);
     RUN(test_wrong_overrides_are_counted);
+    RUN(test_baud_rates_are_the_codes);
     return h_finish();
 }
