@@ -20,6 +20,11 @@
 # The firmware images (boards/CMakeLists.txt), the Linux program and the
 # tests build their own libraries and are not changed by these.
 
+if(CMAKE_CROSSCOMPILING AND NOT DEFINED CMAKE_INSTALL_LIBDIR)
+  # A bare-metal target has no multiarch folder (and GNUInstallDirs, not
+  # knowing the pointer size there, would warn): plain lib.
+  set(CMAKE_INSTALL_LIBDIR lib CACHE PATH "Object code libraries (lib)")
+endif()
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -137,7 +142,7 @@ else()
     set(co_sim_input ON)
   endif()
   if(CO_BOARD STREQUAL "rv32-virt")
-    list(APPEND co_bsrc ${co_bdir}/cfi_flash.c ${co_cdir}/sja1000.c)
+    list(APPEND co_bsrc ${co_bdir}/cfi_flash.c ${co_cdir}/flash_ee.c ${co_cdir}/sja1000.c)
   endif()
   if(NOT co_sim_input)
     # Real hardware has no simulated input: no fault names (product.h).

@@ -143,7 +143,7 @@ DST = Facts(
     boot_state=0x7F,
     reads=(Read(0x1009, 0, b"1.00"), Read(0x1200, 1, ID(0x600)), Read(0x1200, 2, ID(0x580)),
            Read(0x1800, 5, u16(100)), Read(0x1010, 1, u32(1)), Read(0x1005, 0, u32(0x80)),
-           Read(0x1800, 1, ID(0x40000180))),                 # bit 30: no RTR (README)
+           Read(0x1800, 1, ID(0x40000180))),                 # bit 30: no RTR (docs/decisions.md)
     rw=((0x1017, 0, u16(250)), (0x2001, 0, u8(2))),
     app_param=(0x6014, 0, i16(-120), i16(0)),
     aborts=COMMON_ABORTS + (
@@ -171,8 +171,8 @@ DST = Facts(
     # decision: stored by the device itself (the example has no save).
     node_id_change=NodeIdChange(steps=(("sdo", 0x20F0, 0, u8(6)), ("sdo", 0x20F1, 0, u8(6)),
                                        ("power-cycle",)), new_id=6),
-    sdo_block=False,                                       # expedited and segmented (README)
-    sync_cobid_writable=False,                             # 1005h constant (README)
+    sdo_block=False,                         # expedited and segmented (docs/decisions.md)
+    sync_cobid_writable=False,               # 1005h constant (docs/decisions.md)
 )
 
 GSH = Facts(

@@ -246,7 +246,7 @@ class EmuTarget(Target):
             raise TargetError(f"{EMU} is missing: the emulated targets need tools/emu")
         if not self.image.exists():
             raise TargetError(f"{self.image} is missing: build the {self.board} images "
-                              f"(cmake -B build-{self.board} ...; see README)")
+                              f"(cmake -B build-{self.board} ...; see docs/emulator.md)")
         for _ in range(3):
             port = free_port()
             self.logf = open(self.log, "a")
@@ -417,7 +417,7 @@ class CanEmuTarget(EmuTarget):
             raise TargetError(f"{EMU} is missing: the emulated targets need tools/emu")
         if not self.image.exists():
             raise TargetError(f"{self.image} is missing: build the rv32-virt images "
-                              "(cmake -B build-rv32-virt ...; see README)")
+                              "(cmake -B build-rv32-virt ...; see docs/emulator.md)")
         for _ in range(3):
             port = free_port()
             self.logf = open(self.log, "a")

@@ -99,13 +99,13 @@ def help_verbs():
 
 def test_verbs_agree_with_the_python_package_and_the_readme():
     """One language: the verbs of the program's table (--help), the Python
-    package's list (a SimBus method each) and the README's command table are
+    package's list (a SimBus method each) and docs/control.md's command table are
     the same, in the same order."""
     from canopen_sensor_sim import VERBS, SimBus
     assert help_verbs() == list(VERBS)
     for verb in VERBS:
         assert callable(getattr(SimBus, verb, None)), verb
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    readme = (Path(__file__).resolve().parents[2] / "docs" / "control.md").read_text()
     table = [m.group(1) for m in re.finditer(r"^\| `([a-z]+)[ `]", readme, re.M)]
     assert list(dict.fromkeys(table)) == list(VERBS)
 

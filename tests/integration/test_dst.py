@@ -56,7 +56,7 @@ def test_sdo_aborts(model, sensor_factory, network, bus):
     assert abort_code(lambda: node.sdo.download(0x1017, 0, struct.pack("<H", 10))) == 0x06090030
     assert abort_code(lambda: node.sdo.download(0x1010, 1, b"sav!")) == 0x08000020
     # The DST guides use expedited transfer only (their SDO section); a segmented download is
-    # taken as the expedited write of its bytes would be (README): too long
+    # taken as the expedited write of its bytes would be (docs/decisions.md): too long
     # for the object is 06070012h, and the value stays.
     node.sdo.download(0x2001, 0, b"\x02", force_segment=True)
     assert u32(node, 0x2001, 0) == 2

@@ -61,7 +61,7 @@ def test_boots_onto_the_bus_with_nobody_on_its_serial_line(tmp_path):
     (wait=off), the node answers SDO there; then the serial line answers
     an input line and carries no frame though the node sends heartbeats.
     Three starts: the time from tools/emu's start to the boot-up is
-    printed (a figure of README)."""
+    printed (a figure of docs/emulator.md)."""
     node = PRODUCTS[IMAGE].nodes[0]
     bus = can.Bus(interface="socketcan", channel=IFACE)
     times = []

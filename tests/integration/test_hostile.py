@@ -335,7 +335,7 @@ def small_fs(tmp_path):
 
 def test_failed_save_disk_full_and_read_only(small_fs, tmp_path, procs):
     """A save that cannot be written answers 0x06060000 (CiA 301: hardware
-    error; README), logs the cause, and leaves the file as it was."""
+    error; docs/running.md), logs the cause, and leaves the file as it was."""
     nvm = small_fs / "eeprom.bin"
     p, b = boot(procs, tmp_path, "jd2xxx", 10, nvm=nvm)
     assert not nvm.exists()  # nothing written before the first save
@@ -435,11 +435,11 @@ def test_binary_standard_input_is_not_echoed_raw(tmp_path, procs):
 @pytest.mark.parametrize("delay_ms", [0, 1, 3, 10, 50])
 def test_sigterm_right_after_start_is_a_clean_stop(tmp_path, delay_ms):
     """SIGTERM while the program starts (the log, EEPROM file, sockets
-    being opened) exited 143, the default action, where the README says
+    being opened) exited 143, the default action, where docs/running.md says
     0: the stop signals are blocked from main's first line now, and read
     by the loop. Sent when the log file appears (the start's first step),
     and a few milliseconds later. (Before main, while the dynamic loader
-    runs, no program can have a handler: README.)"""
+    runs, no program can have a handler: docs/running.md.)"""
     log = tmp_path / "log"
     cmd = [BINARY, "--product", "jd2xxx", "--iface", "vcan0", "--log", str(log), "--nvm",
            str(tmp_path / "e.nvm")]
@@ -458,7 +458,7 @@ def test_sigterm_before_main_with_the_mask_inherited(tmp_path):
     """Before main (the kernel's exec and the dynamic loader: up to 20 ms
     under User-Mode Linux, about 1 ms on a PC) no program can catch a
     signal. A parent that may signal at once starts the program with the
-    stop signals blocked (a mask is inherited through exec, README): a
+    stop signals blocked (a mask is inherited through exec, docs/running.md): a
     SIGTERM at any moment, before main included, is then a clean stop."""
     cmd = [BINARY, "--product", "jd2xxx", "--iface", "vcan0", "--log", str(tmp_path / "log")]
     for _ in range(5):

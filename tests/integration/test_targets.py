@@ -599,7 +599,7 @@ def test_segmented_download_as_expedited(dut, facts, product):
     and by block download as by expedited: the same answer (success, or
     the same abort code) and the same value read back. The bytes are the
     object's own value as read (zeros where it is write-only), so nothing
-    changes underway. The DSTs have no block transfer (README): there it
+    changes underway. The DSTs have no block transfer (docs/decisions.md): there it
     is refused with 05040001h, and changes nothing."""
     eds = eds_entries(product)
     dut.power_on(facts.nodes)
@@ -637,7 +637,7 @@ def test_rtr_answers_tpdo(dut, facts):
     """CiA 301: a TPDO whose COB-ID has bit 30 clear ("RTR allowed") is sent
     at once on a remote request while operational, one frame, as long as
     the frames the TPDO sends by itself; while pre-operational none. One
-    with bit 30 set (the DSTs, README) is never sent on a remote request."""
+    with bit 30 set (the DSTs, docs/decisions.md) is never sent on a remote request."""
     dut.power_on(facts.nodes)
     for n in facts.nodes:
         nmt(dut, NMT_PREOP, n)
@@ -723,7 +723,7 @@ def test_mapping_count_beyond_entries(dut, facts, product):
 def test_sync_cobid(dut, facts):
     """A product with SYNC transmission types has CiA 301's 1005h: a TPDO of
     type 1 follows the SYNC on the COB-ID written there (on the DSTs it is
-    constant, README)."""
+    constant, docs/decisions.md)."""
     dut.power_on(facts.nodes)
     n = facts.nodes[0]
     if facts.sync_type is None:
@@ -732,7 +732,7 @@ def test_sync_cobid(dut, facts):
         assert abort_code(lambda: up(dut, n, 0x1005, 0)) == 0x06020000
         return
     assert up(dut, n, 0x1005, 0) == u32(0x80)
-    if not facts.sync_cobid_writable:  # constant (README)
+    if not facts.sync_cobid_writable:  # constant (docs/decisions.md)
         assert abort_code(lambda: down(dut, n, 0x1005, 0, u32(0x81))) == 0x06010002
         return
     cob = facts.tpdo_cob.of(n)

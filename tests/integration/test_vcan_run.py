@@ -227,7 +227,7 @@ def test_shell_next_to_a_sensor_on_a_terminal(tmp_path):
                "s.sendall(b\"set x=12.5\\nget\\n\"); time.sleep(0.5); print(s.recv(200).decode())'\n")
         t.wait_for("ok x=12.500")
         # User-Mode Linux's network is its own: the port is not on this
-        # machine's loopback (what the README says a runner outside meets).
+        # machine's loopback (what docs/running.md says a runner outside meets).
         with pytest.raises(ConnectionRefusedError):
             socket.create_connection(("127.0.0.1", port), timeout=5).close()
         # (Each echo's output differs from the line typed, which the
