@@ -1,4 +1,4 @@
-/*
+/** @file
  * co_guard.h - node guarding and life guarding (CiA 301 7.2.8.3.2.1).
  *
  * Active when the dictionary has 0x100C (guard time). A remote frame on
@@ -23,29 +23,31 @@
 
 #include "co_common.h"
 
-/* Longest lap of the life time: 1e9 us stays well inside co_time_before's
+/** Longest lap of the life time: 1e9 us stays well inside co_time_before's
  * 2^31 us horizon, with room for a late poll. */
 #define CO_GUARD_LAP_MS 1000000u
 
+/** The node object (co_node.h). */
 typedef struct co_node co_node_t;
 
+/** Node and life guarding state in the node. */
 typedef struct co_guard {
-    bool enabled;      /* the dictionary has guarding objects */
-    uint8_t toggle;    /* 0x00 or 0x80, the next answer's bit 7 */
-    bool seen;         /* a request came since the last reset */
-    bool kick;         /* a request came: restart the life time at next poll */
-    bool lost;         /* life-guard event active */
-    uint32_t deadline; /* end of the current lap of the life time */
-    uint32_t left_ms;  /* life time still to run after this lap */
+    bool enabled;      /**< the dictionary has guarding objects */
+    uint8_t toggle;    /**< 0x00 or 0x80, the next answer's bit 7 */
+    bool seen;         /**< a request came since the last reset */
+    bool kick;         /**< a request came: restart the life time at next poll */
+    bool lost;         /**< life-guard event active */
+    uint32_t deadline; /**< end of the current lap of the life time */
+    uint32_t left_ms;  /**< life time still to run after this lap */
 } co_guard_t;
 
-/* Reset communication: toggle 0, life guarding waits for the first request. */
+/** Reset communication: toggle 0, life guarding waits for the first request. */
 void co_guard_reset(co_node_t *node);
 
-/* Handle a remote frame on 0x700 + node-ID. Returns true if it was one. */
+/** Handle a remote frame on 0x700 + node-ID. Returns true if it was one. */
 bool co_guard_receive(co_node_t *node, const co_frame_t *f);
 
-/* The life time (co_service_t.poll): raises the life-guard event when it
+/** The life time (co_service_t.poll): raises the life-guard event when it
  * ran out. Returns the delay (us) until it next needs to run, CO_NEVER
  * while life guarding is off or waits for its first request. */
 uint32_t co_guard_poll(co_node_t *node, uint32_t now);

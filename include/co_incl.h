@@ -1,4 +1,4 @@
-/*
+/** @file
  * co_incl.h - CiA 410 inclinometer profile logic, one module for every
  * inclinometer of the tree.
  *
@@ -38,16 +38,18 @@
 #include "co_common.h"
 #include "co_filter.h"
 
+/** Operating parameter bits (0x6011, 0x6021): invert the output; scaling (offsets added). @{ */
 #define CO_INCL_OP_INVERT 0x01u
 #define CO_INCL_OP_SCALING 0x02u
+/** @} */
 
-/* The most axes a device has: axis arguments are below it (CO_CHECK). */
+/** The most axes a device has: axis arguments are below it (CO_CHECK). */
 #define CO_INCL_AXES 2u
 
-/* One full turn in millidegrees. */
+/** One full turn in millidegrees. */
 #define CO_INCL_TURN_MDEG 360000
 
-/* Circular outputs (0 .. one turn - 1 LSB: the P+F, GSH-A and ifm JD1 mode).
+/** Circular outputs (0 to one turn - 1 LSB: the P+F, GSH-A and ifm JD1 mode).
  * An MCU image of a product without them sets 0 (its family.cmake SIZES):
  * the mode's code is left out, a product that sets incl.circular does not
  * build, and a co_incl_fit_t's turn is not read (every output linear). */
@@ -60,7 +62,7 @@
 
 /* ---- The arithmetic of one output ------------------------------------ */
 
-/* The functions of a slope read (every PDO) are inlined also at -Os, where
+/** The functions of a slope read (every PDO) are inlined also at -Os, where
  * gcc calls them with the co_incl_fit_t on the stack, which makes the ifm
  * JD2's SYNC in tools/bench a fifth slower (the JD image is 350 bytes
  * larger for it; no DST image calls them twice). */
@@ -70,15 +72,15 @@
 #define CO_INCL_INLINE static inline
 #endif
 
-/* Round a / b to nearest, halves away from zero (any a). b must be above
+/** Round a / b to nearest, halves away from zero (any a). b must be above
  * 0: b <= 0 breaks the contract, CO_CHECK fails and the result is 0. */
 int32_t co_div_round(int32_t a, int32_t b);
 
-/* An angle in [-180000, 180000) millidegrees (any a; a few turns take one
+/** An angle in [-180000, 180000) millidegrees (any a; a few turns take one
  * pass each: no division, which an MCU image has as a helper). */
 int32_t co_incl_wrap180(int32_t a);
 
-/* Non-negative a mod m, in [0, m) (any a). Within one m either side of 0,
+/** Non-negative a mod m, in [0, m) (any a). Within one m either side of 0,
  * where the terms of a circular output are, without a division. m must be
  * above 0: m <= 0 breaks the contract, CO_CHECK fails and the result is 0. */
 static inline int32_t co_incl_mod(int32_t a, int32_t m)
@@ -93,7 +95,7 @@ static inline int32_t co_incl_mod(int32_t a, int32_t m)
     return r < 0 ? r + m : r;
 }
 
-/* v saturated to INTEGER32 (wide) or INTEGER16. */
+/** v saturated to INTEGER32 (wide) or INTEGER16. */
 static inline int32_t co_incl_saturate(int64_t v, bool wide)
 {
     int32_t hi = wide ? INT32_MAX : INT16_MAX;
@@ -101,7 +103,7 @@ static inline int32_t co_incl_saturate(int64_t v, bool wide)
     return v > hi ? hi : (v < lo ? lo : (int32_t)v);
 }
 
-/*
+/**
  * How a slope object holds its value, an option of each output:
  *   turn > 0: circular, modulo one turn (turn = 360 deg in resolution
  *             units): outputs 0..turn-1, whatever the offsets hold;
@@ -112,12 +114,12 @@ static inline int32_t co_incl_saturate(int64_t v, bool wide)
  *             INTEGER16, never wrapped (CiA 410, ifm JD2).
  */
 typedef struct co_incl_fit {
-    int32_t turn;
-    bool wide;
-    bool centred;
+    int32_t turn; /**< one turn in resolution units: circular; 0: linear */
+    bool wide;    /**< linear: INTEGER32, else INTEGER16 */
+    bool centred; /**< circular: preset offsets in (-turn/2, turn/2] */
 } co_incl_fit_t;
 
-/* A 32-bit sum wrapped modulo 2^32 (no overflow trap), saturated to
+/** A 32-bit sum wrapped modulo 2^32 (no overflow trap), saturated to
  * INTEGER16: exact while the true sum is within +-2^31. */
 CO_INCL_INLINE int32_t co_incl_sat16(uint32_t sum)
 {
@@ -125,7 +127,7 @@ CO_INCL_INLINE int32_t co_incl_sat16(uint32_t sum)
     return v > INT16_MAX ? INT16_MAX : (v < INT16_MIN ? INT16_MIN : v);
 }
 
-/*
+/**
  * The CiA 410 formula above for one output: m the measured angle in
  * resolution units, op the object's operating parameter, offset and diff
  * its offset and differential offset (read only with the scaling bit).
@@ -167,7 +169,7 @@ CO_INCL_INLINE int32_t co_incl_output(int32_t m, uint8_t op, int32_t offset, int
     return co_incl_saturate(v, true);
 }
 
-/* The offset that makes the output read preset now, at measured angle m:
+/** The offset that makes the output read preset now, at measured angle m:
  * preset - s*m - diff, fitted as fit says (circular: into its window;
  * linear: saturated to the type). diff: the differential offset where the
  * product's offset takes it in (the output then reads preset), 0 where it
@@ -176,7 +178,7 @@ CO_INCL_INLINE int32_t co_incl_output(int32_t m, uint8_t op, int32_t offset, int
 int32_t co_incl_preset_offset(int32_t preset, int32_t m, uint8_t op, int32_t diff,
                               co_incl_fit_t fit);
 
-/*
+/**
  * Measured angles in resolution units, for a product that computes its
  * outputs at each read: divided once per sample and once per change of
  * 0x6000, never per read (a division is a helper call on the Cortex-M0:
@@ -186,17 +188,17 @@ int32_t co_incl_preset_offset(int32_t preset, int32_t m, uint8_t op, int32_t dif
  * writer telling it. The caller owns it and the angles it is given.
  */
 typedef struct co_incl_meas {
-    int32_t m[CO_INCL_AXES]; /* angle / resolution, rounded */
-    int32_t turn;            /* one turn in resolution units */
-    uint16_t res;            /* the resolution m and turn hold; 0: none */
+    int32_t m[CO_INCL_AXES]; /**< angle / resolution, rounded */
+    int32_t turn;            /**< one turn in resolution units */
+    uint16_t res;            /**< the resolution m and turn hold; 0: none */
 } co_incl_meas_t;
 
-/* Recompute *c from angles mdeg[0..CO_INCL_AXES-1] (mdeg, any values) at
+/** Recompute *c from angles mdeg[0..CO_INCL_AXES-1] (mdeg, any values) at
  * resolution res. res 0 (no parameters loaded yet): every m and the turn
  * are 0, until a resolution comes. Cannot fail. */
 void co_incl_remeasure(co_incl_meas_t *c, const int32_t mdeg[CO_INCL_AXES], uint16_t res);
 
-/* *c at resolution res: recomputed from mdeg (the angles it was last
+/** *c at resolution res: recomputed from mdeg (the angles it was last
  * given) when res changed, as it is when read. Call it before reading
  * c->m[] and c->turn; at the start of a read, where little else is live
  * across the rare call (the Cortex-M0 then spills nothing). */
@@ -211,41 +213,42 @@ CO_INCL_INLINE const co_incl_meas_t *co_incl_meas_at(co_incl_meas_t *c,
 
 /* ---- co_incl_t: one INTEGER16 slope set per axis ----------------------- */
 
-/* Stored parameters; products embed this in their PARA struct. Word
+/** Stored parameters; products embed this in their PARA struct. Word
  * aligned (16 bytes, no padding): the slope cache compares it with four
  * word loads (co_incl_para_same). The products' PARA structs already had
  * it at a multiple of 4, so no stored layout moved. */
 typedef struct co_incl_para {
-    _Alignas(4) uint16_t resolution;
-    uint8_t op[2];
-    int16_t preset[2];
-    int16_t offset[2];
-    int16_t diff[2];
+    _Alignas(4) uint16_t resolution; /**< 0x6000 */
+    uint8_t op[2];                   /**< per axis: operating parameter (0x6011, 0x6021) */
+    int16_t preset[2];               /**< per axis: preset (0x6012, 0x6022) */
+    int16_t offset[2];               /**< per axis: offset (0x6013, 0x6023) */
+    int16_t diff[2];                 /**< per axis: differential offset (0x6014, 0x6024) */
 } co_incl_para_t;
 
+/** The CiA 410 logic of one inclinometer; the caller's (co_incl_init). */
 typedef struct co_incl {
-    co_incl_para_t *p;
-    uint8_t axes; /* 1 (single axis) or 2 */
-    bool wrap;    /* full turn: the angle wraps at +-180 deg */
+    co_incl_para_t *p; /**< its stored parameters (the caller's) */
+    uint8_t axes;      /**< 1 (single axis) or 2 */
+    bool wrap;         /**< full turn: the angle wraps at +-180 deg */
 #if CO_INCL_CIRCULAR
-    bool circular; /* outputs 0..full turn - 1 LSB, modulo a full turn (P+F) */
+    bool circular; /**< outputs 0..full turn - 1 LSB, modulo a full turn (P+F) */
 #endif
-    bool fault;                  /* sensor element error: outputs hold */
-    int32_t limit_mdeg;          /* output stops here, error beyond it; 0: none */
-    uint8_t shift;               /* active filter shift */
-    bool beyond[CO_INCL_AXES];   /* measured angle strictly beyond the limit */
-    int32_t angle[CO_INCL_AXES]; /* filtered, saturated angle (mdeg) */
-    /* Wrap mode: each axis' own continuous input to its filter (one value
+    bool fault;                  /**< sensor element error: outputs hold */
+    int32_t limit_mdeg;          /**< output stops here, error beyond it; 0: none */
+    uint8_t shift;               /**< active filter shift */
+    bool beyond[CO_INCL_AXES];   /**< measured angle strictly beyond the limit */
+    int32_t angle[CO_INCL_AXES]; /**< filtered, saturated angle (mdeg) */
+    /** Wrap mode: each axis' own continuous input to its filter (one value
      * for both makes the second axis follow the first's turns). */
     int32_t unwrapped[CO_INCL_AXES];
-    co_filter_t f[CO_INCL_AXES];
-    /* The slope outputs, computed once per sample rather than per read
+    co_filter_t f[CO_INCL_AXES]; /**< each axis' angle filter */
+    /** The slope outputs, computed once per sample rather than per read
      * (SDO, every PDO): valid while *p still equals seen. */
     int16_t out[CO_INCL_AXES];
-    co_incl_para_t seen;
+    co_incl_para_t seen; /**< the parameters out[] was computed with */
 } co_incl_t;
 
-/*
+/**
  * Set incl up for a device of axes axes (1 or 2; CO_INCL_AXES at most)
  * whose parameters are *p: no sample yet (outputs 0), the filter at its
  * slow speed (set incl->shift to change it; 0 passes samples through),
@@ -258,7 +261,7 @@ typedef struct co_incl {
  */
 void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limit_mdeg, bool wrap);
 
-/*
+/**
  * Feed one sensor sample: mdeg[a] is axis a's angle in millidegrees
  * (entries from incl->axes on are not read). Filters it, applies the
  * limit or the wrap, and recomputes every slope output. While
@@ -267,7 +270,7 @@ void co_incl_init(co_incl_t *incl, co_incl_para_t *p, uint8_t axes, int32_t limi
  */
 void co_incl_sample(co_incl_t *incl, const int32_t mdeg[2]);
 
-/*
+/**
  * co_incl_slope's slow path, for a parameter changed since the last
  * sample: recompute every output with *incl->p, return axis's. An axis
  * the device lacks (incl->axes <= axis < CO_INCL_AXES) reads 0. An axis
@@ -278,7 +281,7 @@ int16_t co_incl_refresh_slope(co_incl_t *incl, unsigned axis);
 
 _Static_assert(sizeof(co_incl_para_t) == 16u, "co_incl_para_t: four words, no padding");
 
-/* *a equals *b. On a 32-bit core four word compares, not memcmp: there
+/** *a equals *b. On a 32-bit core four word compares, not memcmp: there
  * memcmp is libc_min.c's byte loop, 135 Cortex-M0 instructions per slope
  * read (each TPDO and slope SDO read has one), for 8 bytes of flash. */
 static inline bool co_incl_para_same(const co_incl_para_t *a, const co_incl_para_t *b)
@@ -299,7 +302,7 @@ static inline bool co_incl_para_same(const co_incl_para_t *a, const co_incl_para
 #endif
 }
 
-/* The slope object (0x6010 axis 0, 0x6020 axis 1) in resolution units.
+/** The slope object (0x6010 axis 0, 0x6020 axis 1) in resolution units.
  * Recomputed only when a parameter changed since the last sample:
  * parameters reach p through plain dictionary writes and the store too,
  * so compare rather than rely on every writer telling us. An axis the
@@ -317,10 +320,10 @@ static inline int16_t co_incl_slope(co_incl_t *incl, unsigned axis)
     return incl->out[axis];
 }
 
-/* The same as a read hook's answer: the slope sign-extended into *v
+/** The same as a read hook's answer: the slope sign-extended into *v
  * (always CO_OK; an axis as co_incl_slope). The slow path is a tail call,
  * so the fast one needs no stack frame. co_incl_refresh_read is that
- * slow path (axes as co_incl_refresh_slope; *v = 0 for any other). */
+ * slow path (axes as co_incl_refresh_slope; *v = 0 for any other). @{ */
 co_res_t co_incl_refresh_read(co_incl_t *incl, unsigned axis, uint32_t *v);
 static inline co_res_t co_incl_read(co_incl_t *incl, unsigned axis, uint32_t *v)
 {
@@ -330,11 +333,12 @@ static inline co_res_t co_incl_read(co_incl_t *incl, unsigned axis, uint32_t *v)
     }
     return co_incl_refresh_read(incl, axis, v);
 }
+/** @} */
 
-/* Any axis beyond its limit at the last sample (never in wrap mode). */
+/** Any axis beyond its limit at the last sample (never in wrap mode). */
 bool co_incl_beyond(const co_incl_t *incl);
 
-/*
+/**
  * Write the resolution (0x6000). Refused with CO_E_STATE unless the scaling
  * bit is set on every axis the device has (0x6011 and 0x6021). A changed
  * value clears every preset, offset and differential offset. The set of
@@ -342,7 +346,7 @@ bool co_incl_beyond(const co_incl_t *incl);
  */
 co_res_t co_incl_set_resolution(co_incl_t *incl, uint16_t res);
 
-/*
+/**
  * Write the preset (0x6012/0x6022): stores it and sets the offset so that
  * the output reads it now (linear: offset = preset - s*m, saturated to
  * INTEGER16; circular: offset = preset - a1 - differential offset, modulo

@@ -1,4 +1,4 @@
-/*
+/** @file
  * co_lss.h - LSS slave (CiA 305): layer setting services on 0x7E5 (master
  * to slave) and 0x7E4 (slave to master), 8-byte frames.
  *
@@ -27,29 +27,32 @@
 
 #include "co_common.h"
 
+/** The node object (co_node.h). */
 typedef struct co_node co_node_t;
 
+/** The node-ID of a node not configured (LSS): silent but for LSS. */
 #define CO_LSS_UNCONFIGURED 0xFFu
 
+/** LSS slave state in the node. */
 typedef struct co_lss {
-    uint8_t state;      /* 0 waiting, 1 configuration */
-    uint8_t selective;  /* switch-state-selective progress (matched parts) */
-    uint8_t pending_id; /* node-ID for the next reset communication; 0: none */
-    uint8_t pending_br; /* CiA 305 bit-timing index configured; 0xFF: none */
-    uint8_t identify;   /* identify-remote-slave progress */
-    uint8_t fs_sub;     /* Fastscan: which LSS address part is checked next */
-    bool fs_active;     /* Fastscan: confirmed so far */
-    bool switching;     /* activate bit timing: the switch is due at switch_at */
-    uint32_t switch_at; /* (us) */
+    uint8_t state;      /**< 0 waiting, 1 configuration */
+    uint8_t selective;  /**< switch-state-selective progress (matched parts) */
+    uint8_t pending_id; /**< node-ID for the next reset communication; 0: none */
+    uint8_t pending_br; /**< CiA 305 bit-timing index configured; 0xFF: none */
+    uint8_t identify;   /**< identify-remote-slave progress */
+    uint8_t fs_sub;     /**< Fastscan: which LSS address part is checked next */
+    bool fs_active;     /**< Fastscan: confirmed so far */
+    bool switching;     /**< activate bit timing: the switch is due at switch_at */
+    uint32_t switch_at; /**< (us) */
 } co_lss_t;
 
-/* Reset communication (co_service_t.reset): back to the waiting state, no
+/** Reset communication (co_service_t.reset): back to the waiting state, no
  * selective switch, identification or Fastscan in progress, a configured
  * bit timing forgotten; a configured node-ID stays pending (co_node_reset
  * applies it). */
 void co_lss_reset(co_node_t *node);
 
-/* Handle a frame on 0x7E5. Returns true if it was one. Works in every NMT
+/** Handle a frame on 0x7E5. Returns true if it was one. Works in every NMT
  * state, and while the node has no node-ID. */
 bool co_lss_receive(co_node_t *node, const co_frame_t *f);
 

@@ -1,4 +1,4 @@
-/*
+/** @file
  * co_node.h - the node object: one CANopen slave, all of its state.
  *
  * The contract between a product (od/), a board (boards/) and the stack.
@@ -78,85 +78,86 @@
 #include "co_sync.h"
 #include "co_tpdo.h"
 
-/* Stored node-ID and bit rate: the RAM struct of class LSS. */
+/** Stored node-ID and bit rate: the RAM struct of class LSS. */
 typedef struct co_lss_para {
-    uint8_t node_id;
-    uint8_t bitrate; /* product's code */
+    uint8_t node_id; /**< stored node-ID */
+    uint8_t bitrate; /**< product's code */
 } co_lss_para_t;
 
-/* Product hooks; every one is optional (NULL). */
+/** Product hooks; every one is optional (NULL). */
 typedef struct co_node_ops {
-    /* After the stack reloaded parameters for a reset; before boot-up. */
+    /** After the stack reloaded parameters for a reset; before boot-up. */
     void (*reset)(co_node_t *node, co_reset_t kind);
-    /* After every NMT state change, boot-up included (old = INIT). */
+    /** After every NMT state change, boot-up included (old = INIT). */
     void (*state)(co_node_t *node, co_nmt_state_t old_state);
-    /* The CAN controller's state changed (co_emcy_can_state reports it by EMCY). */
+    /** The CAN controller's state changed (co_emcy_can_state reports it by EMCY). */
     void (*can_state)(co_node_t *node, co_can_state_t old_state);
-    /* After 0x1010 "save" or 0x1011 "load" succeeded. */
+    /** After 0x1010 "save" or 0x1011 "load" succeeded. */
     void (*stored)(co_node_t *node, uint32_t signature);
-    /* Product work; returns the delay until it next needs to run. */
+    /** Product work; returns the delay until it next needs to run. */
     uint32_t (*poll)(co_node_t *node, uint32_t now);
-    /* Complete a TPDO after its mapped bytes (fixed layouts, counters, checksums). */
+    /** Complete a TPDO after its mapped bytes (fixed layouts, counters, checksums). */
     void (*tpdo_fill)(co_node_t *node, unsigned n, co_frame_t *f);
-    /*
+    /**
      * LSS "store configuration": keep node-ID id and CiA 305 bit-timing
      * index br (0xFF: unchanged). Returns the LSS error code (0 ok,
      * 1 not supported, 2 storage error). NULL: the LSS class is stored.
      */
     uint8_t (*lss_store)(co_node_t *node, uint8_t id, uint8_t br);
-    /* LED patterns; when NULL the CiA 303-3 mapping of co_node_leds() holds. */
+    /** LED patterns; when NULL the CiA 303-3 mapping of co_node_leds() holds. */
     void (*leds)(co_node_t *node, co_led_pattern_t *green, co_led_pattern_t *red);
 } co_node_ops_t;
 
-/*
+/**
  * An optional service: linked into an image only when a product's config
- * lists it (a feature is left out by not linking its file, not by #if).
+ * lists it (a feature is left out by not linking its file, not by `#if`).
  * The core (NMT, SDO, SYNC, heartbeat, TPDO, EMCY, store) is always there.
  */
 typedef struct co_service {
-    bool (*receive)(co_node_t *node, const co_frame_t *f); /* true: consumed */
-    uint32_t (*poll)(co_node_t *node, uint32_t now);       /* next deadline */
-    void (*reset)(co_node_t *node);                        /* at reset communication */
-    bool always; /* receives in every state, and without a node-ID (LSS) */
+    bool (*receive)(co_node_t *node, const co_frame_t *f); /**< true: consumed */
+    uint32_t (*poll)(co_node_t *node, uint32_t now);       /**< next deadline */
+    void (*reset)(co_node_t *node);                        /**< at reset communication */
+    bool always; /**< receives in every state, and without a node-ID (LSS) */
 } co_service_t;
 
-extern const co_service_t co_guard_service; /* node and life guarding (co_guard.h) */
-extern const co_service_t co_hbc_service;   /* heartbeat consumer (co_hbc.h) */
-extern const co_service_t co_lss_service;   /* LSS slave (co_lss.h) */
-extern const co_service_t co_rtr_service;   /* TPDOs on remote request (co_tpdo.h) */
+extern const co_service_t co_guard_service; /**< node and life guarding (co_guard.h) */
+extern const co_service_t co_hbc_service;   /**< heartbeat consumer (co_hbc.h) */
+extern const co_service_t co_lss_service;   /**< LSS slave (co_lss.h) */
+extern const co_service_t co_rtr_service;   /**< TPDOs on remote request (co_tpdo.h) */
 
-/* What a product type is; const, shared by every node of that product. */
+/** What a product type is; const, shared by every node of that product. */
 typedef struct co_node_cfg {
-    const co_od_t *od;
-    const co_node_ops_t *ops;
-    const co_led_timing_t *led;
-    const co_service_t *const *services; /* optional services, NULL-ended (may be NULL) */
-    /* SDO segmented (co_sdo_segmented) and block (co_sdo_block) transfer,
-     * or NULL: not offered, such requests are aborted with 0x05040001. */
+    const co_od_t *od;                   /**< the dictionary */
+    const co_node_ops_t *ops;            /**< the product's hooks, or NULL: none */
+    const co_led_timing_t *led;          /**< LED timings (co_led_cia303, or the manual's) */
+    const co_service_t *const *services; /**< optional services, NULL-ended (may be NULL) */
+    /** SDO segmented (co_sdo_segmented) and block (co_sdo_block) transfer,
+     * or NULL: not offered, such requests are aborted with 0x05040001. @{ */
     co_sdo_proto_fn sdo_segmented;
     co_sdo_proto_fn sdo_block;
-    uint16_t ram_size[CO_CLS_COUNT]; /* sizeof each class struct (0: none) */
-    uint8_t default_node_id;
-    uint8_t default_bitrate;    /* product's code for its default bit rate */
-    uint8_t tpdo_dlc;           /* 0: DLC = mapped bytes; 8: pad with zeros */
-    uint16_t inhibit_unit_us;   /* unit of 0x1800+n sub 3; 0: CiA 301's 100 us; at most
-                                 * 1000, so that 65535 units stay inside the 2^31 us a
-                                 * wrapping deadline can span (a larger one counts as 1000) */
-    uint32_t store_write_limit; /* 0: unlimited */
-    bool autosave;              /* every SDO write to a stored entry is stored at once */
-    bool load_keeps_lss;        /* 0x1011 "load" leaves node-ID and bit rate alone */
-    bool comm_reset_applies_id; /* reset communication also activates a new node-ID */
-    bool save_includes_lss;     /* 0x1010 "save" stores the node-ID / bit-rate set too */
-    uint16_t lss_bitrates;      /* CiA 305 bit-timing indices supported (bit n = index n) */
-    uint8_t id_offset;          /* id_index holds the node-ID minus this (the JD's 3000h: 1) */
-    uint16_t id_index;          /* 0, or a product's own U8 object (sub 0) of the PARA class
-                                 * holding the node-ID (minus id_offset): where a factory
-                                 * node-ID (co_node_set_factory_id) goes when its defaults are
-                                 * loaded. A node-ID in the LSS class needs none. */
-    const uint16_t *kbps;       /* kbit/s of each bit-rate code (16 codes; 0: unused), or NULL */
+    /** @} */
+    uint16_t ram_size[CO_CLS_COUNT]; /**< sizeof each class struct (0: none) */
+    uint8_t default_node_id;         /**< what a blank EEPROM boots with (co_node_set_factory_id) */
+    uint8_t default_bitrate;         /**< product's code for its default bit rate */
+    uint8_t tpdo_dlc;                /**< 0: DLC = mapped bytes; 8: pad with zeros */
+    uint16_t inhibit_unit_us;        /**< unit of 0x1800+n sub 3; 0: CiA 301's 100 us; at most
+                                      * 1000, so that 65535 units stay inside the 2^31 us a
+                                      * wrapping deadline can span (a larger one counts as 1000) */
+    uint32_t store_write_limit;      /**< 0: unlimited */
+    bool autosave;                   /**< every SDO write to a stored entry is stored at once */
+    bool load_keeps_lss;             /**< 0x1011 "load" leaves node-ID and bit rate alone */
+    bool comm_reset_applies_id;      /**< reset communication also activates a new node-ID */
+    bool save_includes_lss;          /**< 0x1010 "save" stores the node-ID / bit-rate set too */
+    uint16_t lss_bitrates;           /**< CiA 305 bit-timing indices supported (bit n = index n) */
+    uint8_t id_offset;    /**< id_index holds the node-ID minus this (the JD's 3000h: 1) */
+    uint16_t id_index;    /**< 0, or a product's own U8 object (sub 0) of the PARA class
+                           * holding the node-ID (minus id_offset): where a factory
+                           * node-ID (co_node_set_factory_id) goes when its defaults are
+                           * loaded. A node-ID in the LSS class needs none. */
+    const uint16_t *kbps; /**< kbit/s of each bit-rate code (16 codes; 0: unused), or NULL */
 } co_node_cfg_t;
 
-/* Whether cfg lists service sv (a node is an LSS slave when it lists
+/** Whether cfg lists service sv (a node is an LSS slave when it lists
  * co_lss_service: the list is the one place that says so). */
 static inline bool co_cfg_has_service(const co_node_cfg_t *cfg, const co_service_t *sv)
 {
@@ -168,47 +169,47 @@ static inline bool co_cfg_has_service(const co_node_cfg_t *cfg, const co_service
     return false;
 }
 
-/* The node's state. Its fields are the stack's: the accessors below and
+/** The node's state. Its fields are the stack's: the accessors below and
  * the modules' functions are the product's and the board's way in. */
 struct co_node {
     /* Bytes first: on a Cortex-M0 a byte field is one load only within the
      * first 32 bytes of the struct (words: 128), so the hot ones go here. */
-    uint8_t node_id;       /* active node-ID */
-    uint8_t bitrate;       /* active bit-rate code (the product's table) */
-    uint8_t can_state;     /* co_can_state_t */
-    bool autostart;        /* set by the reset op: go operational after boot-up */
-    uint8_t reset_request; /* co_reset_t to perform at the next poll (0: none) */
-    bool dirty;            /* something happened since the last full poll */
-    bool due_never;        /* the last full poll found no deadline at all */
-    bool od_checking;      /* write hooks only validate (co_od_validate) */
-    uint8_t factory_id;    /* co_node_set_factory_id(); 0: the config's default */
-    co_nmt_t nmt;
-    uint16_t can_kbps; /* bit rate the board was last asked for (co_port_can_bitrate);
-                        * here, in what was padding before cfg */
-    const co_node_cfg_t *cfg;
-    void *port;              /* board context for co_port_* */
-    void *app;               /* product context for its hooks */
-    void *ram[CO_CLS_COUNT]; /* the class structs, owned by the caller */
-    uint32_t nvm_base;       /* where this node's records start in NVM */
-    uint32_t now;            /* time of the latest co_node_poll() or co_node_receive() */
-    uint32_t due;            /* not dirty: no service needs to run before this time */
-    uint32_t tx_dropped;     /* frames the board could not queue */
-    co_sync_t sync;
-    co_hb_t hb;
-    co_store_t store;
-    co_sdo_t sdo;
-    co_tpdo_t tpdo[CO_TPDO_MAX];
-    co_emcy_t emcy;
-    co_guard_t guard;
-    co_lss_t lss;
-    co_hbc_t hbc;
-    uint32_t serial; /* co_node_set_serial(); 0: none given. Last: read
-                      * once a boot, it shifts no hot field's offset (Cortex-M0 bytes) */
+    uint8_t node_id;             /**< active node-ID */
+    uint8_t bitrate;             /**< active bit-rate code (the product's table) */
+    uint8_t can_state;           /**< co_can_state_t */
+    bool autostart;              /**< set by the reset op: go operational after boot-up */
+    uint8_t reset_request;       /**< co_reset_t to perform at the next poll (0: none) */
+    bool dirty;                  /**< something happened since the last full poll */
+    bool due_never;              /**< the last full poll found no deadline at all */
+    bool od_checking;            /**< write hooks only validate (co_od_validate) */
+    uint8_t factory_id;          /**< co_node_set_factory_id(); 0: the config's default */
+    co_nmt_t nmt;                /**< NMT (co_nmt.h) */
+    uint16_t can_kbps;           /**< bit rate the board was last asked for (co_port_can_bitrate);
+                                  * here, in what was padding before cfg */
+    const co_node_cfg_t *cfg;    /**< the config co_node_init() got (read it with co_cfg()) */
+    void *port;                  /**< board context for co_port_* */
+    void *app;                   /**< product context for its hooks */
+    void *ram[CO_CLS_COUNT];     /**< the class structs, owned by the caller */
+    uint32_t nvm_base;           /**< where this node's records start in NVM */
+    uint32_t now;                /**< time of the latest co_node_poll() or co_node_receive() */
+    uint32_t due;                /**< not dirty: no service needs to run before this time */
+    uint32_t tx_dropped;         /**< frames the board could not queue */
+    co_sync_t sync;              /**< SYNC consumer (co_sync.h) */
+    co_hb_t hb;                  /**< heartbeat producer (co_hb.h) */
+    co_store_t store;            /**< parameter store (co_store.h) */
+    co_sdo_t sdo;                /**< SDO server (co_sdo.h) */
+    co_tpdo_t tpdo[CO_TPDO_MAX]; /**< TPDOs (co_tpdo.h) */
+    co_emcy_t emcy;              /**< EMCY producer (co_emcy.h) */
+    co_guard_t guard;            /**< node and life guarding (co_guard.h) */
+    co_lss_t lss;                /**< LSS slave (co_lss.h) */
+    co_hbc_t hbc;                /**< heartbeat consumer (co_hbc.h) */
+    uint32_t serial;             /**< co_node_set_serial(); 0: none given. Last: read
+                                  * once a boot, it shifts no hot field's offset (Cortex-M0 bytes) */
 };
 
-/*
+/**
  * The node's config. An MCU image of one product may fix it at build time
- * (-DCO_FIXED_CFG=<config symbol>): every flag and hook of the config is
+ * (`-DCO_FIXED_CFG=<config symbol>`): every flag and hook of the config is
  * then a constant to the compiler, which drops the code that product never
  * runs. co_node_init() must then be given that same config.
  */
@@ -219,7 +220,7 @@ extern const co_node_cfg_t CO_FIXED_CFG;
 #define co_cfg(node) ((node)->cfg)
 #endif
 
-/*
+/**
  * Prepare a node; nothing is sent, the board is not called. cfg, port, app
  * and the ram structs are owned by the caller and must outlive the node;
  * ram (copied) has CO_CLS_COUNT entries, NULL where cfg->ram_size is 0.
@@ -229,13 +230,13 @@ extern const co_node_cfg_t CO_FIXED_CFG;
 void co_node_init(co_node_t *node, const co_node_cfg_t *cfg, void *port, void *app,
                   void *const ram[CO_CLS_COUNT], uint32_t nvm_base);
 
-/* Power-on at time now: reset node (restore the stored sets, ask the
+/** Power-on at time now: reset node (restore the stored sets, ask the
  * board for the bit rate, boot-up, pre-operational or, with autostart,
  * operational). A stored set that cannot be used is reported, never
  * fatal: co_node_store_status(). */
 void co_node_start(co_node_t *node, uint32_t now);
 
-/*
+/**
  * Tell the node that something its services look at changed outside a
  * received frame (a sensor sample, a fault): the next co_node_poll() runs
  * every service instead of returning at once because nothing is due.
@@ -245,7 +246,7 @@ static inline void co_node_wake(co_node_t *node)
     node->dirty = true;
 }
 
-/* A write hook runs for co_od_validate(): check the value held, store nothing (co_od_write_fn). */
+/** A write hook runs for co_od_validate(): check the value held, store nothing (co_od_write_fn). */
 static inline bool co_od_checking(const co_node_t *node)
 {
     return node->od_checking;
@@ -255,43 +256,43 @@ static inline bool co_od_checking(const co_node_t *node)
  * Static inline: each is the one load or store it replaces, free in an
  * image. */
 
-/* The product context given to co_node_init() (the product's instance). */
+/** The product context given to co_node_init() (the product's instance). */
 static inline void *co_node_app(const co_node_t *node)
 {
     return node->app;
 }
 
-/* The active node-ID: 1..127, or CO_LSS_UNCONFIGURED (0xFF: none yet, LSS). */
+/** The active node-ID: 1..127, or CO_LSS_UNCONFIGURED (0xFF: none yet, LSS). */
 static inline uint8_t co_node_id(const co_node_t *node)
 {
     return node->node_id;
 }
 
-/* The active bit-rate code (the product's table, co_node_cfg_t.kbps). */
+/** The active bit-rate code (the product's table, co_node_cfg_t.kbps). */
 static inline uint8_t co_node_bitrate(const co_node_t *node)
 {
     return node->bitrate;
 }
 
-/* The NMT state (CO_NMT_INIT while a reset runs). */
+/** The NMT state (CO_NMT_INIT while a reset runs). */
 static inline co_nmt_state_t co_node_nmt_state(const co_node_t *node)
 {
     return (co_nmt_state_t)node->nmt.state;
 }
 
-/* The CAN controller's state as the board last reported it. */
+/** The CAN controller's state as the board last reported it. */
 static inline co_can_state_t co_node_can_state(const co_node_t *node)
 {
     return (co_can_state_t)node->can_state;
 }
 
-/* Frames the board could not queue or that fell due while bus-off. */
+/** Frames the board could not queue or that fell due while bus-off. */
 static inline uint32_t co_node_tx_dropped(const co_node_t *node)
 {
     return node->tx_dropped;
 }
 
-/*
+/**
  * What the last restore of class cls (CO_CLS_PARA, CO_CLS_LSS) found, as
  * updated since (co_store.h: a full save makes a corrupt set sound again).
  * Another cls: a broken contract (CO_CHECK), CO_STORE_BLANK.
@@ -310,7 +311,7 @@ static inline co_store_status_t co_node_store_status(const co_node_t *node, co_c
  * product change them (the NMT state is CO_NMT_INIT then). Anywhere else
  * a call is a broken contract (CO_CHECK) and changes nothing. */
 
-/* Node-ID id (1..127, or CO_LSS_UNCONFIGURED) from the next boot-up on:
+/** Node-ID id (1..127, or CO_LSS_UNCONFIGURED) from the next boot-up on:
  * a product that keeps it in its own object (the JD's 3000h). Another id:
  * a broken contract (CO_CHECK), nothing changes. */
 static inline void co_node_set_id(co_node_t *node, uint8_t id)
@@ -321,7 +322,7 @@ static inline void co_node_set_id(co_node_t *node, uint8_t id)
     }
 }
 
-/* Bit-rate code (0..15, the product's table) activated by this reset: the
+/** Bit-rate code (0..15, the product's table) activated by this reset: the
  * board is asked for its rate when the reset ends (co_port_can_bitrate).
  * Another code: a broken contract (CO_CHECK), nothing changes. */
 static inline void co_node_set_bitrate(co_node_t *node, uint8_t code)
@@ -331,7 +332,7 @@ static inline void co_node_set_bitrate(co_node_t *node, uint8_t code)
     }
 }
 
-/* Go operational by itself after this boot-up (the DST's 0x5000, ...). */
+/** Go operational by itself after this boot-up (the DST's 0x5000, ...). */
 static inline void co_node_set_autostart(co_node_t *node, bool on)
 {
     if (CO_CHECK(node->nmt.state == CO_NMT_INIT)) {
@@ -339,14 +340,14 @@ static inline void co_node_set_autostart(co_node_t *node, bool on)
     }
 }
 
-/*
+/**
  * The factory node-ID of this node (1..127), instead of the config's
  * default_node_id, which all nodes of a product share: what a blank EEPROM
  * boots with and what "restore defaults" (0x1011, then a reset) returns
  * to. The stack puts it in the LSS set's defaults and, where the product
  * keeps its node-ID in its own object (co_node_cfg_t.id_index), in that
  * object's default. A board that runs several nodes of one product (the
- * Linux program's --node PRODUCT@ID) calls it after co_node_init() and
+ * Linux program's `--node PRODUCT@ID`) calls it after co_node_init() and
  * before co_node_start(). While the node runs (its NMT state is not
  * CO_NMT_INIT), or another id, it is a broken contract (CO_CHECK) and
  * changes nothing.
@@ -359,7 +360,7 @@ static inline void co_node_set_factory_id(co_node_t *node, uint8_t id)
     }
 }
 
-/*
+/**
  * The serial number of this unit (0x1018 sub 4, the last part of its LSS
  * address, CiA 305), which the const table cannot hold: every instance of
  * a product needs its own, or LSS cannot address one of them. A board
@@ -377,31 +378,31 @@ static inline void co_node_set_serial(co_node_t *node, uint32_t serial)
     }
 }
 
-/* The serial number co_node_set_serial() gave, 0: none. */
+/** The serial number co_node_set_serial() gave, 0: none. */
 static inline uint32_t co_node_serial(const co_node_t *node)
 {
     return node->serial;
 }
 
-/* The node's factory node-ID: co_node_set_factory_id()'s, else the config's. */
+/** The node's factory node-ID: co_node_set_factory_id()'s, else the config's. */
 static inline uint8_t co_node_factory_id(const co_node_t *node)
 {
     return node->factory_id != 0u ? node->factory_id : co_cfg(node)->default_node_id;
 }
 
-/* Reset at the next poll, after the answer to the current request went out. */
+/** Reset at the next poll, after the answer to the current request went out. */
 static inline void co_node_request_reset(co_node_t *node, co_reset_t kind)
 {
     node->reset_request = (uint8_t)kind;
     co_node_wake(node);
 }
 
-/* Reset node or communication now (what the NMT commands do): the
+/** Reset node or communication now (what the NMT commands do): the
  * product's reset hook runs, the boot-up is sent. From a write hook use
  * co_node_request_reset() instead, so that the answer goes out first. */
 void co_node_reset(co_node_t *node, co_reset_t kind);
 
-/*
+/**
  * One received frame f (copied from where it is needed; the caller keeps
  * f), at time now (us, the clock co_node_poll() gets): the time stamp of
  * what the frame starts (a guard request's life time, a heartbeat
@@ -412,17 +413,17 @@ void co_node_reset(co_node_t *node, co_reset_t kind);
  */
 void co_node_receive(co_node_t *node, const co_frame_t *f, uint32_t now);
 
-/*
+/**
  * Run timers; returns the delay (us) until the next call is needed. When
  * nothing happened since the last poll (no frame, no co_node_wake(), no
  * CAN state change) and no deadline has come, it returns at once.
  */
 uint32_t co_node_poll(co_node_t *node, uint32_t now);
 
-/* co_node_send's cold half: count a frame not sent; returns false. */
+/** co_node_send's cold half: count a frame not sent; returns false. */
 bool co_node_tx_drop(co_node_t *node);
 
-/* Send through the port, counting frames the board could not queue; nothing
+/** Send through the port, counting frames the board could not queue; nothing
  * is sent while the controller is bus-off (counted the same way). Inline,
  * the count out of line: the call and its frame cost x86-64 more than the
  * bus-off gate adds (inline keeps the SDO read and the TPDO within their
@@ -435,24 +436,24 @@ static inline bool co_node_send(co_node_t *node, const co_frame_t *f)
     return co_node_tx_drop(node);
 }
 
-/* The board's view of the CAN controller (LEDs, diagnostics): call it
+/** The board's view of the CAN controller (LEDs, diagnostics): call it
  * from the main loop when it changes (no-op when unchanged); while
  * CO_CAN_BUSOFF the node sends nothing. The product's can_state hook
  * runs. */
 void co_node_set_can_state(co_node_t *node, co_can_state_t s);
 
-/* The patterns the two LEDs show now (CiA 303-3 mapping, product hook). */
+/** The patterns the two LEDs show now (CiA 303-3 mapping, product hook). */
 void co_node_led_patterns(co_node_t *node, co_led_pattern_t *green, co_led_pattern_t *red);
 
-/* Name of a pattern, for logs. */
+/** Name of a pattern, for logs. */
 const char *co_led_pattern_name(co_led_pattern_t p);
 
-/*
+/**
  * LED levels at time now; *next_us receives the delay until either changes.
  */
 void co_node_leds(co_node_t *node, uint32_t now, bool *green, bool *red, uint32_t *next_us);
 
-/*
+/**
  * Write len bytes (little-endian) to entry e of the node's dictionary as an
  * SDO download does: co_od_write() (access, length, limits, write hook),
  * then, where the product stores every change (cfg->autosave), a save of
@@ -463,18 +464,18 @@ void co_node_leds(co_node_t *node, uint32_t now, bool *green, bool *red, uint32_
  */
 co_res_t co_node_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len);
 
-/* One CAN-ID a node consumes (co_node_rx_ids). */
+/** One CAN-ID a node consumes (co_node_rx_ids). */
 typedef struct co_rx_id {
-    uint16_t id; /* 11-bit CAN-ID */
-    bool rtr;    /* true: remote frames on it serve the node; false: data frames do
+    uint16_t id; /**< 11-bit CAN-ID */
+    bool rtr;    /**< true: remote frames on it serve the node; false: data frames do
                   * (every service that takes data frames ignores remote ones) */
 } co_rx_id_t;
 
-/* Entries co_node_rx_ids() may fill: NMT, SYNC, SDO, LSS, guarding,
+/** Entries co_node_rx_ids() may fill: NMT, SYNC, SDO, LSS, guarding,
  * one heartbeat consumed, and a remote request per TPDO. */
 #define CO_NODE_RX_IDS_MAX (6u + CO_TPDO_MAX)
 
-/*
+/**
  * The CAN-IDs the node consumes now, for a board that filters what it
  * receives (a SocketCAN CAN_RAW_FILTER, a controller's acceptance
  * filters): NMT (0x000), the SYNC COB-ID (0x1005), the SDO request
@@ -497,7 +498,7 @@ typedef struct co_rx_id {
  */
 unsigned co_node_rx_ids(const co_node_t *node, co_rx_id_t *ids, unsigned max);
 
-/* Convenience: look up an entry in the node's dictionary (NULL if absent). */
+/** Convenience: look up an entry in the node's dictionary (NULL if absent). */
 const co_od_entry_t *co_node_entry(const co_node_t *node, uint16_t index, uint8_t sub);
 
 #endif /* CO_NODE_H */

@@ -1,4 +1,4 @@
-/*
+/** @file
  * co_port.h - what a board must provide to the stack.
  *
  * Every function takes the board context the node was created with
@@ -12,14 +12,14 @@
 
 #include "co_common.h"
 
-/*
+/**
  * Queue one frame for transmission. Must not block.
  * Returns true when the frame was queued, false when the transmit queue is
  * full (the frame is lost; the stack counts it and goes on).
  */
 bool co_port_can_send(void *port, const co_frame_t *frame);
 
-/*
+/**
  * Bring the CAN controller to kbps kbit/s. Called at start and whenever
  * the node's active bit rate changes: a reset that activates another
  * bit-rate code, and LSS "activate bit timing" (CiA 305) after its switch
@@ -29,7 +29,7 @@ bool co_port_can_send(void *port, const co_frame_t *frame);
  */
 bool co_port_can_bitrate(void *port, uint16_t kbps);
 
-/*
+/** @name EEPROM emulation
  * EEPROM emulation: byte-addressed non-volatile memory; a node's records
  * take CO_STORE_NVM_SIZE bytes from its nvm_base (co_node_init, co_store.h).
  * A read of never-written memory returns 0xFF. Reads and writes are
@@ -44,16 +44,17 @@ bool co_port_can_bitrate(void *port, uint16_t kbps);
  * its data-set error (DST 0x4001 bit 6 and EMCY 1000h; P+F and JD EMCY
  * 6300h; the GSH-A has none), the Linux program logs the set it could not
  * read, and every save is refused with 0x06060000. The check would cost
- * the DST X730 image flash it does not have to spare.
+ * the DST X730 image flash it does not have to spare. @{
  */
-/* Copy len bytes of the EEPROM from addr into buf (the caller's, len
+/** Copy len bytes of the EEPROM from addr into buf (the caller's, len
  * bytes). False: a hardware failure or a byte beyond the EEPROM; buf's
  * contents are then undefined. */
 bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len);
-/* Write len bytes of buf (read only during the call) to the EEPROM at
+/** Write len bytes of buf (read only during the call) to the EEPROM at
  * addr; durable when it returns true. False: a hardware failure or a byte
  * beyond the EEPROM (what the bytes hold then is undefined: the store's
  * records survive it, co_store.h). */
 bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len);
+/** @} */
 
 #endif /* CO_PORT_H */

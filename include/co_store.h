@@ -1,4 +1,4 @@
-/*
+/** @file
  * co_store.h - the parameter store: 0x1010 "save", 0x1011 "load", and the
  * non-volatile image in the board's EEPROM emulation (co_port_nvm_*).
  *
@@ -32,11 +32,12 @@
 #include "co_common.h"
 #include "co_od.h"
 
-/* Bytes of one slot in NVM; a class's RAM struct must fit with the header. */
+/** Bytes of one slot in NVM; a class's RAM struct must fit with the header. @{ */
 #define CO_STORE_SLOT 192u
 #define CO_STORE_HDR 24u
 #define CO_STORE_MAX_DATA (CO_STORE_SLOT - CO_STORE_HDR - 4u)
-/* NVM bytes one node needs (2 classes x 2 slots). */
+/** @} */
+/** NVM bytes one node needs (2 classes x 2 slots). */
 #define CO_STORE_NVM_SIZE (4u * CO_STORE_SLOT)
 /* Fixed sizes, not switches; what a change must keep: the header's 20
  * bytes (store.c writes magic .. class at its bytes 0..19), an even header
@@ -48,31 +49,34 @@
 #error "CO_STORE_HDR must be even and >= 20, CO_STORE_SLOT even, above header + CRC, <= 1024"
 #endif
 
-/* "save" and "load" signatures (CiA 301). */
+/** "save" and "load" signatures (CiA 301). @{ */
 #define CO_SIG_SAVE 0x65766173u
 #define CO_SIG_LOAD 0x64616F6Cu
+/** @} */
 
+/** What the last restore of a class found (co_store_restore, co_node_store_status). */
 typedef enum co_store_status {
-    CO_STORE_OK = 0,   /* a valid record was applied */
-    CO_STORE_BLANK,    /* nothing ever stored: defaults */
-    CO_STORE_DEFAULTS, /* "load" was requested: defaults */
-    CO_STORE_CORRUPT,  /* the slots hold something (not erased) but no valid record:
+    CO_STORE_OK = 0,   /**< a valid record was applied */
+    CO_STORE_BLANK,    /**< nothing ever stored: defaults */
+    CO_STORE_DEFAULTS, /**< "load" was requested: defaults */
+    CO_STORE_CORRUPT,  /**< the slots hold something (not erased) but no valid record:
                         * defaults; or the newest record passed its CRC but some
                         * values failed validation (co_od_validate): those are
                         * defaults. Stays until the next full save */
-    CO_STORE_HW,       /* NVM read failed: defaults */
+    CO_STORE_HW,       /**< NVM read failed: defaults */
 } co_store_status_t;
 
+/** Parameter store state in the node. */
 typedef struct co_store {
-    uint32_t writes;              /* save cycles so far (from the newest record) */
-    uint8_t status[CO_CLS_COUNT]; /* co_store_status_t of the last restore */
+    uint32_t writes;              /**< save cycles so far (from the newest record) */
+    uint8_t status[CO_CLS_COUNT]; /**< co_store_status_t of the last restore */
 } co_store_t;
 
-/* Scan the NVM for the write count. Call once, on a node fresh from
+/** Scan the NVM for the write count. Call once, on a node fresh from
  * co_node_init(), before the first restore (co_node_start does). */
 void co_store_init(co_node_t *node);
 
-/*
+/**
  * Restore the entries of class cls with index in [lo, hi] from the newest
  * valid record, or set them to their defaults; [0, 0xFFFF] restores the
  * whole struct (the LSS struct has no dictionary entries of its own).
@@ -83,20 +87,20 @@ void co_store_init(co_node_t *node);
  */
 co_store_status_t co_store_restore(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi);
 
-/*
+/**
  * Run every value of class cls through co_od_validate(), as an SDO write of it
  * would be checked; one that fails takes its default, and the set is
  * reported as corrupt (status CO_STORE_CORRUPT) until the next full save.
  */
 void co_store_validate(co_node_t *node, co_cls_t cls);
 
-/*
+/**
  * Save the RAM struct of class cls. Returns CO_OK, CO_E_STORE when the
  * write-cycle limit is reached, CO_E_HW when the NVM write failed.
  */
 co_res_t co_store_save(co_node_t *node, co_cls_t cls);
 
-/*
+/**
  * Save one CiA 301 group of class cls: entries with index in [lo, hi] from
  * RAM (defaults = false) or as their defaults (true: a group "load"); the
  * class's other entries keep their stored values. Same results as
@@ -106,7 +110,7 @@ co_res_t co_store_save(co_node_t *node, co_cls_t cls);
 co_res_t co_store_save_group(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi,
                              bool defaults);
 
-/*
+/**
  * A value of the restored set of cls that only the product can judge (the
  * DST's bit-rate code, kept without a dictionary entry) failed: the product
  * set it to its default; the set is reported as corrupt, like one whose
@@ -116,7 +120,7 @@ co_res_t co_store_save_group(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_
  */
 void co_store_mark_corrupt(co_node_t *node, co_cls_t cls);
 
-/*
+/**
  * Keep EMCY 6300h ("data set", CiA 301) active in the error table while the
  * last restore of PARA or LSS found a corrupt set or could not read the
  * NVM, and clear it once a full save made the set sound again. For the
@@ -126,37 +130,37 @@ void co_store_mark_corrupt(co_node_t *node, co_cls_t cls);
  */
 void co_store_report_emcy(co_node_t *node);
 
-/* Make the next restore of cls use defaults (0x1011 "load"). */
+/** Make the next restore of cls use defaults (0x1011 "load"). */
 co_res_t co_store_request_defaults(co_node_t *node, co_cls_t cls);
 
-/* Write-cycle limit reached: further saves are refused. */
+/** Write-cycle limit reached: further saves are refused. */
 bool co_store_limit_reached(const co_node_t *node);
 
-/* Layout hash of class cls in the node's dictionary. */
+/** Layout hash of class cls in the node's dictionary. */
 uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls);
 
-/* CRC-32 (IEEE 802.3, reflected, init and xor 0xFFFFFFFF), chainable. */
+/** CRC-32 (IEEE 802.3, reflected, init and xor 0xFFFFFFFF), chainable. */
 uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len);
 
-/*
+/**
  * Write hook for 0x1010 sub 1 "save all parameters": value must be the
  * signature "save" (CO_SIG_SAVE), else CO_E_STORE. Stores PARA, and LSS
  * where cfg->save_includes_lss and it changed; results of co_store_save().
  * On success the product's stored hook (co_node_ops_t.stored) runs.
  */
 co_res_t co_store_write_save(co_node_t *node, const co_od_entry_t *e, uint32_t value);
-/*
+/**
  * Write hook for 0x1011 sub 1 "restore default parameters": value must be
  * "load" (CO_SIG_LOAD), else CO_E_STORE. Makes the next restore of PARA
  * (and of LSS, unless cfg->load_keeps_lss) use defaults: the values in use
  * stay until the next reset. Then the stored hook, as for "save".
  */
 co_res_t co_store_write_load(co_node_t *node, const co_od_entry_t *e, uint32_t value);
-/* Write hook for 0x1010 sub 2..4: "save" of one CiA 301 group
+/** Write hook for 0x1010 sub 2..4: "save" of one CiA 301 group
  * (co_store_save_group; LSS too where cfg->save_includes_lss). Another
  * signature, or another sub-index: CO_E_STORE. */
 co_res_t co_store_write_group_save(co_node_t *node, const co_od_entry_t *e, uint32_t value);
-/* Write hook for 0x1011 sub 2..4: "load" of one group: its entries are
+/** Write hook for 0x1011 sub 2..4: "load" of one group: its entries are
  * stored as their defaults, the others keep their stored values. Same
  * errors as the group save. */
 co_res_t co_store_write_group_load(co_node_t *node, const co_od_entry_t *e, uint32_t value);
