@@ -29,6 +29,7 @@
 #define UART_RBR (*(volatile uint8_t *)(UART + 0u))
 #define UART_LSR (*(volatile uint8_t *)(UART + 5u))
 #define MTIME_LO (*(volatile uint32_t *)0x0200BFF8u)
+#define MTIME_HI (*(volatile uint32_t *)0x0200BFFCu)
 
 /* The serial line: SLCAN frames and simulated-input lines (serial_link.h). */
 static serial_link_t link;
@@ -95,9 +96,18 @@ bool board_can_bitrate(uint16_t kbps)
     return serial_link_bitrate(&link, kbps, put);
 }
 
+/* The 64-bit 10 MHz mtime in microseconds, its low 32 bits: wrapping at
+ * 2^32 us as board.h wants (the low word of mtime alone, divided, jumped
+ * back to 0 every 429.5 s, and the stack took time for running backwards). */
 uint32_t board_now_us(void)
 {
-    return MTIME_LO / 10u; /* 10 MHz */
+    uint32_t hi;
+    uint32_t lo;
+    do {
+        hi = MTIME_HI;
+        lo = MTIME_LO;
+    } while (hi != MTIME_HI);
+    return (uint32_t)((((uint64_t)hi << 32) | lo) / 10u);
 }
 
 /*
@@ -108,7 +118,6 @@ uint32_t board_now_us(void)
  * the timer (MTIE) and the PLIC's external line (MEIE, the UART's source
  * claimed and completed here) only wake the core.
  */
-#define MTIME_HI (*(volatile uint32_t *)0x0200BFFCu)
 #define MTIMECMP_LO (*(volatile uint32_t *)0x02004000u)
 #define MTIMECMP_HI (*(volatile uint32_t *)0x02004004u)
 #define UART_IER (*(volatile uint8_t *)(UART + 1u))
