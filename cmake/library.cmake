@@ -59,7 +59,15 @@ set(co_lib_targets)
 function(co_library target export)
   add_library(${target} STATIC ${ARGN})
   add_library(canopen::${export} ALIAS ${target})
-  set_target_properties(${target} PROPERTIES OUTPUT_NAME canopen_${export} EXPORT_NAME ${export})
+  # A Debug build's libraries are libcanopen_<export>d.a: Debug and
+  # Release installs share a prefix.
+  set_target_properties(${target} PROPERTIES OUTPUT_NAME canopen_${export} EXPORT_NAME ${export}
+    DEBUG_POSTFIX d)
+  # In a parent project (add_subdirectory) a library is built when the
+  # parent links it, not with the parent's "all".
+  if(NOT CO_TOP_LEVEL)
+    set_target_properties(${target} PROPERTIES EXCLUDE_FROM_ALL TRUE)
+  endif()
   target_compile_options(${target} PRIVATE ${co_lib_flags})
   target_compile_features(${target} PUBLIC c_std_11)
   set(co_lib_targets ${co_lib_targets} ${target} PARENT_SCOPE)
@@ -187,8 +195,11 @@ if(NOT CMAKE_CROSSCOMPILING)
   install(FILES ${co_linux_headers} DESTINATION ${CO_INSTALL_INCLUDEDIR}/linux)
 else()
   install(FILES ${co_cdir}/mcu_main.c ${co_bdir}/link.ld DESTINATION ${CO_INSTALL_DATADIR})
-  # The toolchain file this was built with: a consumer builds with the same.
-  install(FILES ${CMAKE_TOOLCHAIN_FILE} DESTINATION ${CO_INSTALL_DATADIR})
+  # The toolchain files (the one this was built with includes others): a
+  # consumer builds with the same.
+  install(FILES ${PROJECT_SOURCE_DIR}/cmake/arm-none-eabi.cmake
+    ${PROJECT_SOURCE_DIR}/cmake/microbit.cmake ${PROJECT_SOURCE_DIR}/cmake/riscv32.cmake
+    DESTINATION ${CO_INSTALL_DATADIR})
 endif()
 install(EXPORT ${CO_PKG}Targets NAMESPACE canopen:: DESTINATION ${CO_INSTALL_CMAKEDIR})
 
@@ -234,6 +245,12 @@ Version: @PROJECT_VERSION@
 Cflags: -I${includedir}@co_pc_cflags@
 Libs: -L${libdir} -lcanopen_product -lcanopen_stack
 ]=])
+# Relocatable (the prefix from the .pc file's place) unless the library
+# directory was given as an absolute path.
+if(IS_ABSOLUTE "${CMAKE_INSTALL_LIBDIR}")
+  message(FATAL_ERROR "CMAKE_INSTALL_LIBDIR=${CMAKE_INSTALL_LIBDIR}: give it relative to "
+    "CMAKE_INSTALL_PREFIX (the package and its .pc file find their files from their place)")
+endif()
 file(RELATIVE_PATH co_pc_up /root/${CMAKE_INSTALL_LIBDIR}/pkgconfig /root)
 configure_file(${PROJECT_BINARY_DIR}/${CO_PKG}.pc.in ${PROJECT_BINARY_DIR}/${CO_PKG}.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/${CO_PKG}.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)

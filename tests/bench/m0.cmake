@@ -18,7 +18,7 @@ set(CO_BENCH_OPS
   "tpdo 3 dst_x730_cfg"
   "idle-poll 4 dst_x730_cfg"
   "sync 5 jd2_cfg")
-set(CO_BENCH_DIR ${CMAKE_SOURCE_DIR}/tests/bench)
+set(CO_BENCH_DIR ${PROJECT_SOURCE_DIR}/tests/bench)
 add_custom_target(bench_m0 ALL)
 foreach(entry ${CO_BENCH_OPS})
   separate_arguments(f UNIX_COMMAND "${entry}")
@@ -36,9 +36,9 @@ foreach(entry ${CO_BENCH_OPS})
         list(GET cf 1 fam)
       endif()
     endforeach()
-    add_library(${lib} STATIC ${CO_STACK_SOURCES} ${CMAKE_SOURCE_DIR}/od/bitrates.c
+    add_library(${lib} STATIC ${CO_STACK_SOURCES} ${PROJECT_SOURCE_DIR}/od/bitrates.c
       ${CO_FAMILY_SOURCES_${fam}})
-    target_include_directories(${lib} PUBLIC ${CMAKE_SOURCE_DIR}/include ${CO_PRODUCT_INCLUDES})
+    target_include_directories(${lib} PUBLIC ${PROJECT_SOURCE_DIR}/include ${CO_PRODUCT_INCLUDES})
     target_compile_options(${lib} PRIVATE ${CO_BARE_FLAGS})
     target_compile_definitions(${lib} PUBLIC CO_OD_NO_NAMES CO_NO_SIM_INPUT
       CO_FIXED_CFG=${cfg} ${CO_MCU_SIZES_${cfg}})

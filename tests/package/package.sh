@@ -80,8 +80,14 @@ target_link_libraries(tiny PRIVATE canopen::stack canopen::product)
 add_test(NAME tiny COMMAND tiny)
 EOT
   cfg -S "$tmp/parent" -B "$tmp/b"
-  bld "$tmp/b" --target tiny
+  bld "$tmp/b"
   "$tmp/b/tiny" || fail "the parent's program fails"
+  # The parent's "all" built what it links, nothing else of this tree.
+  for lib in libcanopen_registry.a libcanopen_linux_port.a libcanopen_family_dst.a; do
+    if [ -n "$(find "$tmp/b/canopen" -name "$lib")" ]; then
+      fail "the parent's build made $lib, which it does not link"
+    fi
+  done
   for t in canopen-sensor co_firmware co_firmware_test test_dst_manual bench fw-dst-x730-xy10; do
     if "$cmake" --build "$tmp/b" --target "$t" >/dev/null 2>&1; then
       fail "the parent's build has the target $t"
