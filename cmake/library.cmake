@@ -225,6 +225,12 @@ if(NOT "${CMAKE_SYSTEM_NAME} ${CMAKE_SYSTEM_PROCESSOR}" STREQUAL "@CMAKE_SYSTEM_
   set(PACKAGE_VERSION "${PACKAGE_VERSION} (for @CMAKE_SYSTEM_NAME@ @CMAKE_SYSTEM_PROCESSOR@)")
   set(PACKAGE_VERSION_UNSUITABLE TRUE)
 endif()
+# One Cortex-M0 is not another: a consumer whose toolchain file names a
+# board (CO_BOARD) takes that board's package only.
+if(DEFINED CO_BOARD AND NOT "@CO_BOARD@" STREQUAL "" AND NOT CO_BOARD STREQUAL "@CO_BOARD@")
+  set(PACKAGE_VERSION "${PACKAGE_VERSION} (for the board @CO_BOARD@)")
+  set(PACKAGE_VERSION_UNSUITABLE TRUE)
+endif()
 ]=])
 configure_file(${PROJECT_BINARY_DIR}/${CO_PKG}ConfigVersion.cmake.in
   ${PROJECT_BINARY_DIR}/${CO_PKG}ConfigVersion.cmake @ONLY)

@@ -556,11 +556,15 @@ static const char *select_nodes(const app_t *a, const char *line, unsigned *firs
     const char *p = line + strspn(line, " \t");
     size_t n = strcspn(p, " \t");
     char tok[32];
-    if (n == 0u || n >= sizeof(tok) || (p[0] != '@' && (p[0] < '0' || p[0] > '9'))) {
+    if (n == 0u || (p[0] != '@' && (p[0] < '0' || p[0] > '9'))) {
         const app_inst_t *in = &a->inst[0];
         *first = in->first;
         *end = in->first + in->prod->nodes;
         return p; /* no selector */
+    }
+    if (n >= sizeof(tok)) {
+        snprintf(err, errlen, "'%.20s...': not a node selector (0xNN, NN, @N, @all)", p);
+        return NULL;
     }
     memcpy(tok, p, n);
     tok[n] = '\0';

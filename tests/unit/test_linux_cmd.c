@@ -202,6 +202,8 @@ static void test_selectors_all_or_none(void)
     CHECK(is(ask("0x55 get"), "error: no node with node-ID 0x55"));
     CHECK(starts(ask("200 get"), "error: '200': not a node-ID 1..127"));
     CHECK(is(ask("33 get"), ask("0x21 get")));
+    CHECK(is(ask("@00000000000000000000000000000000001 get"),
+             "error: '@0000000000000000000...': not a node selector (0xNN, NN, @N, @all)"));
 }
 
 static void test_line_assembly(void)
