@@ -69,6 +69,14 @@ const char *cmd_lines_take(cmd_lines_t *lb, char *err, size_t errlen)
     return lb->line;
 }
 
+size_t cmd_answer_line(const char *text, char *out)
+{
+    size_t n = strnlen(text, CMD_REPLY_MAX);
+    memcpy(out, text, n);
+    out[n] = '\n';
+    return n + 1u;
+}
+
 /* ---- Arguments ---------------------------------------------------------- */
 
 /* The next blank-separated token, or NULL. */

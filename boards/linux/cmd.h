@@ -71,6 +71,11 @@ bool cmd_lines_pending(const cmd_lines_t *lb);
  * rejected in err (errlen bytes); lb is then ready for the next line. */
 const char *cmd_lines_take(cmd_lines_t *lb, char *err, size_t errlen);
 
+/* An answer as it goes out on a channel: text (its first CMD_REPLY_MAX
+ * bytes) and a newline into out, which has room for CMD_REPLY_MAX + 1
+ * bytes; no NUL. Returns the bytes written: always one line. */
+size_t cmd_answer_line(const char *text, char *out);
+
 /* ---- The language ------------------------------------------------------ */
 
 /* A line's parsed arguments (one verb's fields are used). */

@@ -126,10 +126,8 @@ int ctl_open(ctl_t *c, const char *spec, char *err, size_t errlen)
 /* One answer line; a client that cannot take it at once is dropped. */
 static bool reply(ctl_client_t *k, const char *text)
 {
-    char out[CMD_REPLY_MAX + 2u];
-    int n = snprintf(out, sizeof(out), "%s\n", text);
-    size_t len = n <= 0 ? 1u : (size_t)n >= sizeof(out) ? sizeof(out) - 1u : (size_t)n;
-    out[len - 1u] = '\n'; /* cut short or not, one line */
+    char out[CMD_REPLY_MAX + 1u];
+    size_t len = cmd_answer_line(text, out);
     return send(k->fd, out, len, MSG_NOSIGNAL | MSG_DONTWAIT) == (ssize_t)len;
 }
 
@@ -159,15 +157,6 @@ static void drop(ctl_client_t *k)
     k->lines = (cmd_lines_t){0};
 }
 
-/* Append one answer line to client k's buffer (room was checked). */
-static void queue_reply(ctl_client_t *k, const char *text)
-{
-    size_t n = strnlen(text, CMD_REPLY_MAX);
-    memcpy(k->out + k->olen, text, n);
-    k->olen += n;
-    k->out[k->olen++] = '\n';
-}
-
 /* A complete line of client k: answered into its buffer. */
 static void line_done(ctl_client_t *k, ctl_line_fn fn, void *ctx)
 {
@@ -180,7 +169,7 @@ static void line_done(ctl_client_t *k, ctl_line_fn fn, void *ctx)
         out[0] = '\0';
         fn(ctx, line, out, sizeof(out));
     }
-    queue_reply(k, out);
+    k->olen += cmd_answer_line(out, k->out + k->olen); /* room was checked (out_room) */
 }
 
 /* Hand waiting answers to the kernel; false when the client is gone. */

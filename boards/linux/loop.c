@@ -84,10 +84,8 @@ static void reject_input(loop_t *l, const char *error)
  * the log, and the nodes run on. */
 static void answer_out(loop_t *l, const char *answer)
 {
-    char line[CMD_REPLY_MAX + 2u];
-    int n = snprintf(line, sizeof(line), "%s\n", answer);
-    size_t len = n <= 0 ? 1u : (size_t)n >= sizeof(line) ? sizeof(line) - 1u : (size_t)n;
-    line[len - 1u] = '\n'; /* cut short or not, one line */
+    char line[CMD_REPLY_MAX + 1u];
+    size_t len = cmd_answer_line(answer, line);
     struct pollfd pf = {.fd = STDOUT_FILENO, .events = POLLOUT};
     /* A pipe with room takes a line of this size whole (atomic below PIPE_BUF). */
     if (poll(&pf, 1, 0) == 1 && (pf.revents & POLLOUT) != 0 &&

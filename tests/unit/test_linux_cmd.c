@@ -239,6 +239,18 @@ static void test_line_assembly(void)
     CHECK(cmd_lines_put(&lb, '\n'));
     const char *line = cmd_lines_take(&lb, err, sizeof(err));
     CHECK(line != NULL && strlen(line) == CMD_LINE_MAX);
+    /* An answer goes out as one line, cut at CMD_REPLY_MAX bytes. */
+    char out[CMD_REPLY_MAX + 1u];
+    CHECK_EQ(cmd_answer_line("ok", out), 3u);
+    CHECK(memcmp(out, "ok\n", 3) == 0);
+    CHECK_EQ(cmd_answer_line("", out), 1u);
+    CHECK_EQ(out[0], '\n');
+    char big[CMD_REPLY_MAX + 20u];
+    memset(big, 'x', sizeof(big) - 1u);
+    big[sizeof(big) - 1u] = '\0';
+    CHECK_EQ(cmd_answer_line(big, out), CMD_REPLY_MAX + 1u);
+    CHECK_EQ(out[CMD_REPLY_MAX - 1u], 'x');
+    CHECK_EQ(out[CMD_REPLY_MAX], '\n');
     /* A line without its newline waits (the end of input takes it). */
     CHECK(!cmd_lines_put(&lb, 'q'));
     CHECK(cmd_lines_pending(&lb));
