@@ -169,6 +169,19 @@ static void test_baud_rates_are_the_codes(void)
     }
 }
 
+/* Every code of the table counts, the last (15) too, and every CiA 306
+ * rate, the lowest (10 kbit/s) too: a product whose table has 10 kbit/s at
+ * code 15 alone declares BaudRate_10 alone. */
+static void test_baud_rates_every_code_and_rate(void)
+{
+    static const uint16_t table[16] = {[15] = 10};
+    const co_node_cfg_t cfg = {.kbps = table};
+    const product_t p = {.id = "edge", .cfg = &cfg};
+    CHECK_EQ(product_kbps(&p, 15), 10);
+    CHECK_EQ(product_kbps(&p, 16), 0);
+    CHECK_EQ(product_eds_bitrates(&p), PRODUCT_BR_10K);
+}
+
 int main(void)
 {
     RUN(test_every_product_applies_its_overrides);
@@ -177,5 +190,6 @@ int main(void)
     RUN(test_live_values_and_node_relative_default);
     RUN(test_wrong_overrides_are_counted);
     RUN(test_baud_rates_are_the_codes);
+    RUN(test_baud_rates_every_code_and_rate);
     return h_finish();
 }

@@ -412,13 +412,29 @@ static void test_bus_off_ended_by_another_state(void)
     (void)lp_poll(&app.ports[0], back);
     CHECK_EQ(lp_can_state(&app.ports[0]), CO_CAN_WARNING);
     CHECK_EQ(serial_link_can_state(&s, back), CO_CAN_WARNING);
-    /* A bus-off left alone comes back error active, on both. */
-    CHECK(is(ask_at("can bus-off", back), "ok"));
-    CHECK(is(serial_ask(&s, "can bus-off"), "ok"));
+    /* A bus-off left alone comes back error active after its hold, on
+     * both: the former one's cut does not shorten it. */
+    CHECK(is(ask_at("can bus-off 1", back), "ok"));
+    CHECK(is(serial_ask(&s, "can bus-off 1"), "ok"));
     CHECK_EQ(serial_link_can_state(&s, back), CO_CAN_BUSOFF);
-    (void)lp_poll(&app.ports[0], back + 5632u);
+    uint32_t again = back + 1000000u + 5632u;
+    (void)lp_poll(&app.ports[0], again - 1u);
+    CHECK_EQ(lp_can_state(&app.ports[0]), CO_CAN_BUSOFF);
+    CHECK_EQ(serial_link_can_state(&s, again - 1u), CO_CAN_BUSOFF);
+    (void)lp_poll(&app.ports[0], again);
     CHECK_EQ(lp_can_state(&app.ports[0]), CO_CAN_ACTIVE);
-    CHECK_EQ(serial_link_can_state(&s, back + 5632u), CO_CAN_ACTIVE);
+    CHECK_EQ(serial_link_can_state(&s, again), CO_CAN_ACTIVE);
+    /* A state commanded in the last recovery never makes the bus-off
+     * longer: it ends when it would have. */
+    CHECK(is(ask_at("can bus-off", again), "ok"));
+    CHECK(is(serial_ask(&s, "can bus-off"), "ok"));
+    CHECK_EQ(serial_link_can_state(&s, again), CO_CAN_BUSOFF);
+    CHECK(is(ask_at("can passive", again + 5000u), "ok"));
+    CHECK(is(serial_ask(&s, "can passive"), "ok"));
+    CHECK_EQ(serial_link_can_state(&s, again + 5000u), CO_CAN_BUSOFF);
+    (void)lp_poll(&app.ports[0], again + 5632u);
+    CHECK_EQ(lp_can_state(&app.ports[0]), CO_CAN_PASSIVE);
+    CHECK_EQ(serial_link_can_state(&s, again + 5632u), CO_CAN_PASSIVE);
 }
 
 /* `@all replay FILE` over two products: each instance takes its product's
