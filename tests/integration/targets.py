@@ -495,6 +495,27 @@ def list_products():
     return [line.split()[0] for line in out.splitlines() if line.strip()]
 
 
+def period_fault(times, period_ms, window_s):
+    """None if frames that arrived at these times (seconds), collected for
+    window_s, came every period_ms; else what is wrong. The period is the
+    median gap, to a fifth: a moment in which the machine starves an
+    emulator or a process drops a beat (CiA 301's producer does not catch
+    up) or delivers two frames together; it moves the mean and the count,
+    not the median. The count is checked on top, loosely: at least half of
+    what the window holds, at most two more (one at each end, one that a
+    late read brought in). A period of a half or double, a producer that
+    stops or bursts, fails either way."""
+    want = window_s * 1000 / period_ms
+    if not want / 2 <= len(times) <= want + 2:
+        return f"{len(times)} in {window_s} s at {period_ms} ms"
+    gaps = sorted(b - a for a, b in zip(times, times[1:]))
+    median = gaps[len(gaps) // 2] * 1000
+    if abs(median - period_ms) > period_ms / 5:
+        return f"median period {median:.1f} ms, want {period_ms} ms " \
+               f"(gaps {', '.join(f'{g * 1000:.0f}' for g in gaps)} ms)"
+    return None
+
+
 class Frames(can.Listener):
     """Every frame the master sees, with its arrival time, for the checks the
     canopen API hides (boot-up, heartbeat, EMCY, PDO counts)."""
@@ -536,6 +557,25 @@ class Frames(can.Listener):
         """(time, frame) of every frame with this CAN-ID during seconds."""
         return [(t, m) for t, m in self.stream(seconds)
                 if m.arbitration_id == can_id and not m.is_remote_frame]
+
+    def count(self, can_id, want, timeout=2.0, quiet=0.3):
+        """(time, frame) of the frames with this CAN-ID until want of them
+        came (at most timeout seconds), then for quiet seconds more to see
+        any extra one. A target that answers late (an emulator the machine
+        starves for a moment) is waited for; one that answers too often or
+        not at all is still counted wrong."""
+        got = self.collect_until(can_id, timeout, want) if want else []
+        return got + self.collect(can_id, quiet)
+
+    def collect_until(self, can_id, seconds, n):
+        """At most n frames with this CAN-ID within seconds."""
+        got = []
+        for t, m in self.stream(seconds):
+            if m.arbitration_id == can_id and not m.is_remote_frame:
+                got.append((t, m))
+                if len(got) == n:
+                    break
+        return got
 
 
 class Master:
