@@ -75,6 +75,9 @@ void co_assert_failed(const char *cond, const char *file, int line);
 #define CO_CHECK(cond) ((cond) ? true : false)
 #endif
 
+/** The highest node-ID: CiA 301's node-IDs are 1..CO_NODE_ID_MAX. */
+#define CO_NODE_ID_MAX 127u
+
 /** "No deadline" returned by poll functions. */
 #define CO_NEVER UINT32_MAX
 

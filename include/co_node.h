@@ -317,7 +317,7 @@ static inline co_store_status_t co_node_store_status(const co_node_t *node, co_c
 static inline void co_node_set_id(co_node_t *node, uint8_t id)
 {
     if (CO_CHECK(node->nmt.state == CO_NMT_INIT) &&
-        CO_CHECK((id >= 1u && id <= 127u) || id == CO_LSS_UNCONFIGURED)) {
+        CO_CHECK((id >= 1u && id <= CO_NODE_ID_MAX) || id == CO_LSS_UNCONFIGURED)) {
         node->node_id = id;
     }
 }
@@ -354,7 +354,7 @@ static inline void co_node_set_autostart(co_node_t *node, bool on)
  */
 static inline void co_node_set_factory_id(co_node_t *node, uint8_t id)
 {
-    if (CO_CHECK(node->nmt.state == CO_NMT_INIT) && CO_CHECK(id >= 1u && id <= 127u)) {
+    if (CO_CHECK(node->nmt.state == CO_NMT_INIT) && CO_CHECK(id >= 1u && id <= CO_NODE_ID_MAX)) {
         node->factory_id = id;
         node->node_id = id;
     }

@@ -24,7 +24,7 @@ void co_hbc_reset(co_node_t *node)
 
 co_res_t co_hbc_write_time(co_node_t *node, const co_od_entry_t *e, uint32_t value)
 {
-    if ((value & 0xFF000000u) != 0u || ((value >> 16) & 0xFFu) > 127u) {
+    if ((value & 0xFF000000u) != 0u || ((value >> 16) & 0xFFu) > CO_NODE_ID_MAX) {
         return CO_E_VAL;
     }
     co_res_t r = co_od_store(node, e, value);

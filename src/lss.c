@@ -218,7 +218,7 @@ bool co_lss_receive(co_node_t *node, const co_frame_t *f)
     switch (cs) {
     case CS_CONFIG_NODE_ID: {
         uint8_t id = d[1];
-        bool ok = (id >= 1u && id <= 127u) || id == CO_LSS_UNCONFIGURED;
+        bool ok = (id >= 1u && id <= CO_NODE_ID_MAX) || id == CO_LSS_UNCONFIGURED;
         if (ok) {
             l->pending_id = id;
         }

@@ -112,7 +112,7 @@ void co_node_reset(co_node_t *node, co_reset_t kind)
     }
     const co_lss_para_t *lss = node->ram[CO_CLS_LSS];
     if (kind == CO_RESET_NODE || co_cfg(node)->comm_reset_applies_id) {
-        bool id_ok = lss != NULL && lss->node_id >= 1u && lss->node_id <= 127u;
+        bool id_ok = lss != NULL && lss->node_id >= 1u && lss->node_id <= CO_NODE_ID_MAX;
         if (lss != NULL && !id_ok) {
             /* Defaults always hold a good one: a stored node-ID out of 1..127. */
             co_store_mark_corrupt(node, CO_CLS_LSS);

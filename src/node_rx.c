@@ -34,7 +34,7 @@ unsigned co_node_rx_ids(const co_node_t *node, co_rx_id_t *ids, unsigned max)
 {
     unsigned n = 0;
     uint8_t id = node->node_id;
-    bool configured = id >= 1u && id <= 127u;
+    bool configured = id >= 1u && id <= CO_NODE_ID_MAX;
     n = add(ids, n, max, 0x000u, false); /* NMT */
     n = add(ids, n, max, node->sync.cob_id, false);
     if (configured) {

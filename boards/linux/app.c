@@ -152,7 +152,7 @@ static void log_id_clashes(const app_t *a)
 {
     for (unsigned i = 0; i < a->nnodes; i++) {
         uint8_t id = co_node_id(a->nodes[i]);
-        for (unsigned j = 0; j < i && id >= 1u && id <= 127u; j++) {
+        for (unsigned j = 0; j < i && id >= 1u && id <= CO_NODE_ID_MAX; j++) {
             if (co_node_id(a->nodes[j]) == id && strcmp(a->ifn[i], a->ifn[j]) == 0) {
                 lp_log("warning: node %u (%s) and node %u (%s) both have node-ID 0x%02X on %s: "
                        "their frames collide",

@@ -19,8 +19,8 @@
 #include "product_registry.h"
 #include "sim.h"
 
-/* Nodes in one process at most: one bus holds 127 node-IDs. */
-#define APP_MAX_NODES 127u
+/* Nodes in one process at most: one bus holds CO_NODE_ID_MAX node-IDs. */
+#define APP_MAX_NODES CO_NODE_ID_MAX
 
 /* Replay tables one line may load: one per product it names. */
 #define APP_REPLAY_TABLES                                                                          \

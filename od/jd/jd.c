@@ -278,7 +278,7 @@ static const uint8_t lss_to_code[8] = {7, 6, 5, 4, 3, 0xFF, 1, 0};
 static uint8_t jd_lss_store(co_node_t *n, uint8_t id, uint8_t br)
 {
     jd_dev_t *d = dev_of(n);
-    if (id >= 1u && id <= 127u) {
+    if (id >= 1u && id <= CO_NODE_ID_MAX) {
         d->para.node_number = (uint8_t)(id - 1u);
     }
     if (br < 8u && lss_to_code[br] != 0xFFu) {
