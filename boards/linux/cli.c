@@ -122,7 +122,8 @@ void cli_usage_error(const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(msg, sizeof(msg), fmt, ap);
     va_end(ap);
-    fprintf(stderr, "canopen-sensor: %s (see --help)\n", msg);
+    /* One hint a line: the message's own (see --list-products), or --help. */
+    fprintf(stderr, "canopen-sensor: %s%s\n", msg, strstr(msg, "(see ") ? "" : " (see --help)");
     if (lp_log_is_file()) { /* a wrong command line found once --log is open */
         lp_log("error: %s", msg);
     }
@@ -138,17 +139,11 @@ int cli_start_failure(int rc, const char *msg)
     return rc;
 }
 
-/* --serial: decimal or 0x hex as cmd_number, 1..0xFFFFFFFF (0 is no serial). */
+/* --serial: 1..0xFFFFFFFF (0 is no serial). */
 static bool parse_serial(const char *s, uint32_t *out)
 {
-    bool hex = s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
-    const char *d = hex ? s + 2 : s;
-    size_t n = strspn(d, hex ? "0123456789abcdefABCDEF" : "0123456789");
-    if (n == 0u || d[n] != '\0' || n > 10u) {
-        return false;
-    }
-    unsigned long long v = strtoull(d, NULL, hex ? 16 : 10);
-    if (v == 0u || v > 0xFFFFFFFFu) {
+    long long v = 0;
+    if (!cmd_number(s, 0xFFFFFFFFll, &v) || v == 0) {
         return false;
     }
     *out = (uint32_t)v;
@@ -157,7 +152,7 @@ static bool parse_serial(const char *s, uint32_t *out)
 
 static int parse_int(const char *s, int *out)
 {
-    long v;
+    long long v;
     if (!cmd_number(s, 4096, &v)) {
         return -1;
     }
@@ -220,8 +215,8 @@ static int parse_node(options_t *o, const char *arg)
     char *at = strchr(name, '@');
     if (at != NULL) {
         *at = '\0';
-        long id = 0;
-        if (!cmd_number(at + 1, 127, &id) || id < 1) {
+        long long id = 0;
+        if (!cmd_number(at + 1, CO_NODE_ID_MAX, &id) || id < 1) {
             return USAGE_ERROR("--node %s: node-ID '%s' is not 1..127 (e.g. 0x21 or 33)", arg,
                                at + 1);
         }
@@ -231,11 +226,11 @@ static int parse_node(options_t *o, const char *arg)
     if (n->prod == NULL) {
         return USAGE_ERROR("--node %s: unknown product '%s' (see --list-products)", arg, name);
     }
-    if (n->id != 0u && n->id + n->prod->nodes - 1u > 127u) {
+    if (n->id != 0u && n->id + n->prod->nodes - 1u > CO_NODE_ID_MAX) {
         return USAGE_ERROR("--node %s: %s has %u nodes, node-IDs 0x%02X to 0x%02X: the last "
                            "passes 127 (give at most 0x%02X)",
                            arg, n->prod->id, n->prod->nodes, n->id, n->id + n->prod->nodes - 1u,
-                           128u - n->prod->nodes);
+                           CO_NODE_ID_MAX + 1u - n->prod->nodes);
     }
     n->iface = slash != NULL ? slash + 1 : NULL;
     n->arg = arg;

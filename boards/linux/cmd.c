@@ -540,15 +540,15 @@ void cmd_usage(FILE *f)
 
 /* ---- Selectors ---------------------------------------------------------- */
 
-bool cmd_number(const char *s, long max, long *out)
+bool cmd_number(const char *s, long long max, long long *out)
 {
     bool hex = s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
     const char *d = hex ? s + 2 : s;
     size_t n = strspn(d, hex ? "0123456789abcdefABCDEF" : "0123456789");
-    if (n == 0u || d[n] != '\0' || n > 9u) {
+    if (n == 0u || d[n] != '\0' || n > (hex ? 15u : 18u)) {
         return false;
     }
-    long v = strtol(d, NULL, hex ? 16 : 10);
+    long long v = strtoll(d, NULL, hex ? 16 : 10);
     if (v > max) {
         return false;
     }
@@ -582,10 +582,10 @@ static const char *select_nodes(const app_t *a, const char *line, unsigned *firs
         *end = a->nnodes;
         return rest;
     }
-    long v = -1;
+    long long v = -1;
     bool num = cmd_number(tok[0] == '@' ? tok + 1 : tok, 100000, &v);
     if (tok[0] == '@') {
-        if (!num || v >= (long)a->nnodes) {
+        if (!num || v >= (long long)a->nnodes) {
             snprintf(err, errlen, "no node %s (@0..@%u, or @all)", tok, a->nnodes - 1u);
             return NULL;
         }
@@ -593,7 +593,7 @@ static const char *select_nodes(const app_t *a, const char *line, unsigned *firs
         *end = *first + 1u;
         return rest;
     }
-    if (!num || v < 1 || v > 127) {
+    if (!num || v < 1 || v > (long long)CO_NODE_ID_MAX) {
         /* An LSS-unconfigured node has none (it reads 0xFF): @N names it. */
         snprintf(err, errlen,
                  "'%s': not a node-ID 1..127 (a node without one: select it by "

@@ -125,7 +125,9 @@ def test_help_lists_every_products_inputs_and_faults():
 
 def test_usage_errors():
     one_line(run(), 2, "--product is missing (see --help)")
-    one_line(run("--product", "nope", "--iface", "vcan0"), 2, "unknown product 'nope'")
+    one_line(run("--product", "nope", "--iface", "vcan0"), 2,
+             "unknown product 'nope' (see --list-products)")
+    assert "--help" not in run("--product", "nope", "--iface", "vcan0").stderr  # one hint
     one_line(run("--product", "dst-x730-xy30"), 2, "--iface is missing (see --help)")
     one_line(run("--product", "dst-x730-xy30", "--iface", "vcan0,vcan1"), 2,
              "dst-x730-xy30 has one node: give one interface")
