@@ -145,7 +145,8 @@ static const co_od_t jd1_od = {.entries = jd1_entries, .count = sizeof(jd1_entri
 _Static_assert(sizeof(jd_para_t) <= CO_STORE_MAX_DATA, "PARA set must fit one store slot");
 
 /* CiA 305 bit-timing indices 0-4, 6, 7 (not 5 = reserved, not 8 = 10k):
- * the rates 3001h has. */
+ * the rates 3001h has (product_kbps_ifm; test_products_edge checks that
+ * the two agree). */
 #define JD_LSS_BITRATES 0x00DFu
 static const co_service_t *const jd_services[] = {&co_lss_service, &co_guard_service,
                                                   &co_hbc_service, &co_rtr_service, NULL};

@@ -9,9 +9,9 @@
  * 0x4000 = 0 in pre-operational, an EEPROM that cannot be read (0x4001
  * bit 6); on the P+F the fixed resolution (0.1 deg),
  * the error LED and 6300h for stored sets that cannot be used. For every
- * product: each TPDO's mapping names objects of the mapped length and
- * covers exactly the bytes the frame has (CiA 301: a consumer checks the
- * length against the mapping, EMCY 8220h).
+ * product: its LSS bit rates are its own table's; each TPDO's mapping names objects of the mapped
+ * length and covers exactly the bytes the frame has (CiA 301: a consumer checks the length against
+ * the mapping, EMCY 8220h).
  */
 #include "dst.h"
 #include "gsh.h"
@@ -55,6 +55,32 @@ static void test_registry(void)
     CHECK_EQ(product_kbps(&pf_inx360d, 3), 0);
     product_t none = {.id = "no-table"};
     CHECK_EQ(product_kbps(&none, 3), 0);
+}
+
+/* An LSS slave offers a CiA 305 bit-timing index exactly when its own
+ * bit-rate table (what its code object and co_node_set_bitrate take) has
+ * that rate: co_node_cfg_t.lss_bitrates is written next to the table and
+ * must say the same. A product without LSS offers none. */
+static void test_lss_rates_are_the_tables(void)
+{
+    static const uint16_t cia305[16] = {1000, 800, 500, 250, 125, 0 /* reserved */, 50, 20, 10};
+    unsigned lss_products = 0;
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        const product_t *p = product_list[i];
+        if (!product_lss(p)) {
+            CHECK_EQ(p->cfg != NULL ? p->cfg->lss_bitrates : 0u, 0u);
+            continue;
+        }
+        lss_products++;
+        for (unsigned k = 0; k < 16u; k++) {
+            bool has = false;
+            for (uint8_t code = 0; code < 16u; code++) {
+                has = has || (cia305[k] != 0u && product_kbps(p, code) == cia305[k]);
+            }
+            CHECK_EQ((p->cfg->lss_bitrates >> k) & 1u, has ? 1u : 0u);
+        }
+    }
+    CHECK(lss_products >= 2u); /* JD1xxx, JD2xxx */
 }
 
 #define ANSWERS_MAX 128u
@@ -655,6 +681,7 @@ static void test_each_node_stores_in_its_area(void)
 int main(void)
 {
     RUN(test_registry);
+    RUN(test_lss_rates_are_the_tables);
     RUN(test_dst_values);
     RUN(test_dst_node_id_pair_unchanged);
     RUN(test_dst_pair_copies_are_their_own);
