@@ -28,11 +28,13 @@ ex=$src/examples/my-sensor
 case $mode in
 find_package_host)
   need pkg-config
+  # A prefix with a blank in its name: the package and its .pc file find
+  # their files from their own place, whatever it is called.
   cfg -S "$src" -B "$tmp/b" -DCO_BUILD_PROGRAM=OFF -DCO_BUILD_TESTS=OFF \
-    -DCMAKE_INSTALL_PREFIX="$tmp/prefix"
+    -DCMAKE_INSTALL_PREFIX="$tmp/an install"
   bld "$tmp/b"
   inst "$tmp/b"
-  cfg -S "$ex" -B "$tmp/ex" -DCMAKE_PREFIX_PATH="$tmp/prefix"
+  cfg -S "$ex" -B "$tmp/ex" -DCMAKE_PREFIX_PATH="$tmp/an install"
   bld "$tmp/ex"
   "$tmp/ex/my-sensor" --help | grep -q '^usage: my-sensor' || fail "my-sensor --help: no usage"
   rc=0
@@ -40,11 +42,11 @@ find_package_host)
   [ "$rc" = 1 ] || fail "my-sensor no-such-can0: exit $rc, not 1"
   grep -q '^my-sensor: no-such-can0: ' "$tmp/err" || { cat "$tmp/err" >&2; fail "my-sensor no-such-can0: no clear error"; }
   echo "my-sensor no-such-can0: $(grep '^my-sensor' "$tmp/err")"
-  flags=$(PKG_CONFIG_PATH="$tmp/prefix/lib/pkgconfig" pkg-config --cflags --libs canopen_sensors) ||
+  flags=$(PKG_CONFIG_PATH="$tmp/an install/lib/pkgconfig" pkg-config --cflags --libs canopen_sensors) ||
     fail "pkg-config canopen_sensors failed"
   echo "pkg-config --cflags --libs canopen_sensors: $flags"
-  # shellcheck disable=SC2086 # the flags are words
-  cc -std=c11 -Wall -Wextra -Werror "$src/tests/package/tiny.c" -o "$tmp/tiny" $flags ||
+  # The flags as a shell reads them: pkg-config escapes the prefix's blank.
+  eval "cc -std=c11 -Wall -Wextra -Werror \"\$src/tests/package/tiny.c\" -o \"\$tmp/tiny\" $flags" ||
     fail "the pkg-config program does not build"
   "$tmp/tiny" || fail "the pkg-config program fails"
   ;;
