@@ -140,13 +140,15 @@ def wait_state(dut, node_id, state, timeout=1.0):
     return seen
 
 
-def boot_up(dut, node_id, timeout=2.0):
+def boot_up(dut, node_id, timeout=5.0):
     return dut.frames.wait_for(0x700 + node_id, timeout=timeout,
                                pred=lambda m: bytes(m.data) == b"\0")
 
 
-def sdo_answers(dut, node_id, timeout=0.3):
-    """Whether node_id answers an SDO read of 0x1000 (raw, no retries)."""
+def sdo_answers(dut, node_id, timeout=1.0):
+    """Whether node_id answers an SDO read of 0x1000 (raw, no retries)
+    within timeout: long enough for an emulator the machine starves for a
+    moment, and a silence that long is a real one."""
     dut.frames.clear()
     dut.send(0x600 + node_id, bytes.fromhex("4000100000000000"))
     return dut.frames.wait_for(0x580 + node_id, timeout=timeout) is not None
@@ -263,7 +265,7 @@ def test_nmt_states(dut, facts):
     dut.frames.clear()
     nmt(dut, NMT_RESET_COMM, n)
     assert boot_up(dut, n) is not None, "no boot-up after reset communication"
-    beat = heartbeat_state(dut, n, timeout=3 * HB_MS / 1000)
+    beat = heartbeat_state(dut, n, timeout=20 * HB_MS / 1000)
     assert (beat is not None) == facts.autosave, f"heartbeat after reset communication: {beat}"
     assert up(dut, n, index, sub) == new
     # Reset node: boot-up, every parameter from the stored set.
@@ -285,7 +287,7 @@ def test_heartbeat_period(dut, facts):
     assert all(bytes(m.data) == bytes([facts.boot_state]) for _, m in beats)
     down(dut, n, 0x1017, 0, struct.pack("<H", 0))
     dut.frames.clear()
-    assert heartbeat_state(dut, n, timeout=3 * HB_MS / 1000) is None, "heartbeat after 0x1017 = 0"
+    assert heartbeat_state(dut, n, timeout=20 * HB_MS / 1000) is None, "heartbeat after 0x1017 = 0"
 
 
 def test_tpdo_by_sync(dut, facts):
@@ -329,7 +331,7 @@ def test_tpdo_by_event_timer(dut, facts):
     dut.frames.clear()
     assert not dut.frames.collect(cob, 0.15), "TPDO in pre-operational"
     nmt(dut, NMT_START, n)
-    dut.frames.wait_for(cob, timeout=0.5)
+    dut.frames.wait_for(cob, timeout=2.0)
     assert_period(dut.frames.collect(cob, WINDOW_S), EVENT_MS, "TPDOs")
 
 
@@ -352,8 +354,7 @@ def test_tpdo_length_is_the_mapped_length(dut, facts):
         event_timer_tpdo(dut, facts, n)
         dut.frames.clear()
         nmt(dut, NMT_START, n)
-        dut.frames.wait_for(cob, timeout=0.5)
-        got = dut.frames.collect(cob, 0.2)
+        got = dut.frames.collect_until(cob, 2.0, 3)
         assert got and all(len(m.data) == total for _, m in got), \
             f"node {n:#x}: TPDO1 lengths {sorted({len(m.data) for _, m in got})}, mapped {total}"
 
