@@ -122,8 +122,13 @@ void cli_usage_error(const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(msg, sizeof(msg), fmt, ap);
     va_end(ap);
-    /* One hint a line: the message's own (see --list-products), or --help. */
-    fprintf(stderr, "canopen-sensor: %s%s\n", msg, strstr(msg, "(see ") ? "" : " (see --help)");
+    /* One hint a line: the message's own, which ends it (unknown product:
+     * see --list-products), or --help. Only the end is looked at: a word
+     * of the command line inside the message chooses nothing. */
+    static const char own[] = " (see --list-products)";
+    size_t len = strlen(msg);
+    bool has_own = len >= sizeof(own) - 1u && strcmp(msg + len - (sizeof(own) - 1u), own) == 0;
+    fprintf(stderr, "canopen-sensor: %s%s\n", msg, has_own ? "" : " (see --help)");
     if (lp_log_is_file()) { /* a wrong command line found once --log is open */
         lp_log("error: %s", msg);
     }
@@ -269,9 +274,11 @@ static int check_specs(options_t *o)
         return USAGE_ERROR("%u nodes: at most %u in one process", o->nnodes_total, APP_MAX_NODES);
     }
     if (o->serial != 0u && o->serial > 0xFFFFFFFFu - (o->nnodes_total - 1u)) {
-        return USAGE_ERROR("--serial 0x%08lX: %u nodes take 0x%08lX..0x%08lX, past 0xFFFFFFFF",
-                           (unsigned long)o->serial, o->nnodes_total, (unsigned long)o->serial,
-                           (unsigned long)o->serial + o->nnodes_total - 1u);
+        /* long long: a 32-bit host's unsigned long would wrap the last one. */
+        return USAGE_ERROR("--serial 0x%08llX: %u nodes take 0x%08llX..0x%08llX, past 0xFFFFFFFF",
+                           (unsigned long long)o->serial, o->nnodes_total,
+                           (unsigned long long)o->serial,
+                           (unsigned long long)o->serial + o->nnodes_total - 1u);
     }
     return CLI_GO_ON;
 }

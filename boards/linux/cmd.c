@@ -545,7 +545,12 @@ bool cmd_number(const char *s, long long max, long long *out)
     bool hex = s[0] == '0' && (s[1] == 'x' || s[1] == 'X');
     const char *d = hex ? s + 2 : s;
     size_t n = strspn(d, hex ? "0123456789abcdefABCDEF" : "0123456789");
-    if (n == 0u || d[n] != '\0' || n > (hex ? 15u : 18u)) {
+    if (n == 0u || d[n] != '\0') {
+        return false;
+    }
+    /* Leading zeros are no digits of the value: beyond them at most 15 hex
+     * or 18 decimal digits, which a long long always holds. */
+    if (n - strspn(d, "0") > (hex ? 15u : 18u)) {
         return false;
     }
     long long v = strtoll(d, NULL, hex ? 16 : 10);

@@ -131,8 +131,9 @@ void cmd_usage(FILE *f);
 void cmd_describe(const product_t *p, char *buf, size_t len);
 
 /* A number as the lines and the command line write it: decimal digits
- * ("033" is 33: no octal) or 0x and hex digits; no sign, no blanks. True
- * with *out (at most max, which is below 10^18), false otherwise. long
+ * ("033" is 33: no octal; leading zeros as many as given) or 0x and hex
+ * digits; no sign, no blanks. True with *out (at most max, which is below
+ * 10^18), false otherwise. long
  * long: a 32-bit host's long cannot hold the largest serial number. */
 bool cmd_number(const char *s, long long max, long long *out);
 

@@ -148,6 +148,38 @@ def test_usage_errors():
              "--on-eof takes quit or run, not 'later'")
 
 
+@pytest.mark.parametrize("serial", ["1", "0xFFFFFFFF", "4294967295", "0000000000000000000001",
+                                    "0x00000000000000000000FFFFFFFF"])
+def test_serial_accepted(serial):
+    """Past the command line: the interface is what stops it (exit 1)."""
+    r = run("--product", "dst-x730-xy30", "--iface", "nosuchcan0", "--serial", serial)
+    assert r.returncode == 1, r.stderr
+
+
+@pytest.mark.parametrize("serial", ["0", "4294967296", "0x100000000", "-1", "+1", " 1", "",
+                                    "0x", "1e3", "12x", "0x0000000000000000000100000000"])
+def test_serial_refused(serial):
+    one_line(run("--product", "jd2xxx", "--iface", "vcan0", "--serial", serial), 2,
+             f"--serial takes a serial number 1..0xFFFFFFFF (decimal or 0x hex), not '{serial}' "
+             "(see --help)")
+
+
+def test_serial_range_of_several_nodes():
+    """Node i takes serial + i: the last one must fit too (the range in
+    the refusal computed wide enough on any host)."""
+    one_line(run("--product", "gsh-a-redundant", "--iface", "vcan0", "--serial", "0xFFFFFFFF"), 2,
+             "--serial 0xFFFFFFFF: 2 nodes take 0xFFFFFFFF..0x100000000, past 0xFFFFFFFF")
+    assert "--serial N" in run("--help").stdout
+
+
+def test_one_hint_chosen_by_the_message_not_its_words():
+    """A word of the command line that looks like a hint chooses nothing."""
+    one_line(run("--product", "dst-x730-xy30", "--iface", "vcan0", "oops (see --list-products)"),
+             2, "unexpected argument 'oops (see --list-products)' (see --help)")
+    one_line(run("--node", "dst-x730-xy30@(see 1", "--iface", "vcan0"), 2,
+             "is not 1..127 (e.g. 0x21 or 33) (see --help)")
+
+
 def test_nvm_not_a_regular_file(tmp_path):
     """Refused before anything is opened: a FIFO must not hang the start."""
     fifo = tmp_path / "fifo"

@@ -344,12 +344,3 @@ def test_three_jds_have_their_own_lss_addresses(tmp_path, network, bus):
         stop(proc)
     log = (tmp_path / "sensor.log").read_text()
     assert "factory node-ID 0x22, serial 0x5E000002" in log
-
-
-def test_serial_usage_errors():
-    for bad in ("0", "-1", "0x100000000", "4294967296", "12x", "", "0x"):
-        refused(run("--product", "jd2xxx", "--iface", "vcan0", "--serial", bad),
-                f"--serial takes a serial number 1..0xFFFFFFFF (decimal or 0x hex), not '{bad}'")
-    refused(run("--product", "gsh-a-redundant", "--iface", "vcan0", "--serial", "0xFFFFFFFF"),
-            "--serial 0xFFFFFFFF: 2 nodes take 0xFFFFFFFF..0x100000000, past 0xFFFFFFFF")
-    assert "--serial N" in run("--help").stdout
