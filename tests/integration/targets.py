@@ -497,17 +497,18 @@ def list_products():
 
 def period_fault(times, period_ms, window_s):
     """None if frames that arrived at these times (seconds), collected for
-    window_s, came every period_ms; else what is wrong. The period is the
-    median gap, to a fifth: a moment in which the machine starves an
-    emulator or a process drops a beat (CiA 301's producer does not catch
-    up) or delivers two frames together; it moves the mean and the count,
-    not the median. The count is checked on top, loosely: at least half of
-    what the window holds, at most two more (one at each end, one that a
-    late read brought in). A period of a half or double, a producer that
-    stops or bursts, fails either way."""
+    window_s, came every period_ms; else what is wrong. A moment in which
+    the machine starves an emulator or a process drops a beat (CiA 301's
+    producer does not catch up) or delivers two frames together: it moves
+    the mean, so the period is the median gap, to a fifth. The count: at
+    least three quarters of what the window holds (a stall of a quarter of
+    it is forgiven; a producer silent for longer fails), at most two more
+    (one at each end, one that a late read brought in). Frames the host
+    reads late arrive bunched, so a device's burst cannot be told from
+    that here: the unit tests find bursts, on the stack's own clock."""
     want = window_s * 1000 / period_ms
-    if not want / 2 <= len(times) <= want + 2:
-        return f"{len(times)} in {window_s} s at {period_ms} ms"
+    if len(times) < 2 or not want * 3 / 4 <= len(times) <= want + 2:
+        return f"{len(times)} in {window_s} s at {period_ms} ms, want {want:.0f}"
     gaps = sorted(b - a for a, b in zip(times, times[1:]))
     median = gaps[len(gaps) // 2] * 1000
     if abs(median - period_ms) > period_ms / 5:
