@@ -148,7 +148,7 @@ int cli_start_failure(int rc, const char *msg)
 static bool parse_serial(const char *s, uint32_t *out)
 {
     long long v = 0;
-    if (!cmd_number(s, 0xFFFFFFFFll, &v) || v == 0) {
+    if (!cmd_number(s, 0xFFFFFFFFLL, &v) || v == 0) {
         return false;
     }
     *out = (uint32_t)v;
