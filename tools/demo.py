@@ -17,7 +17,6 @@ import json
 import os
 import queue
 import subprocess
-import sys
 import tempfile
 import time
 

@@ -433,7 +433,7 @@ class CanEmuTarget(EmuTarget):
             self._reap(signal.SIGKILL)
             if "port" not in self.log.read_text().splitlines()[-1]:
                 break  # not a port another program took meanwhile: no retry
-        raise TargetError(f"rv32-can: tools/emu did not get ready; its output:\n"
+        raise TargetError("rv32-can: tools/emu did not get ready; its output:\n"
                           + self.log.read_text()[-2000:])
 
     def _ready(self, start):

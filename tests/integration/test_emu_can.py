@@ -20,7 +20,7 @@ import pytest
 
 from conftest import IFACE, Sensor
 from facts import PRODUCTS
-from targets import EMU, CanEmuTarget, Frames, Master, free_port, period_fault
+from targets import EMU, CanEmuTarget, Master, free_port, period_fault
 
 IMAGE = "jd1xxx"  # node 10; the mixed bus adds the Linux program's
 OTHERS = ("dst-x730-xy30", "inx360d")  # nodes 0x7F and 1: SYNC types, as the JD

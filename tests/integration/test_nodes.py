@@ -9,7 +9,6 @@ import subprocess
 import time
 
 import canopen
-import pytest
 
 from conftest import BINARY, IFACE, eds_od
 
