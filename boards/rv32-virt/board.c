@@ -96,10 +96,9 @@ bool board_can_bitrate(uint16_t kbps)
     return serial_link_bitrate(&link, kbps, put);
 }
 
-/* The 64-bit 10 MHz mtime in microseconds, its low 32 bits: wrapping at
- * 2^32 us as board.h wants (the low word of mtime alone, divided, jumped
- * back to 0 every 429.5 s, and the stack took time for running backwards). */
-uint32_t board_now_us(void)
+/* The CLINT's 64-bit mtime (10 MHz), read as two words: again if the high
+ * word moved in between. */
+static uint64_t mtime(void)
 {
     uint32_t hi;
     uint32_t lo;
@@ -107,7 +106,15 @@ uint32_t board_now_us(void)
         hi = MTIME_HI;
         lo = MTIME_LO;
     } while (hi != MTIME_HI);
-    return (uint32_t)((((uint64_t)hi << 32) | lo) / 10u);
+    return ((uint64_t)hi << 32) | lo;
+}
+
+/* mtime in microseconds, its low 32 bits: wrapping at 2^32 us as board.h
+ * wants (the low word of mtime alone, divided, jumped back to 0 every
+ * 429.5 s, and the stack took time for running backwards). */
+uint32_t board_now_us(void)
+{
+    return (uint32_t)(mtime() / 10u);
 }
 
 /*
@@ -162,17 +169,10 @@ void board_sleep(uint32_t us)
 {
     /* The deadline in mtime ticks (10 MHz), 64 bits: at most 1 s ahead. */
     uint32_t ticks = (us < 1000000u ? us : 1000000u) * 10u;
-    uint32_t hi;
-    uint32_t lo;
-    do {
-        hi = MTIME_HI;
-        lo = MTIME_LO;
-    } while (hi != MTIME_HI);
-    uint32_t dlo = lo + ticks;
-    uint32_t dhi = hi + (dlo < lo ? 1u : 0u);
+    uint64_t deadline = mtime() + ticks;
     MTIMECMP_LO = 0xFFFFFFFFu; /* no moment with a deadline in the past */
-    MTIMECMP_HI = dhi;
-    MTIMECMP_LO = dlo;
+    MTIMECMP_HI = (uint32_t)(deadline >> 32);
+    MTIMECMP_LO = (uint32_t)deadline;
     plic_done(); /* interrupts seen before: done */
     if ((UART_LSR & 1u) == 0u && !can_rx_waiting()) {
         __asm__ volatile("wfi");

@@ -389,6 +389,15 @@ static void test_serial_line_answers(void)
     }
 }
 
+/* The program's first port, polled at t, and the serial line s at t: both
+ * in state want (a macro: a failure names the caller's line). */
+#define BOTH_STATES_AT(s, t, want)                                                                 \
+    do {                                                                                           \
+        (void)lp_poll(&app.ports[0], (t));                                                         \
+        CHECK_EQ(lp_can_state(&app.ports[0]), (want));                                             \
+        CHECK_EQ(serial_link_can_state((s), (t)), (want));                                         \
+    } while (0)
+
 /* Another state during a bus-off ends the hold: the controller is back
  * after the recovery alone (128 x 11 bits), in that state; the same on the
  * program's ports and on the serial line. */
@@ -406,24 +415,16 @@ static void test_bus_off_ended_by_another_state(void)
     CHECK(is(ask_at("can warning", t0 + 1000u), "ok"));
     CHECK(is(serial_ask(&s, "can warning"), "ok"));
     CHECK_EQ(serial_link_can_state(&s, t0 + 1000u), CO_CAN_BUSOFF);
-    (void)lp_poll(&app.ports[0], back - 1u);
-    CHECK_EQ(lp_can_state(&app.ports[0]), CO_CAN_BUSOFF);
-    CHECK_EQ(serial_link_can_state(&s, back - 1u), CO_CAN_BUSOFF);
-    (void)lp_poll(&app.ports[0], back);
-    CHECK_EQ(lp_can_state(&app.ports[0]), CO_CAN_WARNING);
-    CHECK_EQ(serial_link_can_state(&s, back), CO_CAN_WARNING);
+    BOTH_STATES_AT(&s, back - 1u, CO_CAN_BUSOFF);
+    BOTH_STATES_AT(&s, back, CO_CAN_WARNING);
     /* A bus-off left alone comes back error active after its hold, on
      * both: the former one's cut does not shorten it. */
     CHECK(is(ask_at("can bus-off 1", back), "ok"));
     CHECK(is(serial_ask(&s, "can bus-off 1"), "ok"));
     CHECK_EQ(serial_link_can_state(&s, back), CO_CAN_BUSOFF);
     uint32_t again = back + 1000000u + 5632u;
-    (void)lp_poll(&app.ports[0], again - 1u);
-    CHECK_EQ(lp_can_state(&app.ports[0]), CO_CAN_BUSOFF);
-    CHECK_EQ(serial_link_can_state(&s, again - 1u), CO_CAN_BUSOFF);
-    (void)lp_poll(&app.ports[0], again);
-    CHECK_EQ(lp_can_state(&app.ports[0]), CO_CAN_ACTIVE);
-    CHECK_EQ(serial_link_can_state(&s, again), CO_CAN_ACTIVE);
+    BOTH_STATES_AT(&s, again - 1u, CO_CAN_BUSOFF);
+    BOTH_STATES_AT(&s, again, CO_CAN_ACTIVE);
     /* A state commanded in the last recovery never makes the bus-off
      * longer: it ends when it would have. */
     CHECK(is(ask_at("can bus-off", again), "ok"));
@@ -432,9 +433,7 @@ static void test_bus_off_ended_by_another_state(void)
     CHECK(is(ask_at("can passive", again + 5000u), "ok"));
     CHECK(is(serial_ask(&s, "can passive"), "ok"));
     CHECK_EQ(serial_link_can_state(&s, again + 5000u), CO_CAN_BUSOFF);
-    (void)lp_poll(&app.ports[0], again + 5632u);
-    CHECK_EQ(lp_can_state(&app.ports[0]), CO_CAN_PASSIVE);
-    CHECK_EQ(serial_link_can_state(&s, again + 5632u), CO_CAN_PASSIVE);
+    BOTH_STATES_AT(&s, again + 5632u, CO_CAN_PASSIVE);
 }
 
 /* `@all replay FILE` over two products: each instance takes its product's
