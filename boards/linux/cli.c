@@ -165,14 +165,17 @@ static int parse_int(const char *s, int *out)
     return 0;
 }
 
-/* --iface: one interface for all nodes, or one per node ("A,B"). Returns
- * CLI_GO_ON or the exit status of a wrong command line. */
-static int split_ifaces(node_spec_t *o)
+/* A spec's interfaces, one for all its nodes or one per node ("A,B"), from
+ * --iface or from --node's /IFACE: opt and val are what a refusal names
+ * ("--iface", "A,B" or "--node", "PRODUCT@ID/A,B"), the option the
+ * interfaces came from. Returns CLI_GO_ON or the exit status of a wrong
+ * command line. */
+static int split_ifaces(node_spec_t *o, const char *opt, const char *val)
 {
     const product_t *prod = o->prod;
     const char *iface = o->iface;
     if (snprintf(o->ifbuf, sizeof(o->ifbuf), "%s", iface) >= (int)sizeof(o->ifbuf)) {
-        return USAGE_ERROR("--iface %s: too long", iface);
+        return USAGE_ERROR("%s %s: too long", opt, val);
     }
     unsigned nif = 0;
     for (char *s = o->ifbuf, *comma;; s = comma + 1) {
@@ -181,7 +184,7 @@ static int split_ifaces(node_spec_t *o)
             *comma = '\0';
         }
         if (s[0] == '\0' || strlen(s) >= IFNAMSIZ) {
-            return USAGE_ERROR("--iface %s: '%s' is not an interface name", iface, s);
+            return USAGE_ERROR("%s %s: '%s' is not an interface name", opt, val, s);
         }
         if (nif == prod->nodes) {
             return prod->nodes == 1u
@@ -263,7 +266,9 @@ static int check_specs(options_t *o)
                 n->ifn[i] = n->ifbuf;
             }
         } else {
-            int rc = split_ifaces(n);
+            /* spec[0] with --product is --iface's; any other, a --node's. */
+            bool product = k == 0u && o->prod != NULL;
+            int rc = split_ifaces(n, product ? "--iface" : "--node", product ? n->iface : n->arg);
             if (rc != CLI_GO_ON) {
                 return rc;
             }

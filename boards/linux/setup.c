@@ -103,8 +103,8 @@ static int open_inst_nvm(app_t *a, const options_t *o, unsigned k, bool *former)
     }
     int r = lp_nvm_open(&in->nvm, opt, path, in->nvm_mem,
                         (uint32_t)(in->prod->nodes * CO_STORE_NVM_SIZE), err, sizeof(err));
-    if (r != 0) {
-        return cli_start_failure(r == -2 ? 2 : 1, err);
+    if (r != 0) { /* a path --nvm does not take (a FIFO, ...): with the hint, as its siblings */
+        return r == -2 ? USAGE_ERROR("%s", err) : cli_start_failure(CLI_FAILED, err);
     }
     if (*former) { /* held and saved under the new name from now (same directory) */
         char *slash = strrchr(in->nvm.real, '/');
@@ -124,7 +124,10 @@ static int open_inst_nvm(app_t *a, const options_t *o, unsigned k, bool *former)
     }
     r = lp_nvm_lock(&in->nvm, opt, path, err, sizeof(err));
     if (r != 0) {
-        return cli_start_failure(r == -2 ? 2 : 1, err);
+        /* Held by another process: exit 2 as a wrong command line, but
+         * without "(see --help)": the path is one --nvm takes, and the
+         * message says what holds it. */
+        return cli_start_failure(r == -2 ? CLI_USAGE : CLI_FAILED, err);
     }
     return CLI_GO_ON;
 }

@@ -185,12 +185,34 @@ def test_nvm_not_a_regular_file(tmp_path):
     fifo = tmp_path / "fifo"
     os.mkfifo(fifo)
     base = ["--product", "jd1xxx", "--iface", "vcan0", "--nvm"]
-    one_line(run(*base, str(fifo)), 2, f"--nvm {fifo}: a FIFO, not a regular file")
-    one_line(run(*base, str(tmp_path)), 2, f"--nvm {tmp_path}: a directory, not a regular file")
-    one_line(run(*base, "/dev/zero"), 2, "--nvm /dev/zero: a character device, not a regular file")
+    # Each with the hint, as the options' other refusals (it was on
+    # --nvm-dir's and not on these).
+    one_line(run(*base, str(fifo)), 2, f"--nvm {fifo}: a FIFO, not a regular file (see --help)")
+    one_line(run(*base, str(tmp_path)), 2,
+             f"--nvm {tmp_path}: a directory, not a regular file (see --help)")
+    one_line(run(*base, "/dev/zero"), 2,
+             "--nvm /dev/zero: a character device, not a regular file (see --help)")
     missing = tmp_path / "no" / "e.bin"
-    one_line(run(*base, str(missing)), 2, f"directory {missing.parent} does not exist")
+    one_line(run(*base, str(missing)), 2,
+             f"directory {missing.parent} does not exist (see --help)")
     assert not missing.parent.exists()
+    d = tmp_path / "d"
+    d.mkdir()
+    os.mkfifo(d / "jd1xxx-0x0A-vcan0.nvm")
+    one_line(run("--product", "jd1xxx", "--iface", "vcan0", "--nvm-dir", str(d)), 2,
+             f"--nvm-dir {d}: {d}/jd1xxx-0x0A-vcan0.nvm: a FIFO, not a regular file (see --help)")
+
+
+@pytest.mark.parametrize("node, bad", [
+    ("jd1xxx@0x0B/", ""), ("gsh-a-redundant/vcan0,", ""), ("gsh-a-redundant/,vcan1", ""),
+    ("jd1xxx/a-name-longer-than-ifnamsiz", "a-name-longer-than-ifnamsiz")])
+def test_node_interface_refusal_names_the_node(node, bad):
+    """--node's own /IFACE refused: the message names that --node value,
+    not --iface (which was blamed, given or not)."""
+    for extra in ([], ["--iface", "vcan1"]):
+        r = run("--node", node, *extra)
+        one_line(r, 2, f"--node {node}: '{bad}' is not an interface name (see --help)")
+        assert "--iface" not in r.stderr
 
 
 def test_missing_interface_is_a_clear_error(tmp_path):
@@ -351,3 +373,18 @@ def test_control_form_checked_with_the_command_line(spec, text):
     """A --control that has neither form is a wrong command line (2), found
     before anything opens: the same answer with or without CAN."""
     one_line(run("--product", "jd2xxx", "--iface", "vcan0", "--control", spec), 2, text)
+
+
+CTL = str(Path(__file__).resolve().parents[2] / "tools" / "ctl")
+
+
+@pytest.mark.parametrize("port", ["\u0668\u0660", "\u0968\u0966", "\uff18\uff10", "\u00b2",
+                                  "8\u0660", "+80", " 80", "80 ", "0x50", "", "0", "65536"])
+def test_ctl_port_ascii_digits_only(port):
+    """tools/ctl tcp:PORT: ASCII 0-9 only. Arabic-Indic, Devanagari or
+    full-width digits were taken (str.isdigit and int() accept them) and
+    a connection to port 80 tried; now a wrong command line, sent nowhere."""
+    r = subprocess.run([CTL, f"tcp:{port}", "get"], capture_output=True, text=True, timeout=10)
+    assert r.returncode == 2, r.stderr
+    assert r.stderr.startswith(f"ctl: tcp:{port}: not a port 1..65535 (usage: tools/ctl"), \
+        r.stderr

@@ -175,7 +175,7 @@ def test_nvm_device_refused_as_root(tmp_path):
                        capture_output=True, text=True, timeout=5, stdin=subprocess.DEVNULL)
     assert r.returncode == 2
     assert r.stderr.strip().splitlines() == [
-        "canopen-sensor: --nvm /dev/null: a character device, not a regular file"]
+        "canopen-sensor: --nvm /dev/null: a character device, not a regular file (see --help)"]
     assert stat.S_ISCHR(os.stat("/dev/null").st_mode)
 
 
