@@ -121,6 +121,9 @@ uint32_t app_poll(app_t *a, uint32_t t, uint32_t wait, bool *backlog)
         leds_set(&a->leds[i], i, g, rd, gp, rp);
         wait = co_min_u32(wait, led_next);
     }
+    for (unsigned k = 0; k < a->ninst; k++) {
+        wait = co_min_u32(wait, lp_nvm_renew(&a->inst[k].nvm, t)); /* the hold's lease */
+    }
     /* What the nodes sent in this pass and before it (answers to frames
      * received since the last pass), in one go. */
     *backlog = lp_tx_flush(&a->tx, a->ports, a->nnodes) > 0u;
@@ -229,8 +232,13 @@ void app_shut_down(app_t *a)
         lp_close(p);
     }
     lp_tx_close(&a->tx);
+    app_release_nvm(a);
+    lp_log("stopped");
+}
+
+void app_release_nvm(app_t *a)
+{
     for (unsigned k = 0; k < a->ninst; k++) {
         lp_nvm_unlock(&a->inst[k].nvm); /* the EEPROM files free for the next user */
     }
-    lp_log("stopped");
 }

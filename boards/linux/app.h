@@ -97,7 +97,12 @@ void app_log_states(app_t *a);
 /* Which stored sets could not be used at the start, in the log. */
 void app_log_store_status(const app_t *a);
 
-/* Send what is queued, LEDs off, sockets closed, the counts in the log. */
+/* Send what is queued, LEDs off, sockets closed, the counts in the log,
+ * the EEPROM files' holds given back (app_release_nvm). */
 void app_shut_down(app_t *a);
+
+/* Give back the EEPROM files' holds (nvm_file.h), also after a failed
+ * start: the instances that took none are skipped. */
+void app_release_nvm(app_t *a);
 
 #endif /* LINUX_APP_H */

@@ -44,6 +44,7 @@ int main(int argc, char **argv)
     static loop_t l;
     rc = setup_run(&a, &l, &o);
     if (rc != CLI_GO_ON) {
+        app_release_nvm(&a); /* a failed start leaves no hold file behind */
         return rc;
     }
     rc = loop_run(&l);

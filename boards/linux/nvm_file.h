@@ -16,8 +16,24 @@ typedef struct lp_nvm {
     uint8_t *mem;     /* mirror of the file, size bytes (caller's storage); always
                        * what the file holds (a write that fails changes neither) */
     uint32_t size;
-    int lock_fd; /* lp_nvm_lock's hold on the file; -1 or 0: none */
+    int lock_fd;      /* lp_nvm_lock's hold on this kernel; -1 or 0: none */
+    char hold[160];   /* the hold file's line while held ("": none) */
+    uint32_t renewed; /* when lp_nvm_renew last touched the hold file */
+    bool lost;        /* the hold file is gone or another's: logged once */
 } lp_nvm_t;
+
+/*
+ * The hold file, FILE.lock beside the file (the resolved path's), holds one
+ * line: "canopen-hold 1 boot=B pidns=N pid=P start=S by=NAME", the kernel's
+ * boot id, the PID namespace's inode, the holder's PID and start time (field
+ * 22 of /proc/PID/stat) and its program. tools/emu --flash makes the same
+ * file, so each refuses the other. The holder touches its mtime every
+ * LP_NVM_RENEW_US; a hold of another kernel (another User-Mode Linux, or
+ * the host seen from one) is stale once it is LP_NVM_LEASE_S seconds old,
+ * one of this kernel and PID namespace as soon as its process is gone.
+ */
+#define LP_NVM_RENEW_US 1000000u
+#define LP_NVM_LEASE_S 10
 
 /*
  * Open the EEPROM file (path NULL: RAM only). path must be a regular file,
@@ -37,12 +53,21 @@ int lp_nvm_open(lp_nvm_t *n, const char *opt, const char *path, uint8_t *mem, ui
 
 /*
  * Hold n's file (lp_nvm_open'ed; nothing for RAM) for this process until
- * lp_nvm_unlock or its end: one file, one user. Returns 0; -2 with the
- * cause in err when another holder (this process or another) has the
- * same resolved path; -1 when the hold cannot be made. Messages begin
- * with opt and path as lp_nvm_open's.
+ * lp_nvm_unlock: one file, one user, across kernels (see the hold file
+ * above). A stale hold file is removed (logged) and the file taken.
+ * Returns 0; -2 with the cause in err when another holder (this process
+ * or another, on this kernel or another) has the same resolved path; -1
+ * when the hold cannot be made. Messages begin with opt and path as
+ * lp_nvm_open's.
  */
 int lp_nvm_lock(lp_nvm_t *n, const char *opt, const char *path, char *err, unsigned errlen);
+
+/* Keep the hold alive at time now (us, the loop's clock): the hold file's
+ * mtime touched when LP_NVM_RENEW_US have passed. Returns the time until
+ * the next renewal is due. A hold file gone or another's is logged once. */
+uint32_t lp_nvm_renew(lp_nvm_t *n, uint32_t now);
+
+/* Give the hold back: the hold file is removed (if it is still ours). */
 void lp_nvm_unlock(lp_nvm_t *n);
 
 /* len bytes at addr of the EEPROM (its mirror); false outside it. */

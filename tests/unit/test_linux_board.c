@@ -7,6 +7,8 @@
 #include <stdlib.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "can_port.h"
@@ -216,6 +218,178 @@ static void test_eeprom_lock(void)
     CHECK_EQ(lp_nvm_lock(&ram, "--nvm", NULL, err, sizeof(err)), 0);
     CHECK_EQ(lp_nvm_lock(&ram, "--nvm", NULL, err, sizeof(err)), 0);
     rmdir(dir);
+    log_stop();
+}
+
+/* The hold file's line for process pid (start: its start time) of the kernel
+ * boot (NULL: this one), as nvm_file.h describes it. */
+static void hold_line(char *buf, size_t len, const char *boot, long pid, unsigned long long start)
+{
+    char mine[64] = "";
+    FILE *f = fopen("/proc/sys/kernel/random/boot_id", "r");
+    CHECK(f != NULL);
+    if (f != NULL) {
+        CHECK(fgets(mine, sizeof(mine), f) != NULL);
+        fclose(f);
+    }
+    mine[strcspn(mine, "\n")] = '\0';
+    struct stat st;
+    CHECK_EQ(stat("/proc/self/ns/pid", &st), 0);
+    snprintf(buf, len, "canopen-hold 1 boot=%s pidns=%llu pid=%ld start=%llu by=tools/emu\n",
+             boot != NULL ? boot : mine, (unsigned long long)st.st_ino, pid, start);
+}
+
+/* This process's start time, field 22 of /proc/self/stat. */
+static unsigned long long own_start(void)
+{
+    char buf[1024] = "";
+    FILE *f = fopen("/proc/self/stat", "r");
+    CHECK(f != NULL);
+    if (f != NULL) {
+        CHECK(fgets(buf, sizeof(buf), f) != NULL);
+        fclose(f);
+    }
+    const char *p = strrchr(buf, ')');
+    for (int field = 2; p != NULL && field < 22; field++) {
+        p = strchr(p + 1, ' ');
+    }
+    return p != NULL ? strtoull(p + 1, NULL, 10) : 0u;
+}
+
+/* The hold file's mtime set age seconds back. */
+static void age_file(const char *path, long age)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_REALTIME, &now);
+    struct timespec t[2] = {{.tv_sec = now.tv_sec - age}, {.tv_sec = now.tv_sec - age}};
+    CHECK_EQ(utimensat(AT_FDCWD, path, t, 0), 0);
+}
+
+static long file_age(const char *path)
+{
+    struct stat st;
+    struct timespec now;
+    clock_gettime(CLOCK_REALTIME, &now);
+    return stat(path, &st) == 0 ? (long)(now.tv_sec - st.st_mtim.tv_sec) : -1;
+}
+
+/* Try to hold path with the hold file holding line (mtime age s back);
+ * returns lp_nvm_lock's result, err its message, the hold given back. */
+static int lock_over(const char *path, const char *lock, const char *line, long age, char *err,
+                     unsigned errlen)
+{
+    write_file(lock, line, strlen(line));
+    age_file(lock, age);
+    uint8_t mem[CO_STORE_NVM_SIZE];
+    lp_nvm_t n;
+    CHECK_EQ(lp_nvm_open(&n, "--nvm", path, mem, sizeof(mem), err, errlen), 0);
+    int r = lp_nvm_lock(&n, "--nvm", path, err, errlen);
+    if (r == 0) {
+        char ours[200];
+        hold_line(ours, sizeof(ours), NULL, (long)getpid(), own_start());
+        /* ours names tools/emu; the file canopen-sensor: compare up to by= */
+        CHECK(file_equals(lock, n.hold, strlen(n.hold)));
+        CHECK(strncmp(n.hold, ours, (size_t)(strstr(ours, " by=") - ours)) == 0);
+        lp_nvm_unlock(&n);
+        CHECK(access(lock, F_OK) != 0); /* given back: gone */
+    } else {
+        CHECK(file_equals(lock, line, strlen(line))); /* a live hold is left alone */
+        (void)unlink(lock);
+    }
+    return r;
+}
+
+/* The hold file (nvm_file.h): made at lock, renewed, removed at unlock;
+ * another's refused while it lives, taken over once it is stale: on this
+ * kernel by its process being gone (a PID used again has another start
+ * time), from another kernel by its lease running out. */
+static void test_eeprom_hold_file(void)
+{
+    char dir[] = "/tmp/co-nvm-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char path[300];
+    char lock[310];
+    char line[200];
+    char err[900];
+    snprintf(path, sizeof(path), "%s/e.nvm", dir);
+    snprintf(lock, sizeof(lock), "%s/e.nvm.lock", dir);
+    log_start();
+
+    /* Made at lock, with this process in it; renewed once a second. */
+    uint8_t mem[CO_STORE_NVM_SIZE];
+    lp_nvm_t n;
+    CHECK_EQ(lp_nvm_open(&n, "--nvm", path, mem, sizeof(mem), err, sizeof(err)), 0);
+    CHECK_EQ(lp_nvm_lock(&n, "--nvm", path, err, sizeof(err)), 0);
+    CHECK(file_equals(lock, n.hold, strlen(n.hold)));
+    hold_line(line, sizeof(line), NULL, (long)getpid(), own_start());
+    CHECK(strncmp(n.hold, line, (size_t)(strstr(line, " by=") - line)) == 0);
+    CHECK(strstr(n.hold, " by=canopen-sensor\n") != NULL);
+    age_file(lock, 100);
+    CHECK_EQ(lp_nvm_renew(&n, 5000u), LP_NVM_RENEW_US); /* first call: renewed now */
+    CHECK(file_age(lock) >= 0 && file_age(lock) < 5);
+    age_file(lock, 100);
+    CHECK_EQ(lp_nvm_renew(&n, 5000u + LP_NVM_RENEW_US - 1u), 1u); /* not due yet */
+    CHECK(file_age(lock) >= 100);
+    CHECK_EQ(lp_nvm_renew(&n, 5000u + LP_NVM_RENEW_US), LP_NVM_RENEW_US);
+    CHECK(file_age(lock) < 5);
+    /* Someone took it (judged stale): logged once, never touched again. */
+    hold_line(line, sizeof(line), "other-kernel", 42, 7u);
+    write_file(lock, line, strlen(line));
+    age_file(lock, 100);
+    (void)lp_nvm_renew(&n, 5000u + 2u * LP_NVM_RENEW_US);
+    (void)lp_nvm_renew(&n, 5000u + 3u * LP_NVM_RENEW_US);
+    CHECK(file_age(lock) >= 100);
+    const char *lost = strstr(log_text(), "is gone or another's");
+    CHECK(lost != NULL && strstr(lost + 1, "is gone or another's") == NULL);
+    lp_nvm_unlock(&n);
+    CHECK(file_equals(lock, line, strlen(line))); /* another's stays */
+    (void)unlink(lock);
+    CHECK_EQ(lp_nvm_renew(&n, 0u), UINT32_MAX); /* nothing held */
+
+    /* This kernel: a live holder (this very process) refused, ... */
+    hold_line(line, sizeof(line), NULL, (long)getpid(), own_start());
+    CHECK_EQ(lock_over(path, lock, line, 100, err, sizeof(err)), -2);
+    char want[1500];
+    snprintf(want, sizeof(want),
+             "--nvm %s: EEPROM file %s is in use by tools/emu, pid %ld of this kernel (hold "
+             "file %s; two users would overwrite each other's saves)",
+             path, path, (long)getpid(), lock);
+    CHECK(strcmp(err, want) == 0);
+    /* ... its PID with another start time (used again) taken over, ... */
+    hold_line(line, sizeof(line), NULL, (long)getpid(), own_start() + 1u);
+    CHECK_EQ(lock_over(path, lock, line, 0, err, sizeof(err)), 0);
+    /* ... and an ended process's at once, however fresh. */
+    pid_t child = fork();
+    if (child == 0) {
+        _exit(0);
+    }
+    CHECK(child > 0);
+    CHECK_EQ(waitpid(child, NULL, 0), child);
+    hold_line(line, sizeof(line), NULL, (long)child, own_start());
+    CHECK_EQ(lock_over(path, lock, line, 0, err, sizeof(err)), 0);
+    snprintf(want, sizeof(want),
+             "stale hold file %s removed (tools/emu, pid %ld of this kernel, "
+             "which has ended)",
+             lock, (long)child);
+    CHECK(strstr(log_text(), want) != NULL);
+
+    /* Another kernel: alive while renewed within the lease. */
+    hold_line(line, sizeof(line), "6d3a0c51-other-kernel", 42, 7u);
+    CHECK_EQ(lock_over(path, lock, line, LP_NVM_LEASE_S - 2, err, sizeof(err)), -2);
+    CHECK(strstr(err, "in use by tools/emu, pid 42 of another kernel (boot id 6d3a0c51), "
+                      "renewed ") != NULL);
+    CHECK_EQ(lock_over(path, lock, line, LP_NVM_LEASE_S + 2, err, sizeof(err)), 0);
+    /* A line that does not parse: its age alone. */
+    CHECK_EQ(lock_over(path, lock, "junk\n", 0, err, sizeof(err)), -2);
+    CHECK(strstr(err, "in use by an unknown holder, renewed 0 s ago") != NULL);
+    CHECK_EQ(lock_over(path, lock, "", 0, err, sizeof(err)), -2);
+    CHECK_EQ(lock_over(path, lock, "junk\n", LP_NVM_LEASE_S + 2, err, sizeof(err)), 0);
+
+    /* Nothing but the data file is left in the directory. */
+    char aside[320];
+    snprintf(aside, sizeof(aside), "%s/e.nvm.lock.stale", dir);
+    CHECK(access(aside, F_OK) != 0);
+    CHECK(rmdir(dir) == 0);
     log_stop();
 }
 
@@ -515,6 +689,7 @@ int main(void)
     RUN(test_eeprom_not_a_file);
     RUN(test_eeprom_link_to_nothing);
     RUN(test_eeprom_lock);
+    RUN(test_eeprom_hold_file);
     RUN(test_eeprom_corrupt_untouched);
     RUN(test_eeprom_save_fails);
     RUN(test_rate_limit);
