@@ -84,6 +84,28 @@ def test_status_and_output_pass_through(tmp_path):
     assert_torn_down(f"vcanrun{p.pid}", tmp_path)
 
 
+@pytest.mark.parametrize("name", ["a b", 'a"b', "a\u00a0b"])
+def test_tmpdir_the_kernel_line_cannot_carry(tmp_path, name):
+    """A $TMPDIR with a blank (or a quote, or U+00A0, whose byte A0h the
+    kernel takes for a blank): its path on User-Mode Linux's command line
+    was split, init not found, and vcan-run said "cannot start a process on
+    this host" with exit 77, ctest's skip: every vcan test skipped. The
+    command runs; the work directory is in /tmp then, and gone after."""
+    work = tmp_path / name
+    work.mkdir()
+    e = dict(os.environ, VCAN_RUN_MODE="uml", TMPDIR=str(work))
+    cmd = 'ip -br link show vcan0; echo "$TMPDIR"; exit 7'
+    p = subprocess.Popen([VCAN_RUN, "bash", "-c", cmd], env=e, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    out, err = p.communicate(timeout=BOOT)
+    assert p.returncode == 7, err
+    assert out.startswith("vcan0") and "UP" in out, (out, err)
+    assert out.splitlines()[1] == str(work)  # the command's TMPDIR is the caller's
+    assert list(work.iterdir()) == []
+    assert list(pathlib.Path("/tmp").glob(f"vcan-run.{p.pid}.*")) == []
+    assert uml_pids(f"vcanrun{p.pid}") == []
+
+
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
 def test_signal_reaches_the_command(tmp_path, sig):
     p = start(tmp_path, RECORDER)
