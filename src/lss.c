@@ -172,8 +172,11 @@ bool co_lss_receive(co_node_t *node, const co_frame_t *f)
     const uint8_t *d = f->data;
     uint8_t cs = d[0];
     if (cs == CS_SWITCH_GLOBAL) {
+        if (d[1] > LSS_CONFIG) {
+            return true; /* CiA 305 defines modes 0 and 1 only: the others change nothing */
+        }
         uint8_t was = l->state;
-        l->state = d[1] == 1u ? LSS_CONFIG : LSS_WAITING;
+        l->state = d[1];
         l->selective = 0;
         if (was == LSS_CONFIG && l->state == LSS_WAITING && unconfigured(node) &&
             l->pending_id != 0u && l->pending_id != CO_LSS_UNCONFIGURED) {

@@ -293,6 +293,24 @@ static void test_lss_store_in_lss_set(void)
     LSS("17 00 00 00 00 00 00 00", "17 01 00 00 00 00 00 00");
 }
 
+/* LSS "switch state global" with a mode CiA 305 does not define (2..255)
+ * changes nothing: a slave in configuration stays there (it still answers
+ * "inquire node-ID"), one in waiting stays there. */
+static void test_lss_switch_global_reserved_mode(void)
+{
+    boot();
+    LSS("04 01 00 00 00 00 00 00", NULL);
+    LSS("5E 00 00 00 00 00 00 00", "5E 40 00 00 00 00 00 00");
+    LSS("04 02 00 00 00 00 00 00", NULL);
+    LSS("5E 00 00 00 00 00 00 00", "5E 40 00 00 00 00 00 00");
+    LSS("04 FF 00 00 00 00 00 00", NULL);
+    LSS("5E 00 00 00 00 00 00 00", "5E 40 00 00 00 00 00 00");
+    LSS("04 00 00 00 00 00 00 00", NULL);
+    LSS("5E 00 00 00 00 00 00 00", NULL); /* waiting: no answer */
+    LSS("04 80 00 00 00 00 00 00", NULL);
+    LSS("5E 00 00 00 00 00 00 00", NULL);
+}
+
 /* LSS "activate bit timing" (CiA 305): each index of the bit timing table
  * reaches the board as its rate once the switch delay is over; the
  * reserved index 5 and automatic detection (9) are refused. */
@@ -1030,6 +1048,7 @@ int main(void)
     RUN(test_lss_store_in_lss_set);
     RUN(test_lss_fastscan_ignored_requests);
     RUN(test_lss_bit_timing_table);
+    RUN(test_lss_switch_global_reserved_mode);
     RUN(test_lss_identity_bounds);
     RUN(test_lss_switch_selective_sequence);
     RUN(test_lss_fastscan_no_part_4);
