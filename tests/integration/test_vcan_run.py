@@ -281,3 +281,81 @@ def test_shell_reads_commands_from_a_pipe(tmp_path):
     assert r.returncode == 3, r.stderr
     assert "vcan1  123   [2]  11 22" in r.stdout
     assert list(work.iterdir()) == []
+
+
+# ---- One EEPROM file, one user, across User-Mode Linux kernels ----------
+
+LEASE = 10  # s: boards/linux/nvm_file.h, LP_NVM_LEASE_S; tools/emu's HOLD_LEASE
+
+
+def hold_age(lock):
+    return time.time() - lock.stat().st_mtime
+
+
+def test_one_eeprom_file_across_sessions(tmp_path):
+    """Each tools/vcan-run is a kernel of its own, which neither the
+    program's abstract-socket hold nor a flock reaches: two sessions each
+    ran canopen-sensor --nvm on one file, both saved, the last save won.
+    The hold file beside it is seen everywhere: a second session, the
+    program on the host and tools/emu on the host are refused while the
+    first runs (it renews the hold every second, seen from the host); a
+    kill -9 of that session leaves the hold, refused until its lease has
+    run out (aged here rather than waited for), then taken over by a third
+    session; its clean stop removes it."""
+    nvm, lock = tmp_path / "e.nvm", tmp_path / "e.nvm.lock"
+    env = {"B": BINARY}
+    first = start(tmp_path, 'exec "$B" --product jd2xxx --iface vcan0 --nvm "$D/e.nvm" '
+                  '--on-eof run < /dev/null 2> "$D/first.log"', **env)
+    try:
+        wait_file(lock, first)
+        holder = lock.read_text()
+        assert holder.startswith("canopen-hold 1 boot=") and holder.endswith(
+            " by=canopen-sensor\n"), holder
+        pid = holder.split(" pid=")[1].split()[0]
+        who = f"canopen-sensor, pid {pid} of another kernel"
+        # Renewed from inside, seen on the host.
+        os.utime(lock, (time.time() - 100, time.time() - 100))
+        end = time.monotonic() + LEASE
+        while hold_age(lock) > 50 and time.monotonic() < end:
+            time.sleep(0.1)
+        assert hold_age(lock) < LEASE, "the hold file is not renewed"
+        # A second session: refused, exit 2, naming the holder.
+        second = start(tmp_path, 'exec "$B" --product jd2xxx --iface vcan0 --nvm "$D/e.nvm" '
+                       '--on-eof quit < /dev/null', **env)
+        _, err = second.communicate(timeout=BOOT)
+        assert second.returncode == 2, err
+        assert (f"EEPROM file {nvm} is in use by {who} (boot id ") in err, err
+        # The program on the host (refused before it looks for an interface).
+        r = subprocess.run([BINARY, "--product", "jd2xxx", "--iface", "vcan0", "--nvm", str(nvm)],
+                           stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=30)
+        assert r.returncode == 2 and f"is in use by {who}" in r.stderr, r.stderr
+        # tools/emu on the host, for the same file as its flash (refused
+        # before QEMU would start: the image need not be one).
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        r = subprocess.run([str(ROOT / "tools" / "emu"), "--board", "rv32-virt", "--product",
+                            "dst-x730-xy30", "--port", str(port), "--image", BINARY, "--flash",
+                            str(nvm)], stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                           timeout=30)
+        assert r.returncode == 2, r.stderr
+        assert f"emu: flash file {nvm} is in use by {who}" in r.stderr, r.stderr
+        assert lock.read_text() == holder
+    finally:
+        first.kill()  # a power cut: User-Mode Linux and the program die at once
+        first.communicate(timeout=30)
+    assert lock.read_text() == holder  # nobody removed it
+    r = subprocess.run([BINARY, "--product", "jd2xxx", "--iface", "vcan0", "--nvm", str(nvm)],
+                       stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=30)
+    assert r.returncode == 2 and f"is in use by {who}" in r.stderr, r.stderr
+    # The lease run out: another session takes the file over, and removes
+    # the hold at its clean stop.
+    os.utime(lock, (time.time() - LEASE - 2, time.time() - LEASE - 2))
+    third = start(tmp_path, 'exec "$B" --product jd2xxx --iface vcan0 --nvm "$D/e.nvm" '
+                  '--on-eof quit < /dev/null', **env)
+    _, err = third.communicate(timeout=BOOT)
+    assert third.returncode == 0, err
+    assert f"stale hold file {lock} removed ({who} (boot id " in err, err
+    assert not lock.exists()
+    assert sorted(f.name for f in tmp_path.iterdir() if f.name.startswith("e.")) == [], \
+        "a hold file or a helper of it was left"
