@@ -82,9 +82,11 @@ class Mutants(unittest.TestCase):
 
     def test_operators(self):
         self.assertEqual(sorted(self.by_line[12]), sorted([
-            "<= -> <", "<= -> >", "0 -> 1", "&& -> ||", "!= -> =="]))
+            "<= -> <", "<= -> >", "<= -> >=", "0 -> 1", "&& -> ||", "!= -> ==",
+            "cond -> 1", "cond -> 0", "operand -> 1", "operand -> 0", "operand -> 1", "operand -> 0"]))
         self.assertIn("< -> <=", self.by_line[15])
         self.assertIn("< -> >=", self.by_line[15])
+        self.assertIn("< -> >", self.by_line[15])   # swapped
         self.assertIn("++ -> --", self.by_line[15])
         self.assertIn("+ -> -", self.by_line[16])
         self.assertIn("& -> |", self.by_line[16])   # binary &
@@ -98,7 +100,62 @@ class Mutants(unittest.TestCase):
 
     def test_constants_in_tables_but_not_array_sizes(self):
         self.assertEqual(sorted(self.by_line[6]), sorted([
-            "1 -> 0", "2 -> 3", "2 -> 1", "3 -> 4", "3 -> 2", "5 -> 6", "5 -> 4"]))
+            "1 -> 0", "2 -> 3", "2 -> 1", "2 -> 0", "3 -> 4", "3 -> 2", "3 -> 0", "5 -> 6", "5 -> 4",
+            "5 -> 0"]))
+
+    def apply(self, src, line, desc, col=None):
+        """The text of src with the mutant of line (and column) desc."""
+        ms = [m for m in mutants_of(src) if m.line == line and m.desc == desc
+              and (col is None or m.col == col)]
+        self.assertEqual(len(ms), 1, [(m.line, m.col, m.desc) for m in mutants_of(src) if m.line == line])
+        return src[:ms[0].start] + ms[0].repl + src[ms[0].end:]
+
+    def test_conditions_true_and_false(self):
+        # if, for and ?: conditions; each operand of && and || on its own
+        src = ("int f(int a, int b, int *p)\n{\n"
+               "    if (a < b && (p != 0 || b > 2)) {\n"      # line 3
+               "        return a ? b : (a + b > 1 ? 1 : 2);\n"  # line 4
+               "    }\n"
+               "    for (int i = 0; i < b; i++) {\n"          # line 6
+               "        p[i] = 0;\n    }\n"
+               "    while (1) {\n        break;\n    }\n"     # line 9
+               "    return 0;\n}\n")
+        self.assertIn("    if (1) {\n", self.apply(src, 3, "cond -> 1"))
+        self.assertIn("    if (0) {\n", self.apply(src, 3, "cond -> 0"))
+        self.assertIn("if (1 && (p != 0 || b > 2))", self.apply(src, 3, "operand -> 1", 9))
+        self.assertIn("if (a < b && (0 || b > 2))", self.apply(src, 3, "operand -> 0", 19))
+        self.assertIn("if (a < b && (p != 0 || 1))", self.apply(src, 3, "operand -> 1", 29))
+        self.assertIn("return 1 ? b : (a + b > 1 ? 1 : 2);", self.apply(src, 4, "cond -> 1", 16))
+        self.assertIn("return a ? b : (0 ? 1 : 2);", self.apply(src, 4, "cond -> 0", 25))
+        self.assertIn("for (int i = 0; 0; i++)", self.apply(src, 6, "cond -> 0"))
+        # while (1) is true already: only made false
+        self.assertIn("while (0)", self.apply(src, 9, "cond -> 0"))
+        self.assertNotIn("cond -> 1", [m.desc for m in mutants_of(src) if m.line == 9])
+
+    def test_a_digit_changed_or_dropped(self):
+        src = "unsigned f(unsigned x)\n{\n    return (x & 0x7FFu) + 1000u + 3;\n}\n"
+        descs = [m.desc for m in mutants_of(src) if m.line == 3]
+        for d in ("0x7FFu -> 0x0FFu", "0x7FFu -> 0x70Fu", "0x7FFu -> 0x7F0u", "0x7FFu -> 0x7Fu",
+                  "0x7FFu -> 0x800u", "1000u -> 100u", "1000u -> 1001u", "1000u -> 1100u",
+                  "3 -> 0", "3 -> 4", "3 -> 2"):
+            self.assertIn(d, descs)
+        # no value twice, no decimal made octal (0000u, 000u)
+        self.assertEqual(len([d for d in descs if d.startswith("1000u")]),
+                         len({d for d in descs if d.startswith("1000u")}))
+        self.assertFalse([d for d in descs if d.startswith("1000u -> 0") and d != "1000u -> 0u"], descs)
+
+    def test_array_index(self):
+        src = ("int f(const int *a, int i)\n{\n    uint8_t buf[8];\n    int m[2][3];\n"
+               "    return a[i] + a[0] + (int)buf[i + 1] + m[1][i];\n}\n")
+        out = self.apply(src, 5, "[i] -> [0]", 13)
+        self.assertIn("return a[0] + a[0]", out)
+        self.assertIn("return a[(i) + 1] + a[0]", self.apply(src, 5, "[i] -> [+1]", 13))
+        self.assertIn("a[(0) + 1] + (int)", self.apply(src, 5, "[0] -> [+1]"))
+        self.assertIn("(int)buf[0] + m", self.apply(src, 5, "[i + 1] -> [0]"))
+        self.assertIn("m[1][0]", self.apply(src, 5, "[i] -> [0]", 48))
+        # declared sizes are not indices
+        self.assertNotIn(3, {m.line for m in mutants_of(src) if m.kind == "index"})
+        self.assertNotIn(4, {m.line for m in mutants_of(src) if m.kind == "index"})
 
     def test_statements(self):
         self.assertIn("return -> (removed)", self.by_line[13])
@@ -141,6 +198,45 @@ class Mutants(unittest.TestCase):
             with open(os.path.join(ROOT, f)) as fh:
                 ms = mutants_of(fh.read())
             self.assertEqual(len({m.id for m in ms}), len(ms), f)
+
+
+class UniversalMutator(unittest.TestCase):
+    """universalmutator's mutant files made into this tool's mutants: a
+    stand-in for its command writes them as it does (<name>.mutant.N.c in
+    --mutantDir); the real one runs in `tools/mutate --generator
+    universalmutator`."""
+
+    SRC = "int f(int a)\n{\n    /* a < 1 */\n    if (a < 1) {\n        return 0;\n    }\n    return a;\n}\n"
+
+    def mutants(self, texts):
+        with tempfile.TemporaryDirectory() as d:
+            fake = os.path.join(d, "fake-mutate")
+            with open(fake, "w") as fh:
+                fh.write("#!%s\nimport sys, os\nd = sys.argv[sys.argv.index('--mutantDir') + 1]\n"
+                         "for n, t in enumerate(%r):\n"
+                         "    open(os.path.join(d, 'x.mutant.%%d.c' %% n), 'w').write(t)\n"
+                         % (sys.executable, texts))
+            os.chmod(fake, 0o755)
+            return mutate.um_mutants("src/x.c", self.SRC, fake, d)
+
+    def test_changed_inserted_and_removed_lines(self):
+        texts = [self.SRC.replace("if (a < 1)", "if (a > 1)"),
+                 self.SRC.replace("        return 0;\n", "        return 0;\n        break;\n"),
+                 self.SRC.replace("    return a;\n", ""),
+                 self.SRC,                                          # unchanged: no mutant
+                 self.SRC.replace("if (a < 1)", "if (a > 1)")]      # the same again: one mutant
+        ms = self.mutants(texts)
+        self.assertEqual([(m.line, m.kind) for m in ms],
+                         [(4, "universalmutator"), (5, "universalmutator"), (7, "universalmutator")])
+        for m, t in zip(ms, texts):
+            self.assertEqual(self.SRC[:m.start] + m.repl + self.SRC[m.end:], t)
+        self.assertTrue(ms[0].id.startswith("f@") and "#um:" in ms[0].id, ms[0].id)
+        # ids as stable as ours: the same change of the same line after an unrelated edit
+        moved = self.SRC.replace("{\n", "{\n    g();\n", 1)
+        self.SRC, old = moved, self.SRC
+        again = self.mutants([moved.replace("if (a < 1)", "if (a > 1)")])
+        self.SRC = old
+        self.assertEqual(again[0].id, ms[0].id)
 
 
 class Merge(unittest.TestCase):
@@ -206,9 +302,34 @@ class Arguments(unittest.TestCase):
     def test_gate(self):
         self.assertEqual(mutate.parse_gate("src=95, od = 95 ,boards/common/=90%,all=0"),
                          [("src", 95.0), ("od", 95.0), ("boards/common", 90.0), ("all", 0.0)])
-        for bad in ("src", "src=abc", "src=95,", "nosuchdir=90", "ALL=90", "od=101", "od=95=3"):
+        for bad in ("src", "src=abc", "src=95,", "nosuchdir=90", "ALL=90", "od=101", "od=95=3",
+                    "src=95,od=90,src/=80"):
             with self.assertRaises(SystemExit, msg=bad):
                 mutate.parse_gate(bad)
+
+    def test_every_usage_error_exits_2_with_its_message(self):
+        # the exit status does not depend on which check refuses (argparse's
+        # own, or the tool's); 1 is left to a failed gate
+        with tempfile.TemporaryDirectory() as d:
+            ids = os.path.join(d, "ids.txt")
+            with open(ids, "w") as fh:
+                fh.write("src/sync.c nosuch@0#0:a:b\n")
+            cases = [(["--gate", "src=95,src=90"], "src given twice"),
+                     (["--gate", "nosuch=9"], "want DIR=PCT"),
+                     (["--jobs", "0"], "--jobs wants 1 or more"),
+                     (["--sample", "0"], "--sample wants 1 or more"),
+                     (["--files", "nosuch.c"], "no file of"),
+                     (["--json", os.path.join(d, "no", "x.json")], "cannot write in"),
+                     (["--files", "src/sync.c", "--ids", ids, "--list"], "no mutant"),
+                     (["--merge", os.path.join(d, "none.json")], "--merge"),
+                     (["--generator", "nosuch"], "invalid choice"),
+                     (["--nosuchoption"], "unrecognized arguments")]
+            for argv, msg in cases:
+                r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "mutate")] + argv,
+                                   stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                   env=dict(os.environ, MUTATE_DIR=d))
+                self.assertEqual(r.returncode, 2, (argv, r.stdout))
+                self.assertIn(msg, r.stdout, argv)
 
     def test_ids(self):
         ms = mutants_of(SRC)
