@@ -626,6 +626,18 @@ static void test_tpdo_sync_and_bad_mapping(void)
     h_rx(d, 0x081, "");
     f = h_next(d);
     CHECK(f != NULL && f->id == 0x190);
+    /* All 11 bits of it: a SYNC on 1A1h, not on its low byte's A1h. */
+    SDO(d, "23 05 10 00 A1 01 00 00", "60 05 10 00 00 00 00 00");
+    h_drain(d);
+    h_rx(d, 0x0A1, "");
+    h_rx(d, 0x0A1, "");
+    EXPECT_NONE(d);
+    h_rx(d, 0x1A1, "");
+    h_rx(d, 0x1A1, "");
+    f = h_next(d);
+    CHECK(f != NULL && f->id == 0x190);
+    SDO(d, "23 05 10 00 81 00 00 00", "60 05 10 00 00 00 00 00");
+    h_drain(d);
     /* Never a restricted CAN-ID (CiA 301 7.3.5): this node's SDO, NMT. */
     SDO(d, "23 05 10 00 10 06 00 00", "80 05 10 00 30 00 09 06");
     SDO(d, "23 05 10 00 00 00 00 00", "80 05 10 00 30 00 09 06");
