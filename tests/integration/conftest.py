@@ -8,7 +8,10 @@ import pathlib
 import queue
 import signal
 import subprocess
+import sys
+import threading
 import time
+import traceback
 
 import can
 import canopen
@@ -36,6 +39,154 @@ def pytest_addoption(parser):
     group.addoption("--shard", default="1/1", metavar="K/N",
                     help="run the K-th of N shares of the products (ctest runs the "
                          "shares of a board in parallel)")
+
+
+# ---- Bounds ----------------------------------------------------------------
+# Every test ends within its bound (seconds): a test still running then (a
+# frame that never comes, an emulator the machine stopped, a read without a
+# timeout) fails with the stack of every thread, its teardown ends what it
+# started, and the tests after it are not run: ctest's output then says
+# what stopped and where, long before ctest's own TIMEOUT would kill the
+# shard without a word. CO_TEST_TIMEOUT replaces the default for a run; a
+# test that needs longer says so with @pytest.mark.bound(SECONDS). The
+# longest test here takes about a minute on a loaded machine.
+TEST_BOUND_S = 180.0
+# After the bound, setup and teardown have this long to finish; a test that
+# has not ended by then (its main thread stuck where no signal reaches it)
+# gets every thread's stack written out, its processes killed and pytest
+# ended at once (exit status 3).
+TEARDOWN_GRACE_S = 60.0
+# At the session's end the threads a test left running (not daemons, so the
+# interpreter would wait for them without end) get this long to end.
+THREAD_GRACE_S = 10.0
+WATCHDOG = "test-bound-watchdog"  # the last resort's thread
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "bound(seconds): this test's bound instead of the "
+                                       "default TEST_BOUND_S (conftest.py)")
+
+
+def bound_of(item):
+    """The seconds item may run: its bound marker, else CO_TEST_TIMEOUT, else TEST_BOUND_S."""
+    mark = item.get_closest_marker("bound")
+    if mark is not None:
+        return float(mark.args[0])
+    text = os.environ.get("CO_TEST_TIMEOUT", "")
+    if not text:
+        return TEST_BOUND_S
+    try:
+        bound = float(text)
+    except ValueError:
+        bound = 0.0
+    if not 0 < bound < 86400:
+        pytest.exit(f"CO_TEST_TIMEOUT={text!r}: not a number of seconds (0 to 86400)",
+                    returncode=4)
+    return bound
+
+
+def thread_stacks():
+    """Where every thread of this process is, innermost call last: pytest's
+    and pluggy's frames and the bound's own left out."""
+    frames = sys._current_frames()
+    parts = []
+    for t in threading.enumerate():
+        frame = frames.get(t.ident)
+        if frame is None or t.name == WATCHDOG:
+            continue
+        stack = [f for f in traceback.extract_stack(frame)
+                 if not any(k in f.filename for k in ("/_pytest/", "/pluggy/"))
+                 and f.name not in ("expired", "thread_stacks", "last_resort", "pytest_unconfigure")]
+        kind = " (daemon)" if t.daemon else ""
+        parts.append(f"--- thread {t.name}{kind}:\n" + "".join(traceback.format_list(stack)))
+    return "\n".join(parts)
+
+
+def out_of_capture(config, text):
+    """Write text on the real standard error, past pytest's capture."""
+    capman = config.pluginmanager.getplugin("capturemanager")
+    if capman is not None:
+        capman.suspend_global_capture(in_=True)
+    sys.stderr.write(text)
+    sys.stderr.flush()
+
+
+def kill_children():
+    """SIGKILL to every child of this process, to the whole group of one
+    that leads its own (tools/emu and its QEMU)."""
+    me = os.getpid()
+    for stat in pathlib.Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):
+            continue  # ended meanwhile
+        pid, ppid, pgid = int(stat.parent.name), int(fields[1]), int(fields[2])
+        if ppid != me:
+            continue
+        try:
+            if pgid == pid:
+                os.killpg(pid, signal.SIGKILL)
+            else:
+                os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    bound = bound_of(item)
+
+    def expired(signum, frame):
+        hit.append(True)
+        item.session.shouldstop = (f"{item.nodeid} ran into its bound of {bound:g} s: "
+                                   "the tests after it were not run")
+        pytest.fail(f"{item.nodeid}: still running after its bound of {bound:g} s "
+                    "(see conftest.TEST_BOUND_S); where each thread waited:\n"
+                    + thread_stacks())
+
+    def last_resort():
+        out_of_capture(item.config,
+                       f"\n{item.nodeid}: not ended {TEARDOWN_GRACE_S:g} s after its bound of "
+                       f"{bound:g} s; where each thread waits:\n{thread_stacks()}\n"
+                       "its processes killed, pytest ends here (exit status 3)\n")
+        kill_children()
+        sys.stdout.flush()
+        os._exit(3)
+
+    hit = []
+    old = signal.signal(signal.SIGALRM, expired)
+    signal.setitimer(signal.ITIMER_REAL, bound)
+    watchdog = threading.Timer(bound + TEARDOWN_GRACE_S, last_resort)
+    watchdog.name = WATCHDOG
+    watchdog.daemon = True
+    watchdog.start()
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+        watchdog.cancel()
+        if hit:
+            kill_children()  # what its teardown left: the session stops here
+
+
+def pytest_unconfigure(config):
+    """A thread that is no daemon and still runs keeps the interpreter from
+    exiting, after pytest has said everything, and without a word: named
+    and ended here instead."""
+    left = [t for t in threading.enumerate()
+            if t is not threading.main_thread() and not t.daemon and t.is_alive()]
+    for t in left:
+        t.join(THREAD_GRACE_S)
+    left = [t for t in left if t.is_alive()]
+    if left:
+        out_of_capture(config, f"\npytest: {len(left)} thread(s) a test started still run "
+                               f"{THREAD_GRACE_S:g} s after the last test ("
+                               + ", ".join(t.name for t in left) + "); where each waits:\n"
+                               + thread_stacks() + "\nexit status 3\n")
+        kill_children()
+        sys.stdout.flush()
+        os._exit(3)
 
 
 def pytest_sessionstart(session):
@@ -143,7 +294,14 @@ class Sensor:
         if self.proc.poll() is None:
             self.proc.send_signal(sig)
         try:
-            rc = self.proc.wait(timeout=5)
+            try:
+                rc = self.proc.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                # Killed, so that reading its stderr below cannot wait for it.
+                self.proc.kill()
+                self.proc.wait(timeout=5)
+                pytest.fail(f"{self.product}: canopen-sensor did not end within 5 s of "
+                            f"signal {sig}: killed")
         finally:
             if self.proc.stdin:
                 self.proc.stdin.close()
@@ -206,7 +364,7 @@ def eds_od(product, tmp_path, node_id):
     """The master's dictionary: the product's EDS, as canopen-sensor prints it."""
     path = tmp_path / f"{product}.eds"
     path.write_text(subprocess.run([BINARY, "--product", product, "--eds"], check=True,
-                                   capture_output=True, text=True).stdout)
+                                   capture_output=True, text=True, timeout=30).stdout)
     return canopen.import_od(str(path), node_id)
 
 

@@ -291,8 +291,12 @@ class EmuTarget(Target):
                 rc = self.proc.wait(timeout=10)
             except subprocess.TimeoutExpired:
                 os.killpg(self.proc.pid, signal.SIGKILL)
-                rc = self.proc.wait()
                 self.logf.write(f"--- did not end in 10 s after signal {sig}: killed\n")
+                try:
+                    rc = self.proc.wait(timeout=10)
+                except subprocess.TimeoutExpired:
+                    raise TargetError(f"{self.name}: tools/emu ({self.product}) did not end "
+                                      "within 10 s of SIGKILL") from None
             self.proc = None
             self.logf.close()
         return rc
@@ -491,7 +495,7 @@ def make_target(name, product, tmp_path):
 def list_products():
     """Every product ID canopen-sensor knows (the linux build)."""
     out = subprocess.run([BINARY, "--list-products"], check=True, capture_output=True,
-                         text=True).stdout
+                         text=True, timeout=30).stdout
     return [line.split()[0] for line in out.splitlines() if line.strip()]
 
 
@@ -659,7 +663,10 @@ class Master:
             time.sleep(delay)
         self.target.kill()
         sent = []
-        while (m := bus.recv(0.05)) is not None:
+        # Until 50 ms of silence; a bus that never falls silent (another
+        # node's frames) ends it after a second.
+        end = time.monotonic() + 1.0
+        while time.monotonic() < end and (m := bus.recv(0.05)) is not None:
             sent.append(m)
         self._let_go()
         return sent
