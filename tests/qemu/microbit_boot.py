@@ -18,7 +18,9 @@ every product on every emulated board are the integration tests'.
 
 Usage: microbit_boot.py QEMU IMAGE.elf   (exit status 0: passed)
 """
+import os
 import re
+import select
 import socket
 import subprocess
 import sys
@@ -45,7 +47,7 @@ class Image:
             stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         try:
             # qemu names the port it chose, and waits for the connection.
-            line = self.proc.stderr.readline().decode(errors="replace")
+            line = self.first_line()
             m = re.search(r"waiting for connection on: disconnected:tcp:127\.0\.0\.1:(\d+)", line)
             if not m:
                 raise Failed(f"qemu did not open its serial port: {line.strip()!r}")
@@ -55,6 +57,21 @@ class Image:
             self.proc.wait()
             raise
         self.buf = b""
+
+    def first_line(self):
+        """qemu's first line on its stderr; Failed when none comes within
+        TIMEOUT (a qemu that hangs before it listens)."""
+        deadline = time.monotonic() + TIMEOUT
+        got = b""
+        while b"\n" not in got:
+            left = deadline - time.monotonic()
+            if left <= 0 or not select.select([self.proc.stderr], [], [], left)[0]:
+                raise Failed(f"qemu named no serial port within {TIMEOUT} s; it wrote {got!r}")
+            chunk = os.read(self.proc.stderr.fileno(), 256)
+            if not chunk:
+                break  # ended: its words are the message
+            got += chunk
+        return got.decode(errors="replace")
 
     def line(self, deadline):
         """The next line from the image (without its CR), None at the deadline."""
@@ -78,7 +95,8 @@ class Image:
         deadline = time.monotonic() + TIMEOUT
         seen = []
         while True:
-            text = self.line(deadline)
+            # The deadline holds while other lines keep coming (heartbeats).
+            text = self.line(deadline) if time.monotonic() < deadline else None
             if text is None:
                 raise Failed(f"no {what} within {TIMEOUT} s; lines seen: {seen[-10:]}")
             m = re.fullmatch(pattern, text)
@@ -97,7 +115,12 @@ class Image:
         self.sock.close()
         if self.proc.poll() is None:
             self.proc.terminate()
-        self.proc.wait(timeout=TIMEOUT)
+        try:
+            self.proc.wait(timeout=TIMEOUT)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait(timeout=TIMEOUT)
+            raise Failed(f"qemu did not end within {TIMEOUT} s of SIGTERM: killed") from None
 
 
 def sdo(node, cmd, index, sub, data=b"\0\0\0\0"):
@@ -152,7 +175,10 @@ def run(qemu, elf, tmp):
         # file name quoted: the monitor reads "8192 /tmp/..." as a division.
         img.monitor(f'memsave {EEPROM_ADDR:#x} {EEPROM_SIZE} "{saved}"')
         img.monitor("quit")
-        img.proc.wait(timeout=TIMEOUT)
+        try:
+            img.proc.wait(timeout=TIMEOUT)
+        except subprocess.TimeoutExpired:
+            raise Failed(f"qemu did not quit within {TIMEOUT} s of the monitor's quit") from None
     finally:
         img.stop()
     flash = saved.read_bytes()
