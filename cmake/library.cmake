@@ -53,6 +53,7 @@ if(CMAKE_CROSSCOMPILING)
   list(APPEND co_lib_flags -ffreestanding -fno-builtin)
 endif()
 set(co_lib_targets)
+set(co_debug_postfix d) # a Debug build's names: its libraries and its .pc file
 
 # A library of this tree: its output name libcanopen_<export>.a, its
 # exported name canopen::<export>.
@@ -62,7 +63,7 @@ function(co_library target export)
   # A Debug build's libraries are libcanopen_<export>d.a: Debug and
   # Release installs share a prefix.
   set_target_properties(${target} PROPERTIES OUTPUT_NAME canopen_${export} EXPORT_NAME ${export}
-    DEBUG_POSTFIX d)
+    DEBUG_POSTFIX ${co_debug_postfix})
   # In a parent project (add_subdirectory) a library is built when the
   # parent links it, not with the parent's "all".
   if(NOT CO_TOP_LEVEL)
@@ -131,6 +132,23 @@ if(NOT CMAKE_CROSSCOMPILING)
   target_include_directories(co_linux_port PUBLIC $<BUILD_INTERFACE:${co_linux}>
     $<INSTALL_INTERFACE:${CO_INSTALL_INCLUDEDIR}/linux>)
   target_link_libraries(co_linux_port PUBLIC co_stack)
+  # The stack calls back into the port (co_port.h), and a consumer's link
+  # line has the port's archive before the stack's: one that calls no lp_*
+  # function itself left can_port.o unread when the archive came by, and
+  # co_port_* undefined after the stack. Marked undefined from the start
+  # (each function co_port.h declares), they are taken from this archive
+  # whatever the order.
+  file(STRINGS ${PROJECT_SOURCE_DIR}/include/co_port.h co_port_decls
+    REGEX "^[a-z].*[ *]co_port_[a-z0-9_]+\\(")
+  set(co_port_undefined)
+  foreach(decl ${co_port_decls})
+    string(REGEX MATCH "co_port_[a-z0-9_]+" fn "${decl}")
+    list(APPEND co_port_undefined "LINKER:--undefined=${fn}")
+  endforeach()
+  if(NOT co_port_undefined)
+    message(FATAL_ERROR "include/co_port.h: no co_port_* function found for canopen::linux_port")
+  endif()
+  target_link_options(co_linux_port INTERFACE ${co_port_undefined})
   set(co_linux_headers ${co_linux}/can_port.h ${co_linux}/nvm_file.h ${co_linux}/log.h)
 else()
   # ---- the board of the toolchain file (cross) ---------------------------
@@ -239,17 +257,21 @@ install(FILES ${PROJECT_BINARY_DIR}/${CO_PKG}Config.cmake
   ${PROJECT_BINARY_DIR}/${CO_PKG}ConfigVersionBasic.cmake DESTINATION ${CO_INSTALL_CMAKEDIR})
 
 # pkg-config: the stack (canopen::stack) and what a product is
-# (canopen::product), with the definitions they were built with.
+# (canopen::product), with the definitions they were built with, and the
+# libraries by their names in this configuration: a Debug build's are
+# libcanopen_<name>d.a (DEBUG_POSTFIX), and its .pc file is
+# canopen_sensorsd.pc, so that a Debug and a Release install in one prefix
+# each keep theirs (the Release one is canopen_sensors.pc).
 file(WRITE ${PROJECT_BINARY_DIR}/${CO_PKG}.pc.in [=[
 prefix=${pcfiledir}/@co_pc_up@
 includedir=${prefix}/@CMAKE_INSTALL_INCLUDEDIR@/canopen
 libdir=${prefix}/@CMAKE_INSTALL_LIBDIR@
 
-Name: canopen_sensors
+Name: canopen_sensors$<$<CONFIG:Debug>: (Debug)>
 Description: Portable CANopen slave stack (C11, no heap): the stack and product.h
 Version: @PROJECT_VERSION@
 Cflags: -I${includedir}@co_pc_cflags@
-Libs: -L${libdir} -lcanopen_product -lcanopen_stack
+Libs: -L${libdir} -l$<TARGET_FILE_BASE_NAME:co_product> -l$<TARGET_FILE_BASE_NAME:co_stack>
 ]=])
 # Relocatable (the prefix from the .pc file's place) unless the library
 # directory was given as an absolute path.
@@ -258,5 +280,8 @@ if(IS_ABSOLUTE "${CMAKE_INSTALL_LIBDIR}")
     "CMAKE_INSTALL_PREFIX (the package and its .pc file find their files from their place)")
 endif()
 file(RELATIVE_PATH co_pc_up /root/${CMAKE_INSTALL_LIBDIR}/pkgconfig /root)
-configure_file(${PROJECT_BINARY_DIR}/${CO_PKG}.pc.in ${PROJECT_BINARY_DIR}/${CO_PKG}.pc @ONLY)
-install(FILES ${PROJECT_BINARY_DIR}/${CO_PKG}.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+configure_file(${PROJECT_BINARY_DIR}/${CO_PKG}.pc.in ${PROJECT_BINARY_DIR}/${CO_PKG}.pc.gen @ONLY)
+# One file per configuration (a multi-config generator has several).
+set(co_pc_file "${PROJECT_BINARY_DIR}/pkgconfig-$<CONFIG>/${CO_PKG}$<$<CONFIG:Debug>:${co_debug_postfix}>.pc")
+file(GENERATE OUTPUT ${co_pc_file} INPUT ${PROJECT_BINARY_DIR}/${CO_PKG}.pc.gen)
+install(FILES ${co_pc_file} DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)

@@ -3,8 +3,11 @@
 # library (docs/library.md), in a temporary directory each time.
 #   find_package_host  build and install this tree (host), then build
 #                      examples/my-sensor against the prefix and run it
-#                      (--help; a missing interface is a clear error), and
-#                      compile a program with pkg-config's flags
+#                      (--help; a missing interface is a clear error),
+#                      compile a program with pkg-config's flags, link one
+#                      on the registry and the Linux port that calls no
+#                      lp_* function, and add a Debug install to the
+#                      prefix: its own .pc file, the first one kept
 #   find_package_m0    the same for the Cortex-M0 (cmake/arm-none-eabi.cmake):
 #                      the stack and the Nucleo board installed, my-sensor's
 #                      .elf built with them, its size printed; a host
@@ -49,6 +52,49 @@ find_package_host)
   eval "cc -std=c11 -Wall -Wextra -Werror \"\$src/tests/package/tiny.c\" -o \"\$tmp/tiny\" $flags" ||
     fail "the pkg-config program does not build"
   "$tmp/tiny" || fail "the pkg-config program fails"
+  # A program on the registry and the Linux port, as docs/library.md
+  # links them, that calls no lp_* function: the port's archive comes
+  # before the stack's on its link line, and the stack calls the port.
+  mkdir -p "$tmp/rp"
+  cp "$src/tests/package/registry_port.c" "$tmp/rp/"
+  cat >"$tmp/rp/CMakeLists.txt" <<'EOT'
+cmake_minimum_required(VERSION 3.20)
+project(registry_port C)
+find_package(canopen_sensors 0.1 CONFIG REQUIRED)
+add_executable(registry_port registry_port.c)
+target_link_libraries(registry_port PRIVATE canopen::registry canopen::linux_port)
+EOT
+  cfg -S "$tmp/rp" -B "$tmp/rp/b" -DCMAKE_PREFIX_PATH="$tmp/an install"
+  bld "$tmp/rp/b"
+  "$tmp/rp/b/registry_port" | grep -q '^jd2xxx: node-ID 0x' || fail "the registry and port program fails"
+  # A Debug install into the same prefix: its libraries are
+  # libcanopen_<name>d.a, and its .pc file, canopen_sensorsd.pc, names
+  # them; the first install's canopen_sensors.pc stays and still links.
+  pc="$tmp/an install/lib/pkgconfig"
+  before=$(cat "$pc/canopen_sensors.pc")
+  case $flags in
+  *-lcanopen_product\ *-lcanopen_stack*) ;;
+  *) fail "canopen_sensors.pc: not the libraries of its build: $flags" ;;
+  esac
+  cfg -S "$src" -B "$tmp/bd" -DCMAKE_BUILD_TYPE=Debug -DCO_BUILD_PROGRAM=OFF -DCO_BUILD_TESTS=OFF \
+    -DCMAKE_INSTALL_PREFIX="$tmp/an install"
+  bld "$tmp/bd"
+  inst "$tmp/bd"
+  [ "$(cat "$pc/canopen_sensors.pc")" = "$before" ] || fail "the Debug install replaced canopen_sensors.pc"
+  dflags=$(PKG_CONFIG_PATH="$pc" pkg-config --cflags --libs canopen_sensorsd) ||
+    fail "pkg-config canopen_sensorsd (the Debug install's) failed"
+  echo "pkg-config --cflags --libs canopen_sensorsd: $dflags"
+  case $dflags in
+  *-lcanopen_productd\ *-lcanopen_stackd*) ;;
+  *) fail "canopen_sensorsd.pc: not the Debug libraries: $dflags" ;;
+  esac
+  eval "cc -std=c11 -Wall -Wextra -Werror \"\$src/tests/package/tiny.c\" -o \"\$tmp/tiny-d\" $dflags" ||
+    fail "the pkg-config program does not build with canopen_sensorsd"
+  "$tmp/tiny-d" || fail "the pkg-config program fails with canopen_sensorsd"
+  rm "$tmp/tiny"
+  eval "cc -std=c11 -Wall -Wextra -Werror \"\$src/tests/package/tiny.c\" -o \"\$tmp/tiny\" $flags" ||
+    fail "the pkg-config program no longer builds after the Debug install"
+  "$tmp/tiny" || fail "the pkg-config program fails after the Debug install"
   ;;
 find_package_m0)
   need arm-none-eabi-gcc arm-none-eabi-size
