@@ -341,9 +341,26 @@ static int wait_events(loop_t *l, struct epoll_event *evs, int max, uint32_t wai
     return epoll_wait(l->ep, evs, max, (int)((wait_us + 999u) / 1000u));
 }
 
+/* A pass that took `took` us: the longest is kept, and one longer than
+ * LOOP_LONG_PASS_US and than any logged before is logged (a few lines a
+ * run at most: each one beats the last). */
+static void pass_done(loop_t *l, uint32_t took)
+{
+    if (took > l->pass_max_us) {
+        l->pass_max_us = took;
+    }
+    if (took > LOOP_LONG_PASS_US && took > l->pass_logged_us) {
+        l->pass_logged_us = took;
+        lp_log("loop: a pass took %lu.%03lu ms (the longest so far)", (unsigned long)took / 1000u,
+               (unsigned long)took % 1000u);
+    }
+}
+
 int loop_run(loop_t *l)
 {
     app_t *a = l->app;
+    uint32_t busy_from = loop_now_us(); /* the pass's start: the last wait's end */
+    int rc = 0;
     while (!a->quit) {
         uint32_t t = loop_now_us();
         if (!co_time_before(t, l->next_sample)) {
@@ -371,16 +388,22 @@ int loop_run(loop_t *l)
         /* The inputs' sample may wait for a pass that runs anyway (see
          * SAMPLE_SLACK_US); the rest is served on the grid. */
         uint32_t sample_wait = co_time_until(t, l->next_sample) + SAMPLE_SLACK_US;
+        pass_done(l, loop_now_us() - busy_from);
         int n = wait_events(l, evs, (int)(APP_MAX_NODES + 8u),
                             co_min_u32(coalesce(t, wait), sample_wait));
         if (n < 0 && errno != EINTR) {
             lp_log("error: epoll_wait: %s", strerror(errno));
-            return 1;
+            rc = 1;
+            break;
         }
         t = loop_now_us();
+        busy_from = t;
         for (int k = 0; k < n; k++) {
             handle_event(l, evs[k].data.u32, t);
         }
     }
-    return 0;
+    pass_done(l, loop_now_us() - busy_from);
+    lp_log("loop: the longest pass took %lu.%03lu ms", (unsigned long)l->pass_max_us / 1000u,
+           (unsigned long)l->pass_max_us % 1000u);
+    return rc;
 }

@@ -23,6 +23,10 @@
 /* Timers are served on a grid of this many microseconds of the clock. */
 #define LOOP_GRID_US 250u
 
+/* A pass of the loop longer than this is logged (loop_run): a fifth of
+ * the shortest heartbeat or event-timer period the products are run at. */
+#define LOOP_LONG_PASS_US 2000u
+
 typedef struct loop {
     app_t *app;
     ctl_t ctl;                 /* --control (ctl.fd -1: none) */
@@ -38,6 +42,8 @@ typedef struct loop {
     unsigned long out_dropped; /* answers to get that standard output could not take */
     uint32_t next_sample;      /* when the products sample their inputs next */
     bool no_pwait2;            /* the kernel has no epoll_pwait2: epoll_wait */
+    uint32_t pass_max_us;      /* the longest pass of the loop's own work */
+    uint32_t pass_logged_us;   /* the longest one the log has named so far */
 } loop_t;
 
 /* The stop signals (SIGINT, SIGTERM, SIGHUP), for main() to block first. */
@@ -57,7 +63,12 @@ int loop_open(loop_t *l, app_t *a, const char *control, bool quit_on_eof, char *
 void loop_start(loop_t *l, uint32_t t);
 
 /* Run until app->quit (a command, the end of input, a signal). Returns 0,
- * or 1 when epoll fails. */
+ * or 1 when epoll fails. A pass is the loop's own work between two waits
+ * for events, by its clock (loop_now_us): every timer waits as long as
+ * it takes. A pass longer than LOOP_LONG_PASS_US and longer than any the
+ * log has named is logged ("loop: a pass took ..."), and at the end the
+ * longest ("loop: the longest pass took ..."): how the tests judge that
+ * the program kept its timers (docs/testing.md, "Bounds and timing"). */
 int loop_run(loop_t *l);
 
 /* Close the control socket and the loop's descriptors. */

@@ -3,6 +3,7 @@ language with a node selector, one answer line per line, several clients,
 bad input answered with `error:` and disturbing nothing."""
 import contextlib
 import os
+import re
 import socket
 import subprocess
 import time
@@ -275,18 +276,18 @@ def test_lines_that_misled(sim, tmp_path):
 def test_replay_file_size_bounded(sim, tmp_path):
     """A replay file is read while every node waits: 10 MB of comments
     held every node 8.5 s. Beyond SIM_REPLAY_BYTES (256 KiB) it is refused
-    at once, saying why; one just within is read without a heartbeat
-    missing its period (node 0x22, the JD, at 50 ms)."""
+    at once, saying why; one just within is read in a pass of the loop
+    shorter than the JD's 50 ms heartbeat period by the program's own
+    clock (its log; about 2 ms on a PC, the rest is margin for a loaded
+    machine), and the heartbeat goes on meanwhile."""
     proc, client = sim
     c = client()
     huge = tmp_path / "huge.csv"
     with open(huge, "w") as f:
         f.write("t,x\n" + "#\n" * 5_000_000 + "0,1\n")
-    t0 = time.monotonic()
     assert c.ask(f"replay {huge}") == \
         f"error: replay {huge}: 10000008 bytes, more than the 262144 a replay file may have " \
         "(it is read while every node waits)"
-    assert time.monotonic() - t0 < 0.5
     big = tmp_path / "big.csv"  # 131068 comment lines: at the limit, in bytes
     big.write_text("t,x\n" + "#\n" * ((262144 - 8) // 2) + "0,2\n")
     assert big.stat().st_size == 262144
@@ -299,23 +300,29 @@ def test_replay_file_size_bounded(sim, tmp_path):
                       can_filters=[{"can_id": 0x5A2, "can_mask": 0x7FF}])
         sdo.send(can.Message(arbitration_id=0x622, is_extended_id=False,
                              data=bytes([0x2B, 0x17, 0x10, 0, 50, 0, 0, 0])))
-        assert sdo.recv(2).data[0] == 0x60
+        answer = sdo.recv(2)
+        assert answer is not None and answer.data[0] == 0x60, answer
         sdo.shutdown()
-        stamps = []
+        beats = 0
         end = time.monotonic() + 1.5
         sent = False
         while time.monotonic() < end:
-            m = bus.recv(0.2)
-            if m is not None:
-                stamps.append(m.timestamp)
+            beats += bus.recv(0.2) is not None
             if not sent and time.monotonic() > end - 1.0:
                 assert c.ask(f"0x22 replay {big}") == "ok"
                 sent = True
-        gaps = [b - a for a, b in zip(stamps, stamps[1:])]
-        assert len(gaps) > 20 and max(gaps) < 0.050 * 1.5, max(gaps)
+        # Loose: the wall-clock arrivals are the emulated kernel's as much
+        # as the program's (docs/testing.md, "Bounds and timing"); 30 due.
+        assert beats >= 22, f"{beats} heartbeats in 1.5 s at 50 ms"
     finally:
         bus.shutdown()
     assert c.ask("0x22 get").startswith("ok x=2.000")
+    proc.terminate()
+    assert proc.wait(timeout=5) == 0
+    log = (tmp_path / "log").read_text()
+    longest = re.search(r"loop: the longest pass took (\d+\.\d+) ms", log)
+    assert longest, log[-2000:]
+    assert float(longest[1]) < 50, log[-2000:]
 
 
 def test_socket_removed_at_stop_only_when_ours(tmp_path):
