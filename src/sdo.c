@@ -62,6 +62,15 @@ void sdo_mux(const co_sdo_t *sdo, uint8_t mux[4])
     mux[3] = sdo->e->sub;
 }
 
+void sdo_abort_stray(co_node_t *node, co_res_t r)
+{
+    uint8_t mux[4] = {0, 0, 0, 0};
+    if (node->sdo.state != SDO_IDLE) {
+        sdo_mux(&node->sdo, mux);
+    }
+    sdo_abort(node, mux, r);
+}
+
 void sdo_restart(co_sdo_t *sdo)
 {
     sdo->restart = true;
@@ -216,11 +225,17 @@ static bool upload_expedited(co_node_t *node, const uint8_t *d, const co_od_entr
     return true;
 }
 
-/* The optional protocols (segmented, block) where the product links them. */
-static void optional(co_node_t *node, const uint8_t *d, co_sdo_proto_fn proto)
+/* The optional protocols (segmented, block) where the product links them.
+ * A request none takes is aborted with its own multiplexer when it names
+ * an object (names: an initiate), else as a stray (sdo_abort_stray). */
+static void optional(co_node_t *node, const uint8_t *d, co_sdo_proto_fn proto, bool names)
 {
     if (proto == NULL || !proto(node, d)) {
-        sdo_abort(node, d, CO_E_CMD);
+        if (names) {
+            sdo_abort(node, d, CO_E_CMD);
+        } else {
+            sdo_abort_stray(node, CO_E_CMD);
+        }
     }
 }
 
@@ -260,27 +275,28 @@ CO_NOINLINE void co_sdo_receive(co_node_t *node, const co_frame_t *f)
         if ((d[0] & 0x02u) != 0u || seg == NULL) {
             download_initiate(node, d);
         } else {
-            optional(node, d, seg);
+            optional(node, d, seg, true);
         }
         break;
     case CCS_UPLOAD_INITIATE: {
         sdo->state = SDO_IDLE;
         const co_od_entry_t *e = sdo_find(node, d);
         if (e != NULL && !upload_expedited(node, d, e)) {
-            optional(node, d, seg);
+            optional(node, d, seg, true);
         }
         break;
     }
     case CCS_DOWNLOAD_SEGMENT:
     case CCS_UPLOAD_SEGMENT:
-        optional(node, d, seg);
+        optional(node, d, seg, false);
         break;
-    case CCS_BLOCK_DOWNLOAD:
-    case CCS_BLOCK_UPLOAD:
-        optional(node, d, co_cfg(node)->sdo_block);
+    case CCS_BLOCK_DOWNLOAD: /* its initiate has bit 0 clear */
+    case CCS_BLOCK_UPLOAD:   /* its initiate has bits 1..0 clear */
+        optional(node, d, co_cfg(node)->sdo_block,
+                 (d[0] & ((d[0] >> 5) == CCS_BLOCK_UPLOAD ? 3u : 1u)) == 0u);
         break;
     default:
-        sdo_abort(node, d, CO_E_CMD); /* reserved command specifier */
+        sdo_abort_stray(node, CO_E_CMD); /* reserved command specifier */
         break;
     }
 }

@@ -462,7 +462,7 @@ static void test_derived_rejections(void)
      * download is taken too (CiA 301, test_segmented_download); a segment
      * out of turn, upload segments and block transfer are unsupported
      * command specifiers, and change nothing. */
-    SDO(d, "00 02 00 00 00 00 00 00", "80 02 00 00 01 00 04 05"); /* a download segment */
+    SDO(d, "00 02 00 00 00 00 00 00", "80 00 00 00 01 00 04 05"); /* a download segment */
     SDO(d, "60 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05"); /* an upload segment */
     SDO(d, "C6 01 20 00 01 00 00 00", "80 01 20 00 01 00 04 05"); /* block download */
     SDO(d, "A4 08 10 00 7F 00 00 00", "80 08 10 00 01 00 04 05"); /* block upload */
@@ -607,16 +607,16 @@ static void test_segmented_download(void)
     /* A new initiate replaces an unfinished transfer without a word. */
     SDO(d, "21 17 10 00 02 00 00 00", "60 17 10 00 00 00 00 00");
     SDO(d, "2B 17 10 00 2C 01 00 00", "60 17 10 00 00 00 00 00");
-    SDO(d, "0B E8 03 00 00 00 00 00", "80 E8 03 00 01 00 04 05"); /* none in progress */
+    SDO(d, "0B E8 03 00 00 00 00 00", "80 00 00 00 01 00 04 05"); /* none in progress */
     CHECK_EQ(h_read(d, 0x1017, 0), 300);
     SDO(d, "21 17 10 00 02 00 00 00", "60 17 10 00 00 00 00 00");
-    SDO(d, "60 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05"); /* an upload segment */
-    SDO(d, "0B E8 03 00 00 00 00 00", "80 E8 03 00 01 00 04 05"); /* that ended it */
+    SDO(d, "60 00 00 00 00 00 00 00", "80 17 10 00 01 00 04 05"); /* an upload segment */
+    SDO(d, "0B E8 03 00 00 00 00 00", "80 00 00 00 01 00 04 05"); /* that ended it */
     /* The client's abort ends it silently. */
     SDO(d, "21 17 10 00 02 00 00 00", "60 17 10 00 00 00 00 00");
     h_rx(d, 0x67F, "80 17 10 00 00 00 04 05");
     EXPECT_NONE(d);
-    SDO(d, "0B E8 03 00 00 00 00 00", "80 E8 03 00 01 00 04 05");
+    SDO(d, "0B E8 03 00 00 00 00 00", "80 00 00 00 01 00 04 05");
     /* The SDO timeout (1 s) between segments, restarted by each one
      * (no heartbeat meanwhile: 1017h = 0). */
     SDO(d, "2B 17 10 00 00 00 00 00", "60 17 10 00 00 00 00 00");

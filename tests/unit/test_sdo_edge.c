@@ -130,7 +130,7 @@ static void test_segmented_download_refusals(void)
     CHECK_EQ(h_read(d, 0x2000, 0), 100);
     /* An upload segment while a download is in progress: wrong command. */
     SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00");
-    SDO(d, "60 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05");
+    SDO(d, "60 00 00 00 00 00 00 00", "80 00 20 00 01 00 04 05");
     /* and that ended the transfer: its segment is now out of turn too. (A
      * segment has no multiplexer: only the abort code is checked.) */
     h_drain(d);
@@ -143,10 +143,42 @@ static void test_segmented_download_refusals(void)
      * segment is then out of turn, and no timeout follows. */
     SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00");
     SDO(d, "40 00 10 00 00 00 00 00", "43 00 10 00 91 01 00 00");
-    SDO(d, "0B E8 03 00 00 00 00 00", "80 E8 03 00 01 00 04 05");
+    SDO(d, "0B E8 03 00 00 00 00 00", "80 00 00 00 01 00 04 05");
     h_advance(d, 2u * CO_SDO_TIMEOUT_US);
     EXPECT_NONE(d);
     CHECK_EQ(h_read(d, 0x2000, 0), 100);
+}
+
+/* A request that names no object (a segment or block sub-command outside
+ * its transfer, a reserved command specifier) is aborted with the
+ * multiplexer of the transfer it ends, or 0000h sub 00h with none (CiA
+ * 301): its bytes 1..3 are data, never echoed as an object. */
+static void test_stray_aborts_name_the_transfer(void)
+{
+    boot();
+    /* None in progress: 0000h sub 00h, whatever the bytes. */
+    SDO(d, "E0 11 22 33 44 55 66 77", "80 00 00 00 01 00 04 05"); /* reserved (7) */
+    SDO(d, "FF 11 22 33 44 55 66 77", "80 00 00 00 01 00 04 05");
+    SDO(d, "0B E8 03 00 00 00 00 00", "80 00 00 00 01 00 04 05"); /* download segment */
+    SDO(d, "70 11 22 33 00 00 00 00", "80 00 00 00 01 00 04 05"); /* upload segment */
+    SDO(d, "C1 11 22 33 00 00 00 00", "80 00 00 00 01 00 04 05"); /* block download end */
+    SDO(d, "A3 11 22 33 00 00 00 00", "80 00 00 00 01 00 04 05"); /* block upload start */
+    /* During a segmented download of 2000h: its multiplexer, and the
+     * transfer is over (its next segment is a stray itself). */
+    SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00");
+    SDO(d, "E0 11 22 33 44 55 66 77", "80 00 20 00 01 00 04 05");
+    SDO(d, "07 C8 00 00 00 00 00 00", "80 00 00 00 01 00 04 05");
+    SDO(d, "21 00 20 00 04 00 00 00", "60 00 20 00 00 00 00 00");
+    SDO(d, "C1 11 22 33 00 00 00 00", "80 00 20 00 01 00 04 05");
+    /* During a segmented upload of 1008h; during a block download of 2000h. */
+    SDO(d, "40 08 10 00 00 00 00 00", "41 08 10 00 46 00 00 00");
+    SDO(d, "01 11 22 33 00 00 00 00", "80 08 10 00 01 00 04 05");
+    SDO(d, "C6 00 20 00 04 00 00 00", "A4 00 20 00 0A 00 00 00");
+    SDO(d, "81 F4 01 00 00 00 00 00", "A2 01 0A 00 00 00 00 00");
+    SDO(d, "E0 11 22 33 00 00 00 00", "80 00 20 00 01 00 04 05");
+    CHECK_EQ(h_read(d, 0x2000, 0), 100);
+    /* An initiate names its object, refused or not. */
+    SDO(d, "C6 00 30 00 04 00 00 00", "80 00 30 00 00 00 02 06");
 }
 
 /* An object of exactly the transfer buffer's 64 bytes is taken, segmented
@@ -215,7 +247,7 @@ static void test_writable_string_refused(void)
     SDO(d, "07 C8 00 00 00 00 00 00", "20 00 00 00 00 00 00 00");
     h_advance(d, 2u * CO_SDO_TIMEOUT_US);
     EXPECT_NONE(d);
-    SDO(d, "17 C8 00 00 00 00 00 00", "80 C8 00 00 01 00 04 05");
+    SDO(d, "17 C8 00 00 00 00 00 00", "80 00 00 00 01 00 04 05");
     EXPECT_NONE(d);
     CHECK_EQ(h_read(d, 0x2000, 0), 200);
     /* Segmented upload the same way: each segment restarts the timeout,
@@ -421,8 +453,8 @@ static void test_block_upload_refusals(void)
     /* Block upload frames other than the initiate while none is in
      * progress: 05040001h. */
     SDO(d, "A3 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05");
-    SDO(d, "A1 00 10 00 04 00 00 00", "80 00 10 00 01 00 04 05");
-    SDO(d, "A2 00 10 00 04 00 00 00", "80 00 10 00 01 00 04 05");
+    SDO(d, "A1 00 10 00 04 00 00 00", "80 00 00 00 01 00 04 05");
+    SDO(d, "A2 00 10 00 04 00 00 00", "80 00 00 00 01 00 04 05");
     SDO(d, "A4 08 10 00 10 00 00 00", "80 08 10 00 05 00 04 05"); /* 70 bytes: no room */
     SDO(d, "A4 03 10 01 10 00 00 00", "80 03 10 01 24 00 00 08"); /* empty history */
     SDO(d, "A4 00 10 00 80 00 00 00", "80 00 10 00 02 00 04 05"); /* 128 segments */
@@ -747,6 +779,7 @@ static void test_answers_are_data_frames(void)
 int main(void)
 {
     RUN(test_segmented_download_refusals);
+    RUN(test_stray_aborts_name_the_transfer);
     RUN(test_writable_string_refused);
     RUN(test_buffer_sized_object);
     RUN(test_short_segmented_download_toggles);

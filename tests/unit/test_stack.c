@@ -193,8 +193,8 @@ static void test_sdo_expedited(void)
     SDO(d, "40 00 10 05 00 00 00 00", "80 00 10 05 11 00 09 06");
     SDO(d, "A0 00 10 00 00 00 00 00", "80 00 10 00 02 00 04 05"); /* block size 0 */
     SDO(d, "C0 00 10 00 00 00 00 00", "80 00 10 00 02 00 01 06"); /* block write to ro */
-    SDO(d, "C1 00 10 00 00 00 00 00", "80 00 10 00 01 00 04 05"); /* block end, none open */
-    SDO(d, "E0 00 10 00 00 00 00 00", "80 00 10 00 01 00 04 05");
+    SDO(d, "C1 00 10 00 00 00 00 00", "80 00 00 00 01 00 04 05"); /* block end, none open */
+    SDO(d, "E0 00 10 00 00 00 00 00", "80 00 00 00 01 00 04 05");
     SDO(d, "00 00 00 00 00 00 00 00", "80 00 00 00 01 00 04 05"); /* segment, none open */
     /* Not 8 bytes: ignored. A client abort: no answer. */
     h_drain(d);
