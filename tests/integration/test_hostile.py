@@ -135,11 +135,32 @@ class Proc:
         if self.p.poll() is None:
             self.p.send_signal(sig)
         try:
-            return self.p.wait(timeout=5)
+            try:
+                return self.p.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                # Killed, so that reading its stderr below cannot wait for it.
+                self.p.kill()
+                self.p.wait(timeout=5)
+                pytest.fail(f"canopen-sensor did not end within 5 s of signal {sig}: killed")
         finally:
             self.p.stdin.close()
             self.stderr = self.p.stderr.read().decode(errors="replace")
             self.p.stderr.close()
+
+
+def log_times(log, pattern):
+    """The times (milliseconds since the program's start, its own clock) of
+    the log's lines that match pattern."""
+    return [int(m[1]) * 1000 + int(m[2])
+            for m in re.finditer(r"^\[ *(\d+)\.(\d{3})\] " + pattern, log, re.M)]
+
+
+def longest_pass(log):
+    """The longest pass of the program's loop, in ms, as it logged it at its
+    end (docs/testing.md, "Bounds and timing")."""
+    m = re.search(r"loop: the longest pass took (\d+\.\d+) ms", log)
+    assert m, f"no longest pass in the log (stopped cleanly?):\n{log[-2000:]}"
+    return float(m[1])
 
 
 @pytest.fixture
@@ -259,8 +280,9 @@ def test_redundant_one_bus_down_leaves_the_other(tmp_path, procs):
     ip("set", "vcan1", "up")
     hb0 = [m.timestamp for m in frames(b0, 1.5 - (time.monotonic() - t0))
            if m.arbitration_id == 0x713]
-    gaps = [b - a for a, b in zip(hb0, hb0[1:])]
-    assert len(hb0) >= 25 and max(gaps) < 0.1, gaps
+    # Loose: 30 due; whether the program held node 0x13 is its own clock's
+    # longest pass, below.
+    assert len(hb0) >= 22, f"{len(hb0)} heartbeats of node 0x13 in 1.5 s at 50 ms"
     b1 = bus("vcan1", ids=[0x714])
     assert wait_for(b1, 0x714, 1) is not None
     b1.shutdown()
@@ -268,8 +290,10 @@ def test_redundant_one_bus_down_leaves_the_other(tmp_path, procs):
     assert p.p.poll() is None
     log = p.text()
     assert "node 1: vcan1 is down" in log and "node 1: vcan1 is up again" in log
+    assert not re.search(r"node 0: .*bus-off", log), log
     assert "node 0: vcan0" not in log
     assert p.stop() == 0
+    assert longest_pass(p.text()) < 50
 
 
 def test_start_on_a_down_interface(tmp_path, procs):
@@ -545,26 +569,34 @@ def test_jd_bus_off_sends_nothing_then_8140(tmp_path, procs):
     b.shutdown()
     b = bus()  # everything on the bus: only the node sends
     frames(b, 0.1)
-    t0 = time.time()
     assert p.control.ask("can bus-off 0.5") == "ok"
-    seen = frames(b, 0.8)
-    during = [m for m in seen if t0 + 0.05 < m.timestamp < t0 + 0.48]
-    assert during == [], during
+    # The answer comes after the bus-off: from here to the EMCY nothing.
+    # vcan's receive time stamps are the sender's send times.
+    t_ok = time.time()
+    seen = frames(b, 1.0)
     emcy = [m for m in seen if m.arbitration_id == 0x80 + node and m.data[0:2] == b"\x40\x81"]
     assert len(emcy) == 1, seen
-    assert t0 + 0.5 <= emcy[0].timestamp < t0 + 0.65
+    during = [m for m in seen if t_ok < m.timestamp < emcy[0].timestamp]
+    assert during == [], during
     hb = [m for m in seen if m.arbitration_id == 0x700 + node and m.timestamp > emcy[0].timestamp]
     assert len(hb) >= 5
-    # Without a hold the recovery alone: back within milliseconds.
-    t0 = time.time()
+    # Without a hold the recovery alone.
     assert p.control.ask("can bus-off") == "ok"
     m = wait_for(b, 0x80 + node, 1, lambda m: m.data[0:2] == b"\x40\x81")
-    assert m is not None and m.timestamp - t0 < 0.2
+    assert m is not None
     b.shutdown()
     assert p.stop() == 0
     log = p.text()
     assert "simulated CAN controller bus-off: bus unusable for 500 ms, then back after " \
            "128 x 11 bits (11.264 ms)" in log
+    # How long the bus was off, by the program's clock (its log, to the
+    # millisecond): the hold and 11.3 ms of recovery; what is beyond that
+    # is the scheduler's lateness in waking it, allowed up to 100 ms.
+    off = log_times(log, r"node 0: simulated CAN controller bus-off")
+    back = log_times(log, r"node 0: simulated CAN controller back from bus-off")
+    assert len(off) == 2 and len(back) == 2, log
+    assert 511 <= back[0] - off[0] < 611, log
+    assert 11 <= back[1] - off[1] < 111, log
     assert "red on" in log
 
 
@@ -637,6 +669,7 @@ def test_bus_flood(tmp_path, procs):
     backlog_drops = softnet_dropped() - drops0
     gaps = [b - a for a, b in zip(hb, hb[1:])]
     mean = (hb[-1] - hb[0]) / len(gaps)
+    median = sorted(gaps)[len(gaps) // 2]
     log = p.text()
     m = re.search(r"node 0: (\d+) frames received, (\d+) dropped by the kernel", log)
     assert m, log[-2000:]
@@ -645,11 +678,15 @@ def test_bus_flood(tmp_path, procs):
     print(f"flood: {sent} frames in 10 s ({sent / 10:.0f}/s, {full} ENOBUFS; {own} on its "
           f"SYNC COB-ID, the rest filtered by the kernel), sensor read "
           f"{received}, kernel dropped {dropped} (logged {logged}), backlog drops "
-          f"{backlog_drops}; heartbeat mean {mean * 1000:.2f} ms, longest gap "
-          f"{max(gaps) * 1000:.1f} ms over {len(gaps)} periods")
-    assert 0.099 <= mean <= 0.101, mean
-    assert max(gaps) <= 0.2, max(gaps)
+          f"{backlog_drops}; heartbeat mean {mean * 1000:.2f} ms, median "
+          f"{median * 1000:.2f} ms, longest gap {max(gaps) * 1000:.1f} ms over {len(gaps)} "
+          f"periods; the loop's longest pass {longest_pass(log):.1f} ms")
+    # The period by the median gap (one late beat moves the mean and the
+    # longest gap, not the median), and the count; whether the flood held
+    # the program is its own clock's longest pass: under half the period.
+    assert 0.099 <= median <= 0.101, median
     assert len(gaps) >= 100
+    assert longest_pass(log) < 50
     assert logged == dropped
     # Every flood frame the socket's filter passes (those on the SYNC
     # COB-ID) was read or counted as dropped (save those the kernel's input
