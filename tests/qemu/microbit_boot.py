@@ -8,7 +8,7 @@ TIMER0 as the clock and the sleep alarm, the NVMC flash EEPROM.
   2. an SDO upload of 0x1000 is answered;
   3. a simulated-input line is answered (an unknown input: "error: ...");
   4. a 50 ms heartbeat keeps its period in real time (the timer runs at
-     1 MHz: within 20 %, host load allowed for);
+     1 MHz: the median gap within 20 %, host load allowed for);
   5. "save" to 0x1010, the EEPROM pages copied out through the qemu monitor,
      a new qemu with that flash: the heartbeat time is still 50 ms.
 
@@ -161,12 +161,16 @@ def run(qemu, elf, tmp):
             text = img.line(end)
             if text == f"t{0x700 + node:03X}17F":
                 beats.append(time.monotonic())
+        # 60 due. The period is the median gap: a moment in which the host
+        # starves qemu delays one beat (the producer does not catch up),
+        # which moves the mean and the longest gap but not the median.
         if len(beats) < 20:
             raise Failed(f"{len(beats)} heartbeats in 3 s at 50 ms")
-        period = (beats[-1] - beats[0]) / (len(beats) - 1)
+        gaps = sorted(b - a for a, b in zip(beats, beats[1:]))
+        period = gaps[len(gaps) // 2]
         if not 0.040 <= period <= 0.060:
-            raise Failed(f"heartbeat period {period * 1000:.1f} ms, set 50 ms")
-        print(f"heartbeat: {len(beats)} in 3 s, period {period * 1000:.2f} ms")
+            raise Failed(f"heartbeat period {period * 1000:.1f} ms (median gap), set 50 ms")
+        print(f"heartbeat: {len(beats)} in 3 s, median gap {period * 1000:.2f} ms")
 
         img.send(sdo(node, 0x23, 0x1010, 1, b"save"))
         img.expect(sdo_reply(node, 0x60, 0x1010, 1), "answer to save")
