@@ -3,6 +3,8 @@
  */
 #include "control.h"
 
+#include "co_common.h"
+
 #include <arpa/inet.h>
 #include <errno.h>
 #include <netinet/in.h>
@@ -131,18 +133,48 @@ static bool reply(ctl_client_t *k, const char *text)
     return send(k->fd, out, len, MSG_NOSIGNAL | MSG_DONTWAIT) == (ssize_t)len;
 }
 
-int ctl_accept(ctl_t *c)
+static void drop(ctl_client_t *k)
+{
+    close(k->fd);
+    k->fd = -1;
+    k->lines = (cmd_lines_t){0};
+}
+
+/* Client k told why (if it can take the line at once) and closed. */
+static void close_silent(ctl_client_t *k, uint32_t now, const char *why)
+{
+    char text[96];
+    snprintf(text, sizeof(text), "error: silent for %lu s: closed%s",
+             (unsigned long)((now - k->last) / 1000000u), why);
+    (void)reply(k, text);
+    drop(k);
+}
+
+int ctl_accept(ctl_t *c, uint32_t now)
 {
     int fd = accept4(c->fd, NULL, NULL, SOCK_NONBLOCK | SOCK_CLOEXEC);
     if (fd < 0) {
         return -1;
     }
+    unsigned quiet = 0; /* the client silent longest */
     for (unsigned k = 0; k < CTL_CLIENTS; k++) {
         if (c->cl[k].fd < 0) {
-            memset(&c->cl[k], 0, sizeof(c->cl[k]));
-            c->cl[k].fd = fd;
-            return (int)k;
+            quiet = k;
+            break;
         }
+        if (now - c->cl[k].last > now - c->cl[quiet].last) {
+            quiet = k;
+        }
+    }
+    ctl_client_t *cl = &c->cl[quiet];
+    if (cl->fd >= 0 && now - cl->last >= CTL_EVICT_US) {
+        close_silent(cl, now, " (every slot taken: a new client has it)");
+    }
+    if (cl->fd < 0) {
+        memset(cl, 0, sizeof(*cl));
+        cl->fd = fd;
+        cl->last = now;
+        return (int)quiet;
     }
     ctl_client_t tmp = {.fd = fd};
     (void)reply(&tmp, "error: too many control clients");
@@ -150,11 +182,24 @@ int ctl_accept(ctl_t *c)
     return -1;
 }
 
-static void drop(ctl_client_t *k)
+uint32_t ctl_expire(ctl_t *c, uint32_t now)
 {
-    close(k->fd);
-    k->fd = -1;
-    k->lines = (cmd_lines_t){0};
+    uint32_t wait = UINT32_MAX;
+    if (c->fd < 0) {
+        return wait; /* never opened: the slots are not clients */
+    }
+    for (unsigned k = 0; k < CTL_CLIENTS; k++) {
+        ctl_client_t *cl = &c->cl[k];
+        if (cl->fd < 0) {
+            continue;
+        }
+        if (now - cl->last >= CTL_IDLE_US) {
+            close_silent(cl, now, "");
+        } else {
+            wait = co_min_u32(wait, CTL_IDLE_US - (now - cl->last));
+        }
+    }
+    return wait;
 }
 
 /* A complete line of client k: answered into its buffer. */
@@ -172,8 +217,9 @@ static void line_done(ctl_client_t *k, ctl_line_fn fn, void *ctx)
     k->olen += cmd_answer_line(out, k->out + k->olen); /* room was checked (out_room) */
 }
 
-/* Hand waiting answers to the kernel; false when the client is gone. */
-static bool flush_out(ctl_client_t *k)
+/* Hand waiting answers to the kernel (what it takes is the client's sign
+ * of life at now); false when the client is gone. */
+static bool flush_out(ctl_client_t *k, uint32_t now)
 {
     while (k->olen > 0u) {
         ssize_t n = send(k->fd, k->out, k->olen, MSG_NOSIGNAL | MSG_DONTWAIT);
@@ -185,6 +231,7 @@ static bool flush_out(ctl_client_t *k)
         }
         memmove(k->out, k->out + n, k->olen - (size_t)n);
         k->olen -= (size_t)n;
+        k->last = now;
     }
     return true;
 }
@@ -205,13 +252,13 @@ static void take_input(ctl_client_t *cl, ctl_line_fn fn, void *ctx)
     }
 }
 
-bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx)
+bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx, uint32_t now)
 {
     if (k >= CTL_CLIENTS || c->cl[k].fd < 0) {
         return false;
     }
     ctl_client_t *cl = &c->cl[k];
-    if (!flush_out(cl)) {
+    if (!flush_out(cl, now)) {
         drop(cl);
         return false;
     }
@@ -225,12 +272,13 @@ bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx)
             return false;
         }
         if (n > 0) {
+            cl->last = now;
             cl->ipos = 0;
             cl->ilen = (size_t)n;
             take_input(cl, fn, ctx);
         }
     }
-    if (!flush_out(cl)) {
+    if (!flush_out(cl, now)) {
         drop(cl);
         return false;
     }
@@ -239,7 +287,7 @@ bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx)
      * or the kernel is full, then EPOLLOUT brings the client back). */
     while (cl->ipos < cl->ilen && out_room(cl)) {
         take_input(cl, fn, ctx);
-        if (!flush_out(cl)) {
+        if (!flush_out(cl, now)) {
             drop(cl);
             return false;
         }

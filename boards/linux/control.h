@@ -18,8 +18,19 @@
 
 #include "cmd.h"
 
-/* Clients at once; one more is accepted and told so, then closed. */
+/* Clients at once; one more is accepted and told so, then closed, unless
+ * a client has been silent for CTL_EVICT_US (ctl_accept). */
 #define CTL_CLIENTS 16u
+/* A client silent this long (no byte from it, none of its answers taken)
+ * is told so and closed (ctl_expire): without it, 16 connections that say
+ * nothing would lock every other client out for as long as they stay. A
+ * minute: a test runner pauses for less between two commands; a person at
+ * nc who pauses longer connects again. */
+#define CTL_IDLE_US 60000000u
+/* With every slot taken, a newcomer gets the slot of the client silent
+ * longest if that one has been silent this long; a table full of clients
+ * that talk refuses it. */
+#define CTL_EVICT_US 5000000u
 /* Answers waiting for the kernel, per client: lines are taken while one
  * more answer fits. */
 #define CTL_OUT ((size_t)8 * (CMD_REPLY_MAX + 1u))
@@ -38,6 +49,7 @@ typedef struct ctl_client {
     char out[CTL_OUT]; /* answers the kernel has not taken yet */
     size_t olen;
     uint32_t events; /* epoll events registered for fd (the caller keeps it, ctl_events) */
+    uint32_t last;   /* when it last sent a byte or took an answer (us, the loop's clock) */
 } ctl_client_t;
 
 typedef struct ctl {
@@ -66,15 +78,25 @@ static inline int ctl_fd(const ctl_t *c)
     return c->fd;
 }
 
-/* Accept what waits on the listening socket; returns the new client's slot
- * (its fd is c->cl[slot].fd, for epoll), or -1 when none was added. */
-int ctl_accept(ctl_t *c);
+/* Accept what waits on the listening socket at time now (us); returns the
+ * new client's slot (its fd is c->cl[slot].fd, for epoll), or -1 when none
+ * was added. With every slot taken, the client silent longest is told so
+ * and closed if silent for CTL_EVICT_US (its fd leaves epoll with the
+ * close), and the newcomer takes its slot; else the newcomer is told
+ * "error: too many control clients" and closed. */
+int ctl_accept(ctl_t *c, uint32_t now);
 
-/* Serve client slot k (it is readable or writable): send what waits, read
- * and answer complete lines through fn while their answers fit. Returns
- * false when the client is gone (closed here; a partial line is
- * discarded). */
-bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx);
+/* Serve client slot k (it is readable or writable) at time now (us): send
+ * what waits, read and answer complete lines through fn while their
+ * answers fit. Returns false when the client is gone (closed here; a
+ * partial line is discarded). */
+bool ctl_read(ctl_t *c, unsigned k, ctl_line_fn fn, void *ctx, uint32_t now);
+
+/* Close the clients silent for CTL_IDLE_US at time now (us), each told
+ * "error: silent for 60 s: closed" first if it can take the line (a half
+ * line it sent is dropped). Returns the time until the next one would be
+ * (UINT32_MAX: no client). */
+uint32_t ctl_expire(ctl_t *c, uint32_t now);
 
 /* The epoll events client k needs now: EPOLLIN while it may send more
  * lines, EPOLLOUT while answers wait for the kernel. */

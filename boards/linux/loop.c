@@ -265,7 +265,7 @@ static void handle_event(loop_t *l, uint32_t src, uint32_t t)
             epoll_ctl(l->ep, EPOLL_CTL_DEL, STDIN_FILENO, NULL);
         }
     } else if (src == EV_CONTROL) {
-        int k = ctl_accept(&l->ctl);
+        int k = ctl_accept(&l->ctl, t);
         if (k >= 0) {
             struct epoll_event ev = {.events = EPOLLIN};
             ev.data.u32 = EV_CLIENT + (uint32_t)k;
@@ -274,7 +274,7 @@ static void handle_event(loop_t *l, uint32_t src, uint32_t t)
         }
     } else if (src >= EV_CLIENT && src < EV_CLIENT + CTL_CLIENTS) {
         unsigned k = src - EV_CLIENT;
-        if (ctl_read(&l->ctl, k, control_line, l)) { /* a closed fd leaves epoll */
+        if (ctl_read(&l->ctl, k, control_line, l, t)) { /* a closed fd leaves epoll */
             /* Reading waits while answers wait (control.h). */
             uint32_t want = ctl_events(&l->ctl, k);
             if (want != l->ctl.cl[k].events) {
@@ -380,6 +380,7 @@ int loop_run(loop_t *l)
         if (backlog) {
             wait = co_min_u32(wait, 1000u); /* retry the kernel's full queue soon */
         }
+        wait = co_min_u32(wait, ctl_expire(&l->ctl, t)); /* silent clients closed */
         if (l->stdin_file && !a->quit) {
             l->stdin_file = read_stdin(l);
             wait = l->stdin_file ? co_min_u32(wait, 1000u) : wait;

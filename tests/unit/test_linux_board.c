@@ -2,17 +2,20 @@
  * test_linux_board.c - the Linux program's ports: the EEPROM file, the log's
  * rate limit, the simulated CAN controller and the shared transmit queue.
  */
+#include <errno.h>
 #include <fcntl.h>
 #include <linux/can.h>
 #include <stdlib.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "can_port.h"
 #include "co_port.h"
+#include "control.h"
 #include "dst.h"
 #include "jd.h"
 
@@ -393,6 +396,138 @@ static void test_eeprom_hold_file(void)
     log_stop();
 }
 
+/* got is want, or both are shown. */
+#define CHECK_STR(got, want) check_str((got), (want), __LINE__)
+static void check_str(const char *got, const char *want, int line)
+{
+    if (strcmp(got, want) != 0) {
+        fprintf(stderr, "line %d: got \"%s\", want \"%s\"\n", line, got, want);
+    }
+    CHECK(strcmp(got, want) == 0);
+}
+
+/* The control socket's line function for the tests: "ok LINE". */
+static void echo_line(void *ctx, const char *line, char *reply, size_t len)
+{
+    (void)ctx;
+    snprintf(reply, len, "ok %s", line);
+}
+
+/* A client of the test's control socket at path, connected and accepted
+ * at time now; returns its fd, *slot the slot it got (-1: refused). */
+static int ctl_client(ctl_t *c, const char *path, uint32_t now, int *slot)
+{
+    int fd = socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    struct sockaddr_un sa = {.sun_family = AF_UNIX};
+    snprintf(sa.sun_path, sizeof(sa.sun_path), "%s", path);
+    CHECK_EQ(connect(fd, (const struct sockaddr *)&sa, sizeof(sa)), 0);
+    *slot = ctl_accept(c, now);
+    return fd;
+}
+
+/* What the server sent fd, up to its close (the client's socket read to
+ * its end, or what is there now when it is still open). */
+static const char *ctl_heard(int fd)
+{
+    static char buf[512];
+    ssize_t n = recv(fd, buf, sizeof(buf) - 1u, MSG_DONTWAIT);
+    buf[n > 0 ? n : 0] = '\0';
+    return buf;
+}
+
+/* The server closed fd: its end (ECONNRESET when bytes it had not read
+ * were left: a unix socket closed with them says so). */
+static bool ctl_closed(int fd)
+{
+    char b;
+    ssize_t r = recv(fd, &b, 1, MSG_DONTWAIT);
+    return r == 0 || (r < 0 && errno == ECONNRESET);
+}
+
+/* 16 connections that say nothing locked every other client out for as
+ * long as they stayed: a client silent for CTL_IDLE_US is closed, and a
+ * newcomer finding every slot taken gets the slot of the client silent
+ * longest if that one has been silent for CTL_EVICT_US. Time is the
+ * loop's wrapping clock, here near its wrap. */
+static void test_control_silent_clients(void)
+{
+    char dir[] = "/tmp/co-ctl-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char spec[120];
+    char path[100];
+    snprintf(path, sizeof(path), "%s/s", dir);
+    snprintf(spec, sizeof(spec), "unix:%s", path);
+    static ctl_t c;
+    char err[200];
+    c.fd = -1;                                /* as loop_open leaves it without --control */
+    CHECK_EQ(ctl_expire(&c, 0u), UINT32_MAX); /* never opened: its zeros are no clients */
+    CHECK_EQ(ctl_open(&c, spec, err, sizeof(err)), 0);
+    const uint32_t t0 = UINT32_MAX - 20000000u; /* the clock wraps 20 s later */
+    int fd[CTL_CLIENTS];
+    int slot;
+    for (unsigned k = 0; k < CTL_CLIENTS; k++) {
+        fd[k] = ctl_client(&c, path, t0, &slot);
+        CHECK_EQ(slot, (int)k);
+    }
+    CHECK_EQ(ctl_expire(&c, t0 + CTL_IDLE_US - 1u), 1u); /* nobody yet, the first in 1 us */
+    /* Full, every client silent for less than CTL_EVICT_US: refused. */
+    int late = ctl_client(&c, path, t0 + CTL_EVICT_US - 1u, &slot);
+    CHECK_EQ(slot, -1);
+    CHECK_STR(ctl_heard(late), "error: too many control clients\n");
+    CHECK(ctl_closed(late));
+    close(late);
+    /* Client 0 sends half a line at t0 + 2 s (a byte is a sign of life,
+     * a whole line or not), ... */
+    CHECK_EQ(send(fd[0], "ab", 2, MSG_NOSIGNAL), 2);
+    CHECK(ctl_read(&c, 0, echo_line, NULL, t0 + 2000000u));
+    CHECK_STR(ctl_heard(fd[0]), "");
+    /* ... client 2 takes an answer at t0 + 29 s (as one that waited for
+     * the kernel's room: put there by hand), ... */
+    memcpy(c.cl[2].out, "ok x\n", 5);
+    c.cl[2].olen = 5;
+    CHECK(ctl_read(&c, 2, echo_line, NULL, t0 + 29000000u));
+    CHECK_STR(ctl_heard(fd[2]), "ok x\n");
+    /* ... and client 3 talks at t0 + 30 s: alive from then. */
+    CHECK_EQ(send(fd[3], "get\n", 4, MSG_NOSIGNAL), 4);
+    CHECK(ctl_read(&c, 3, echo_line, NULL, t0 + 30000000u));
+    CHECK_STR(ctl_heard(fd[3]), "ok get\n");
+    /* Later: the client silent longest (1; 0, 2 and 3 spoke) gives its
+     * slot up to a newcomer. */
+    CHECK_EQ(send(fd[1], "half a li", 9, MSG_NOSIGNAL), 9); /* not read yet: no sign of life */
+    int newer = ctl_client(&c, path, t0 + 31000000u, &slot);
+    CHECK_EQ(slot, 1);
+    CHECK_STR(ctl_heard(fd[1]),
+              "error: silent for 31 s: closed (every slot taken: a new client has it)\n");
+    CHECK(ctl_closed(fd[1]));
+    close(fd[1]);
+    fd[1] = newer;
+    /* A minute after: the silent ones closed; 0, 2, 3 and the newcomer
+     * stay, the next of them (0, at t0 + 2 s) due in 1 s. */
+    CHECK_EQ(ctl_expire(&c, t0 + CTL_IDLE_US + 1000000u), 1000000u);
+    for (unsigned k = 0; k < CTL_CLIENTS; k++) {
+        if (k <= 3u) {
+            CHECK(c.cl[k].fd >= 0);
+            CHECK(!ctl_closed(fd[k]));
+        } else {
+            CHECK(c.cl[k].fd < 0);
+            CHECK_STR(ctl_heard(fd[k]), "error: silent for 61 s: closed\n");
+            CHECK(ctl_closed(fd[k]));
+        }
+    }
+    /* 0, 2 and 3 closed at t0 + 90 s; the newcomer (t0 + 31 s) due in 1 s. */
+    CHECK_EQ(ctl_expire(&c, t0 + 90000000u), 1000000u);
+    CHECK(c.cl[0].fd < 0 && c.cl[2].fd < 0 && c.cl[3].fd < 0 && c.cl[1].fd >= 0);
+    CHECK_STR(ctl_heard(fd[0]), "error: silent for 88 s: closed\n");
+    CHECK_EQ(send(fd[1], "x\n", 2, MSG_NOSIGNAL), 2);
+    CHECK(ctl_read(&c, 1, echo_line, NULL, t0 + 90500000u));
+    CHECK_EQ(ctl_expire(&c, t0 + 91000000u), CTL_IDLE_US - 500000u);
+    ctl_close(&c);
+    for (unsigned k = 0; k < CTL_CLIENTS; k++) {
+        close(fd[k]);
+    }
+    CHECK(rmdir(dir) == 0);
+}
+
 /* A corrupt file stays byte for byte as it is until a save. */
 static void test_eeprom_corrupt_untouched(void)
 {
@@ -690,6 +825,7 @@ int main(void)
     RUN(test_eeprom_link_to_nothing);
     RUN(test_eeprom_lock);
     RUN(test_eeprom_hold_file);
+    RUN(test_control_silent_clients);
     RUN(test_eeprom_corrupt_untouched);
     RUN(test_eeprom_save_fails);
     RUN(test_rate_limit);
