@@ -29,6 +29,7 @@ import zlib
 
 import can
 import pytest
+from conftest import BINARY
 from targets import SerialLine
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -128,6 +129,7 @@ class Emu:
                 chunk = os.read(self.proc.stderr.fileno(), 4096)
                 assert chunk, f"tools/emu ended: {err.decode()}"
                 err += chunk
+        self.early = err.decode()  # what it said before it was ready
         # The suite's serial line: keeps what the image sent while pyserial
         # opened the socket (its open() discards it: a lost boot-up).
         bus = SerialLine(port)
@@ -408,6 +410,59 @@ def test_refuses_busy_port_bad_flash_and_shared_flash(emus, tmp_path):
                         str(free_port()), "--flash", str(flash)], capture_output=True, text=True,
                        timeout=30)
     assert r.returncode == 2 and "in use by another emulator" in r.stderr
+
+
+def emu_run(flash):
+    """tools/emu on rv32-virt with flash, expected to refuse: its result."""
+    return subprocess.run([EMU, "--board", "rv32-virt", "--product", PRODUCT, "--port",
+                           str(free_port()), "--flash", str(flash)], capture_output=True,
+                          text=True, timeout=30)
+
+
+def test_flash_hold_file_shared_with_the_program(emus, tmp_path):
+    """The flash file's hold file (FILE.lock; docs/running.md, "The hold on
+    an EEPROM file") is the program's too: tools/emu refuses a file that a
+    canopen-sensor of another kernel (a tools/vcan-run) holds, written here
+    as it writes it, and takes it once not renewed for 10 s; the program
+    refuses the emulator's file; the emulator renews its hold, a power cut
+    leaves it for the next emulator to find stale, a clean end removes it."""
+    flash, lock = tmp_path / "flash.bin", tmp_path / "flash.bin.lock"
+    lock.write_text("canopen-hold 1 boot=0123abcd-another-kernel pidns=1 pid=42 start=7 "
+                    "by=canopen-sensor\n")
+    r = emu_run(flash)
+    who = "canopen-sensor, pid 42 of another kernel (boot id 0123abcd)"
+    assert r.returncode == 2 and (f"flash file {flash} is in use by {who}, renewed 0 s ago "
+                                  f"(hold file {lock})") in r.stderr, r.stderr
+    assert not flash.exists()  # refused before the file is made
+    os.utime(lock, (time.time() - 12, time.time() - 12))
+    e = emus(flash, "rv32-virt")
+    e.start()
+    line = lock.read_text()
+    assert line.endswith(f" pid={e.proc.pid} start={_start_time(e.proc.pid)} by=tools/emu\n")
+    r = subprocess.run([BINARY, "--product", "jd2xxx", "--iface", "vcan0", "--nvm", str(flash)],
+                       stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=30)
+    assert r.returncode == 2 and (f"EEPROM file {flash} is in use by tools/emu, pid "
+                                  f"{e.proc.pid} of this kernel (hold file {lock}") in r.stderr, \
+        r.stderr
+    os.utime(lock, (time.time() - 100, time.time() - 100))
+    end = time.monotonic() + 10
+    while time.time() - lock.stat().st_mtime > 50 and time.monotonic() < end:
+        time.sleep(0.1)
+    assert time.time() - lock.stat().st_mtime < 10, "tools/emu does not renew its hold"
+    e.power_cut()
+    assert lock.read_text() == line
+    e2 = emus(flash, "rv32-virt")
+    e2.start()
+    assert (f"emu: flash file {flash}: stale hold file {lock} removed (tools/emu, pid "
+            f"{e.proc.pid} of this kernel, which has ended)") in e2.early, e2.early
+    assert e2.stop() == 0
+    assert not lock.exists()
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["flash.bin"]
+
+
+def _start_time(pid):
+    text = pathlib.Path(f"/proc/{pid}/stat").read_text()
+    return int(text[text.rindex(")") + 2:].split()[19])
 
 
 def test_flash_path_with_a_comma_through_a_symbolic_link(board, emus, tmp_path):
