@@ -513,6 +513,32 @@ static void test_life_guard_event_cleared_by_reset_communication(void)
     EXPECT(d, 0x740, "7F");
 }
 
+/* A life-guarding event moves an operational node to pre-operational
+ * (CiA 301's default error behaviour) and leaves a stopped one stopped. */
+static void test_life_guard_event_in_stopped(void)
+{
+    boot();
+    SDO(d, "2B 0C 10 00 64 00 00 00", "60 0C 10 00 00 00 00 00"); /* 100 ms */
+    SDO(d, "2F 0D 10 00 02 00 00 00", "60 0D 10 00 00 00 00 00"); /* x 2 */
+    co_frame_t rtr = {.id = 0x740, .rtr = true, .dlc = 1};
+    h_rx(d, 0x000, "02 40");
+    h_drain(d);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x740, "04");
+    h_advance(d, 200000); /* the event (no EMCY frame while stopped) */
+    CHECK_EQ(co_emcy_register(d->node), 0x11);
+    CHECK_EQ(d->node->nmt.state, CO_NMT_STOPPED);
+    h_rx_frame(d, &rtr);
+    EXPECT(d, 0x740, "84"); /* still stopped; the request ends the event */
+    EXPECT_NONE(d);
+    CHECK_EQ(co_emcy_register(d->node), 0);
+    h_rx(d, 0x000, "01 40");
+    h_drain(d);
+    h_advance(d, 200000);
+    EXPECT(d, 0xC0, "30 81 11 00 00 00 00 00");
+    CHECK_EQ(d->node->nmt.state, CO_NMT_PREOP);
+}
+
 /* Life guarding (CiA 301) runs from the last guard request answered: a
  * reset communication forgets the requests before it, and the life time
  * starts again with the first one after. A life time factor of 0 is node
@@ -1055,6 +1081,7 @@ int main(void)
     RUN(test_lss_reset_starts_afresh);
     RUN(test_life_guard_event_cleared_by_reset_communication);
     RUN(test_life_guard_starts_with_a_request);
+    RUN(test_life_guard_event_in_stopped);
     RUN(test_guard_and_consumer_events_apart);
     RUN(test_heartbeat_consumer);
     RUN(test_heartbeat_consumer_timer);
