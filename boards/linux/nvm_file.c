@@ -484,7 +484,7 @@ int lp_nvm_lock(lp_nvm_t *n, const char *opt, const char *path, char *err, unsig
         size_t hl = strlen(n->hold);
         if (t < 0 || write(t, n->hold, hl) != (ssize_t)hl) {
             e = errno;
-            fail = "cannot write";
+            fail = "cannot make";
             if (t >= 0) {
                 close(t);
                 (void)unlink(mine);
@@ -526,6 +526,16 @@ int lp_nvm_lock(lp_nvm_t *n, const char *opt, const char *path, char *err, unsig
         remove_stale(n, lock, ".stale", line, who);
     }
     n->hold[0] = '\0';
+    if (fail != NULL && (e == EROFS || e == EACCES || e == EPERM || e == ENOSPC || e == EDQUOT)) {
+        /* A directory nobody can write in now: no save can replace the
+         * file either (its temporary file goes beside it), so no user can
+         * overwrite another's; the start goes on, as a failed save does
+         * (docs/running.md). */
+        lp_log("warning: EEPROM file %s: no hold file (%s %s: %s): the file is held on this "
+               "kernel only",
+               n->real, fail, lock, strerror(e));
+        return 0;
+    }
     lp_nvm_unlock(n);
     if (fail != NULL) {
         snprintf(err, errlen, "%s %s: cannot hold the file: %s %s: %s", opt, path, fail, lock,

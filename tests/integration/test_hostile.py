@@ -391,6 +391,34 @@ def test_failed_save_disk_full_and_read_only(small_fs, tmp_path, procs):
     assert f"error: EEPROM file {nvm}: save failed" in p.text()
 
 
+def test_eeprom_file_in_a_read_only_file_system(small_fs, tmp_path, procs):
+    """Where nothing can be written the hold file beside the EEPROM file
+    (docs/running.md, "The hold on an EEPROM file") cannot be made either:
+    the start goes on, held on this kernel only and saying so (no save can
+    replace the file there, so nobody can overwrite another's), the stored
+    set loads, and a save is aborted as on any read-only file system."""
+    nvm = small_fs / "eeprom.bin"
+    p, b = boot(procs, tmp_path, "jd2xxx", 10, nvm=nvm)
+    assert (small_fs / "eeprom.bin.lock").exists()
+    assert sdo_write(b, 10, 0x1017, 0, 300, 2) == 0
+    assert sdo_write(b, 10, 0x1010, 1, SAVE) == 0
+    b.shutdown()
+    assert p.stop() == 0
+    assert sorted(f.name for f in small_fs.iterdir()) == ["eeprom.bin"]  # the hold gone
+    subprocess.run(["mount", "-o", "remount,ro", str(small_fs)], check=True)
+    try:
+        p, b = boot(procs, tmp_path, "jd2xxx", 10, nvm=nvm)
+        assert p.wait_log(f"warning: EEPROM file {nvm}: no hold file (cannot make "
+                          f"{nvm}.lock: Read-only file system): the file is held on this "
+                          "kernel only"), p.text()
+        assert sdo_read(b, 10, 0x1017, 0) == 300
+        assert sdo_write(b, 10, 0x1010, 1, SAVE) == 0x06060000
+        b.shutdown()
+        assert p.stop() == 0
+    finally:
+        subprocess.run(["mount", "-o", "remount,rw", str(small_fs)], check=True)
+
+
 # ---- standard input and lifetime -------------------------------------------
 
 def test_stdin_nul_long_and_last_line(tmp_path, procs):
