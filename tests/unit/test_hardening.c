@@ -393,6 +393,12 @@ static void test_div_round_whole_range(void)
     CHECK_EQ(co_div_round(14, 3), 5);
     CHECK_EQ(co_div_round(-13, 3), -4);
     CHECK_EQ(co_div_round(0, 7), 0);
+    /* A divisor of 0 or below breaks the contract: reported, answered 0. */
+    unsigned seen = h_asserts;
+    h_expect_assert(2);
+    CHECK_EQ(co_div_round(7, 0), 0);
+    CHECK_EQ(co_div_round(7, -2), 0);
+    CHECK_EQ(h_asserts, seen + 2u);
 }
 
 /* ---- bus-off ------------------------------------------------------------ */
