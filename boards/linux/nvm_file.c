@@ -468,8 +468,10 @@ int lp_nvm_lock(lp_nvm_t *n, const char *opt, const char *path, char *err, unsig
              k.boot[0] != '\0' ? k.boot : "unknown", k.pidns, pid, start_time(pid));
     char lock[sizeof(n->real) + 8];
     char mine[sizeof(n->real) + 80];
-    char tag[64];
+    char tag[64]; /* our helpers' names: no other starter's, on any kernel */
+    char stale_tag[80];
     snprintf(tag, sizeof(tag), ".%.8s-%ld", k.boot, pid);
+    snprintf(stale_tag, sizeof(stale_tag), ".stale%s", tag);
     if (!lock_name(n, "", lock, sizeof(lock)) || !lock_name(n, tag, mine, sizeof(mine))) {
         snprintf(err, errlen, "%s %s: path too long for its hold file", opt, path);
         lp_nvm_unlock(n);
@@ -523,7 +525,7 @@ int lp_nvm_lock(lp_nvm_t *n, const char *opt, const char *path, char *err, unsig
         if (!hold_stale(line, mtime, who, sizeof(who))) {
             break;
         }
-        remove_stale(n, lock, ".stale", line, who);
+        remove_stale(n, lock, stale_tag, line, who);
     }
     n->hold[0] = '\0';
     if (fail != NULL && (e == EROFS || e == EACCES || e == EPERM || e == ENOSPC || e == EDQUOT)) {
