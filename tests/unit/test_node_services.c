@@ -265,11 +265,14 @@ static void test_lss_store_in_lss_set(void)
     LSS("13 00 10 00 00 00 00 00", "13 01 00 00 00 00 00 00"); /* index 16 */
     LSS("13 00 03 00 00 00 00 00", "13 00 00 00 00 00 00 00"); /* 125 kbit/s */
     LSS("15 00 00 00 00 00 00 00", NULL);                      /* activate: no answer */
-    /* Not LSS frames: fewer than 8 bytes, or a remote request. */
+    /* Not LSS frames: fewer than 8 bytes, a remote request, another
+     * identifier above or below the master's 7E5h. */
     h_drain(d);
     h_rx(d, 0x7E5, "5E 00 00 00");
     co_frame_t rtr = {.id = 0x7E5, .rtr = true, .dlc = 8, .data = {0x5E}};
     h_rx_frame(d, &rtr);
+    h_rx(d, 0x7E6, "5E 00 00 00 00 00 00 00");
+    h_rx(d, 0x7E4, "5E 00 00 00 00 00 00 00");
     EXPECT_NONE(d);
     LSS("17 00 00 00 00 00 00 00", "17 00 00 00 00 00 00 00");
     LSS("5E 00 00 00 00 00 00 00", "5E 40 00 00 00 00 00 00"); /* still the active one */
