@@ -402,17 +402,17 @@ static bool hold_stale(const char *line, struct timespec mtime, char *who, size_
 
 /*
  * Remove the stale hold file whose line was stale_line: moved aside first
- * (rename is atomic), then checked to be that one. Another starter may
+ * (to FILE.lock<aside_tag>; rename is atomic), then checked to be that one. Another starter may
  * have removed it and made its own meanwhile, which the move then took:
  * that one is put back (link, never over a newer one).
  */
-static void remove_stale(const lp_nvm_t *n, const char *lock, const char *tag,
+static void remove_stale(const lp_nvm_t *n, const char *lock, const char *aside_tag,
                          const char *stale_line, const char *who)
 {
     char aside[sizeof(n->real) + 80];
     char line[160];
     struct timespec mtime;
-    if (!lock_name(n, tag, aside, sizeof(aside)) || rename(lock, aside) != 0) {
+    if (!lock_name(n, aside_tag, aside, sizeof(aside)) || rename(lock, aside) != 0) {
         return; /* gone already: the next attempt sees what is there now */
     }
     if (read_line(aside, line, sizeof(line), &mtime) && strcmp(line, stale_line) == 0) {
