@@ -48,6 +48,13 @@ void sdo_reply_head(co_node_t *node, uint8_t cmd, const uint8_t *req, uint32_t v
 
 void sdo_abort(co_node_t *node, const uint8_t *mux, co_res_t r)
 {
+    uint8_t m[4] = {0, 0, 0, 0};
+    if (mux == NULL) {
+        if (node->sdo.state != SDO_IDLE) {
+            sdo_mux(&node->sdo, m);
+        }
+        mux = m;
+    }
     node->sdo.state = SDO_IDLE;
     sdo_reply_head(node, 0x80, mux, co_res_abort_code(r));
 }
@@ -60,15 +67,6 @@ void sdo_mux(const co_sdo_t *sdo, uint8_t mux[4])
     mux[1] = (uint8_t)sdo->e->index;
     mux[2] = (uint8_t)(sdo->e->index >> 8);
     mux[3] = sdo->e->sub;
-}
-
-void sdo_abort_stray(co_node_t *node, co_res_t r)
-{
-    uint8_t mux[4] = {0, 0, 0, 0};
-    if (node->sdo.state != SDO_IDLE) {
-        sdo_mux(&node->sdo, mux);
-    }
-    sdo_abort(node, mux, r);
 }
 
 void sdo_restart(co_sdo_t *sdo)
@@ -226,16 +224,12 @@ static bool upload_expedited(co_node_t *node, const uint8_t *d, const co_od_entr
 }
 
 /* The optional protocols (segmented, block) where the product links them.
- * A request none takes is aborted with its own multiplexer when it names
- * an object (names: an initiate), else as a stray (sdo_abort_stray). */
-static void optional(co_node_t *node, const uint8_t *d, co_sdo_proto_fn proto, bool names)
+ * A request none takes is aborted with mux: the request's own when it
+ * names an object (an initiate), NULL when not (sdo_abort). */
+static void optional(co_node_t *node, const uint8_t *d, co_sdo_proto_fn proto, const uint8_t *mux)
 {
     if (proto == NULL || !proto(node, d)) {
-        if (names) {
-            sdo_abort(node, d, CO_E_CMD);
-        } else {
-            sdo_abort_stray(node, CO_E_CMD);
-        }
+        sdo_abort(node, mux, CO_E_CMD);
     }
 }
 
@@ -275,28 +269,28 @@ CO_NOINLINE void co_sdo_receive(co_node_t *node, const co_frame_t *f)
         if ((d[0] & 0x02u) != 0u || seg == NULL) {
             download_initiate(node, d);
         } else {
-            optional(node, d, seg, true);
+            optional(node, d, seg, d);
         }
         break;
     case CCS_UPLOAD_INITIATE: {
         sdo->state = SDO_IDLE;
         const co_od_entry_t *e = sdo_find(node, d);
         if (e != NULL && !upload_expedited(node, d, e)) {
-            optional(node, d, seg, true);
+            optional(node, d, seg, d);
         }
         break;
     }
     case CCS_DOWNLOAD_SEGMENT:
     case CCS_UPLOAD_SEGMENT:
-        optional(node, d, seg, false);
+        optional(node, d, seg, NULL);
         break;
     case CCS_BLOCK_DOWNLOAD: /* its initiate has bit 0 clear */
     case CCS_BLOCK_UPLOAD:   /* its initiate has bits 1..0 clear */
         optional(node, d, co_cfg(node)->sdo_block,
-                 (d[0] & ((d[0] >> 5) == CCS_BLOCK_UPLOAD ? 3u : 1u)) == 0u);
+                 (d[0] & ((d[0] >> 5) == CCS_BLOCK_UPLOAD ? 3u : 1u)) == 0u ? d : NULL);
         break;
     default:
-        sdo_abort_stray(node, CO_E_CMD); /* reserved command specifier */
+        sdo_abort(node, NULL, CO_E_CMD); /* reserved command specifier */
         break;
     }
 }
@@ -312,9 +306,7 @@ uint32_t co_sdo_poll(co_node_t *node, uint32_t now)
         sdo->deadline = now + CO_SDO_TIMEOUT_US;
     }
     if (!co_time_before(now, sdo->deadline)) {
-        uint8_t mux[4];
-        sdo_mux(sdo, mux);
-        sdo_abort(node, mux, CO_E_TIMEOUT);
+        sdo_abort(node, NULL, CO_E_TIMEOUT);
         return CO_NEVER;
     }
     return sdo->deadline - now;

@@ -40,13 +40,12 @@ void sdo_send(co_node_t *node, co_frame_t *f);
 /* Answer cmd, the request req's multiplexer (bytes 1..3), val in bytes 4..7. */
 void sdo_reply_head(co_node_t *node, uint8_t cmd, const uint8_t *req, uint32_t val);
 /* End the transfer (idle) and answer abort code r for the multiplexer in
- * mux[1..3] (a request, or sdo_mux()'s). */
+ * mux[1..3] (a request, or sdo_mux()'s). mux NULL: for a request that
+ * names no object (a segment or a block sub-command outside its transfer,
+ * a reserved command specifier, the timeout), CiA 301's choice: the
+ * multiplexer of the transfer the abort ends, or 0000h sub 00h with none;
+ * the request's bytes 1..3 are data there, never an object. */
 void sdo_abort(co_node_t *node, const uint8_t *mux, co_res_t r);
-/* Abort r for a request that names no object (a segment or a block
- * sub-command outside its transfer, a reserved command specifier): CiA 301
- * puts the multiplexer of the transfer it ends in the abort, or 0000h sub
- * 00h when there is none; the request's bytes 1..3 are data, no object. */
-void sdo_abort_stray(co_node_t *node, co_res_t r);
 /* The multiplexer of the transfer in progress (sdo->e set), laid out like
  * a request (mux[0] = 0) for sdo_abort(). */
 void sdo_mux(const co_sdo_t *sdo, uint8_t mux[4]);

@@ -116,7 +116,7 @@ bool co_sdo_segmented(co_node_t *node, const uint8_t *d)
         /* A segment belongs to the transfer in progress, of the same direction. */
         bool download = (d[0] >> 5) == CCS_DOWNLOAD_SEGMENT;
         if (sdo->state != (download ? SDO_DOWNLOAD : SDO_UPLOAD)) {
-            sdo_abort_stray(node, CO_E_CMD);
+            sdo_abort(node, NULL, CO_E_CMD);
             return true;
         }
         uint8_t mux[4];
