@@ -583,14 +583,12 @@ def test_ends_with_its_parent(tmp_path):
         EMU, "--board", "rv32-virt", "--product", PRODUCT, "--port", str(port),
         "--flash", str(flash)], stdout=subprocess.PIPE, start_new_session=True)
     try:
-        line = parent.stdout.readline()
-        assert line, "tools/emu did not get ready"
-        emu = int(line)
+        emu = int(line_within(parent.stdout, 30, "tools/emu's PID once it is ready"))
         qemu = [int(p.name) for p in pathlib.Path("/proc").iterdir() if p.name.isdigit()
                 and _ppid(p.name) == emu]
         assert len(qemu) == 1
         os.kill(parent.pid, signal.SIGKILL)
-        parent.wait()
+        parent.wait(timeout=10)
         end = time.monotonic() + 5
         while time.monotonic() < end and any(_alive(p) for p in [emu] + qemu):
             time.sleep(0.1)
@@ -622,8 +620,8 @@ def test_ends_with_a_parent_killed_at_once(tmp_path):
         "--flash", str(flash)], stdout=subprocess.PIPE, start_new_session=True)
     emu = None
     try:
-        emu = int(parent.stdout.readline())
-        assert parent.wait() == -signal.SIGKILL
+        emu = int(line_within(parent.stdout, 30, "tools/emu's PID"))
+        assert parent.wait(timeout=10) == -signal.SIGKILL
         end = time.monotonic() + 10
         while time.monotonic() < end and (_alive(emu) or _group(parent.pid) or _group(emu)):
             time.sleep(0.1)
@@ -634,6 +632,22 @@ def test_ends_with_a_parent_killed_at_once(tmp_path):
     finally:
         _kill_groups(parent.pid, emu)
         flash.unlink(missing_ok=True)
+
+
+def line_within(stream, seconds, what):
+    """The next line of a child's pipe, read within seconds; the test fails
+    naming what it waited for when none comes (or the pipe ends)."""
+    end = time.monotonic() + seconds
+    got = b""
+    while not got.endswith(b"\n"):
+        left = end - time.monotonic()
+        if left <= 0 or not select.select([stream], [], [], left)[0]:
+            pytest.fail(f"no line with {what} within {seconds} s (got {got!r})")
+        chunk = os.read(stream.fileno(), 1)  # a byte at a time: nothing past the line
+        if not chunk:
+            pytest.fail(f"the pipe ended before a line with {what} (got {got!r})")
+        got += chunk
+    return got.decode()
 
 
 def _kill_groups(*groups):
