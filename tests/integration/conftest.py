@@ -6,6 +6,7 @@ brings vcan0 and vcan1 up (inside User-Mode Linux where the kernel has no CAN).
 import os
 import pathlib
 import queue
+import select
 import signal
 import subprocess
 import sys
@@ -358,6 +359,22 @@ class Bus(can.Listener):
 
     def collect(self, can_id, seconds):
         return [m for m in self.frames(seconds) if m.arbitration_id == can_id]
+
+
+def line_within(stream, seconds, what):
+    """The next line of a child's pipe, read within seconds; the test fails
+    naming what it waited for when none comes (or the pipe ends)."""
+    end = time.monotonic() + seconds
+    got = b""
+    while not got.endswith(b"\n"):
+        left = end - time.monotonic()
+        if left <= 0 or not select.select([stream], [], [], left)[0]:
+            pytest.fail(f"no line with {what} within {seconds:.3g} s (got {got!r})")
+        chunk = os.read(stream.fileno(), 1)  # a byte at a time: nothing past the line
+        if not chunk:
+            pytest.fail(f"the pipe ended before a line with {what} (got {got!r})")
+        got += chunk
+    return got.decode()
 
 
 def eds_od(product, tmp_path, node_id):

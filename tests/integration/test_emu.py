@@ -29,7 +29,7 @@ import zlib
 
 import can
 import pytest
-from conftest import BINARY
+from conftest import BINARY, line_within
 from targets import SerialLine
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -632,22 +632,6 @@ def test_ends_with_a_parent_killed_at_once(tmp_path):
     finally:
         _kill_groups(parent.pid, emu)
         flash.unlink(missing_ok=True)
-
-
-def line_within(stream, seconds, what):
-    """The next line of a child's pipe, read within seconds; the test fails
-    naming what it waited for when none comes (or the pipe ends)."""
-    end = time.monotonic() + seconds
-    got = b""
-    while not got.endswith(b"\n"):
-        left = end - time.monotonic()
-        if left <= 0 or not select.select([stream], [], [], left)[0]:
-            pytest.fail(f"no line with {what} within {seconds} s (got {got!r})")
-        chunk = os.read(stream.fileno(), 1)  # a byte at a time: nothing past the line
-        if not chunk:
-            pytest.fail(f"the pipe ended before a line with {what} (got {got!r})")
-        got += chunk
-    return got.decode()
 
 
 def _kill_groups(*groups):

@@ -18,7 +18,7 @@ import time
 import can
 import pytest
 
-from conftest import IFACE, Sensor
+from conftest import IFACE, Sensor, line_within
 from facts import PRODUCTS
 from targets import EMU, CanEmuTarget, Master, free_port, period_fault
 
@@ -43,17 +43,14 @@ def emu_can(port, iface=IFACE, flash=None):
 
 
 def read_line_until(proc, prefix, timeout):
-    """tools/emu's standard error up to a line that starts with prefix."""
+    """tools/emu's standard error up to a line that starts with prefix,
+    within timeout seconds in all."""
     end = time.monotonic() + timeout
     seen = []
-    while time.monotonic() < end:
-        line = proc.stderr.readline().decode()
-        if not line:
-            break
-        seen.append(line)
-        if line.startswith(prefix):
-            return seen
-    pytest.fail(f"no line {prefix!r} from tools/emu: {''.join(seen)}")
+    while not seen or not seen[-1].startswith(prefix):
+        seen.append(line_within(proc.stderr, max(0.0, end - time.monotonic()),
+                                f"{prefix!r} from tools/emu (so far: {''.join(seen)!r})"))
+    return seen
 
 
 def test_boots_onto_the_bus_with_nobody_on_its_serial_line(tmp_path):
