@@ -132,13 +132,17 @@ class ControlClient:
             raise SimError("the control connection is closed")
         if "\n" in line:
             raise SimError("one command a line")
-        self._sock.sendall((line + "\n").encode())
         self._sock.settimeout(timeout)
-        while b"\n" not in self._rx:
-            chunk = self._sock.recv(4096)
-            if not chunk:
-                raise SimError(f"control socket closed while waiting for the answer to {line!r}")
-            self._rx += chunk
+        try:
+            self._sock.sendall((line + "\n").encode())
+            while b"\n" not in self._rx:
+                chunk = self._sock.recv(4096)
+                if not chunk:
+                    raise SimError("control socket closed while waiting for the answer to "
+                                   f"{line!r}")
+                self._rx += chunk
+        except TimeoutError:
+            raise SimError(f"no answer to {line!r} within {timeout} s") from None
         answer, self._rx = self._rx.split(b"\n", 1)
         return answer.decode(errors="replace").strip()
 
