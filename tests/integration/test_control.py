@@ -30,8 +30,11 @@ class Client:
         self.f = self.s.makefile("rb")
 
     def ask(self, line):
-        self.s.sendall(line.encode() + b"\n")
-        return self.f.readline().decode().rstrip("\n")
+        try:
+            self.s.sendall(line.encode() + b"\n")
+            return self.f.readline().decode().rstrip("\n")
+        except TimeoutError:
+            pytest.fail(f"no answer to {line!r} on the control socket within 3 s")
 
     def close(self):
         self.f.close()
