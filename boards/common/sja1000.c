@@ -232,6 +232,11 @@ bool sja1000_init(sja1000_t *c, const sja1000_io_t *io, void *ctx, uint32_t cloc
     if ((rd(c, SJA_CDR) & SJA_CDR_PELICAN) == 0u || rd(c, SJA_ACR0) != 0x5Au) {
         return false;
     }
+    /* RMC counts at most the messages the FIFO holds (none in reset mode).
+     * QEMU's model has no RMC (nor RBSA): it reads 0xFF there, and it is
+     * the model that stores a remote frame's data bytes (sja1000_receive).
+     * No register shows its FIFO's position, so this is the one check. */
+    c->rtr_skews = rd(c, SJA_RMC) > RX_FIFO_FRAMES;
     wr(c, SJA_OCR, SJA_OCR_NORMAL);
     open_filter(c);
     if (!reprogram(c, btr0, btr1)) {
@@ -369,8 +374,10 @@ bool sja1000_receive(sja1000_t *c, co_frame_t *f)
             return false;
         }
         uint8_t fi = rd(c, SJA_FRAME);
-        bool ok = (fi & SJA_FI_FF) == 0u;
-        if (ok) {
+        bool ok = (fi & SJA_FI_FF) == 0u && !c->out_of_step;
+        if (c->out_of_step) {
+            c->unread++; /* what would be read is not this frame */
+        } else if (ok) {
             f->id = (uint16_t)(((uint16_t)rd(c, SJA_FRAME + 1u) << 3) |
                                (rd(c, SJA_FRAME + 2u) >> 5));
             f->rtr = (fi & SJA_FI_RTR) != 0u;
@@ -384,6 +391,10 @@ bool sja1000_receive(sja1000_t *c, co_frame_t *f)
             }
         }
         wr(c, SJA_CMR, SJA_CMR_RRB);
+        /* After this release the FIFO is read from inside the remote
+         * frame's data bytes (extended ones too): this frame is whole. */
+        c->out_of_step = c->out_of_step ||
+                         (c->rtr_skews && (fi & SJA_FI_RTR) != 0u && (fi & 0x0Fu) != 0u);
         if (ok) {
             return true;
         }

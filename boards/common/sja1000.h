@@ -134,6 +134,13 @@ typedef struct sja1000 {
     uint32_t overruns;     /* data overruns (frames lost in the controller) */
     uint32_t filtered_out; /* frames the software check dropped */
     uint32_t restarts;     /* bus-off recoveries started */
+    /* A controller that keeps a remote frame's data bytes in its RX FIFO
+     * but frees only its header (QEMU's model: known by its RMC, see
+     * sja1000_init); once such a frame was released the FIFO is out of
+     * step for good, and the frames after it are released unread. */
+    bool rtr_skews;
+    bool out_of_step;
+    uint32_t unread; /* frames released unread since */
 } sja1000_t;
 
 /*
@@ -186,7 +193,11 @@ bool sja1000_send(sja1000_t *c, const co_frame_t *f);
  * The next received frame that passes the receive list, in *f; false when
  * the FIFO holds none. Extended frames (CANopen here uses 11-bit IDs) and
  * frames not on the list are released and skipped; at most the FIFO's
- * content is read in one call.
+ * content is read in one call. On a controller with rtr_skews, a remote
+ * frame with a DLC above 0 is the last frame read: it is returned, and
+ * from then on every frame is released unread (out_of_step, unread), since
+ * its bytes would be read from the wrong place; only a new sja1000_init
+ * of a controller that starts afresh ends that (QEMU's: a new QEMU).
  */
 bool sja1000_receive(sja1000_t *c, co_frame_t *f);
 

@@ -106,8 +106,10 @@ static void enter_reset(sja_model_t *m, bool by_cpu)
 {
     m->mod |= MOD_RM;
     m->tx_pending = false; /* the transmission is aborted; TCS keeps its value */
-    m->rmc = 0;            /* the FIFO is cleared, RBSA kept */
-    m->rx_bytes = 0;
+    if (!m->qemu) {
+        m->rmc = 0; /* the FIFO is cleared, RBSA kept */
+        m->rx_bytes = 0;
+    }
     m->dos = false;
     m->ir = 0;
     if (by_cpu) {
@@ -163,7 +165,7 @@ static uint8_t msg_len(const sja_model_t *m, unsigned at)
 {
     uint8_t fi = m->fifo[at % 64u];
     unsigned n = (fi & 0x40u) != 0u ? 0u : (fi & 0x0Fu);
-    n = n > 8u ? 8u : n;
+    n = n > 8u && !m->qemu ? 8u : n; /* QEMU takes the field as it is */
     return (uint8_t)(((fi & 0x80u) != 0u ? 5u : 3u) + n);
 }
 
@@ -220,9 +222,9 @@ uint8_t sja_model_read(void *ctx, uint8_t reg)
     case A_TXERR:
         return m->txerr;
     case A_RMC:
-        return m->rmc;
+        return m->qemu ? 0xFFu : m->rmc;
     case A_RBSA:
-        return m->rbsa;
+        return m->qemu ? 0xFFu : m->rbsa;
     case A_CDR:
         return m->cdr;
     default:
@@ -465,7 +467,7 @@ bool sja_model_rx(sja_model_t *m, uint32_t id, bool ext, bool rtr, uint8_t dlc, 
     if (!sja_model_accepts(m, id, ext, rtr, dlc, data)) {
         return false;
     }
-    unsigned n = rtr ? 0u : (dlc > 8u ? 8u : dlc);
+    unsigned n = rtr && !m->qemu ? 0u : (dlc > 8u ? 8u : dlc);
     unsigned len = (ext ? 5u : 3u) + n;
     if (m->rx_bytes + len > sizeof m->fifo) {
         m->lost++;
@@ -486,7 +488,7 @@ bool sja_model_rx(sja_model_t *m, uint32_t id, bool ext, bool rtr, uint8_t dlc, 
         fifo_put(m, (uint8_t)(((id & 7u) << 5) | (rtr ? 0x10u : 0u)));
     }
     for (unsigned i = 0; i < n; i++) {
-        fifo_put(m, data[i]);
+        fifo_put(m, data != NULL ? data[i] : 0u);
     }
     m->rmc++;
     if (m->rxerr > 127u) { /* a successful reception (ISO 11898-1) */

@@ -86,6 +86,14 @@ typedef struct sja_model {
     uint8_t basic16;
     unsigned mode_lag; /* a slow part: writes of MOD asking for another mode
                         * (RM set or cleared) it ignores before it takes one */
+    /* QEMU's model (hw/net/can/can_sja1000.c, PeliCAN mode) where it departs
+     * from the data sheet in what a driver can see: a remote frame goes into
+     * the FIFO with as many data bytes as its DLC says (what the sender's
+     * frame held there), but CMR.RRB frees only its frame information and
+     * identifier, so the next message is read from inside those bytes and
+     * they stay counted as used; RMC and RBSA read 0xFF; reset mode leaves
+     * the FIFO as it is (QEMU tests the MOD value it has just stored). */
+    bool qemu;
 
     /* Registers (PeliCAN). */
     uint8_t mod, ier, btr0, btr1, ocr, ewlr, rxerr, txerr, cdr, rbsa;

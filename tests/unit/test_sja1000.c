@@ -1300,6 +1300,64 @@ static void test_receive_fifo_and_overrun(void)
     CLEAN();
 }
 
+/* QEMU's model (the model's qemu option) keeps a remote frame's data bytes
+ * in its FIFO but frees only its header: after a remote frame with DLC 1
+ * (node guarding as some masters send it) the next message would be read
+ * from inside them. The driver knows that controller by its RMC, returns
+ * the remote frame, and releases every frame after it unread, counted,
+ * rather than hand over what it would misread. A remote frame with DLC 0,
+ * and the data sheet's controller with any DLC, change nothing. */
+static void test_receive_qemu_remote_frame(void)
+{
+    const uint8_t zero[8] = {0};
+    co_frame_t g, sdo = frame(0x605, false, 8, 0x40);
+    /* The data sheet's controller: a remote frame with DLC 1, then a request. */
+    up();
+    CHECK(!c.rtr_skews);
+    CHECK(sja_model_rx(&m, 0x705, false, true, 1, zero) && inject(&sdo));
+    CHECK(sja1000_receive(&c, &g) && g.id == 0x705 && g.rtr && g.dlc == 1);
+    CHECK(sja1000_receive(&c, &g) && same_frame(&g, &sdo));
+    CHECK(!c.out_of_step && c.unread == 0u);
+    CLEAN();
+    /* QEMU's: RMC reads 0xFF; a remote frame with DLC 0 is read as usual. */
+    sja_model_new(&m);
+    m.qemu = true;
+    CHECK(sja1000_init(&c, &sja_model_io, &m, 16000000u, 125u));
+    CHECK(c.rtr_skews);
+    CHECK(sja_model_rx(&m, 0x705, false, true, 0, zero) && inject(&sdo));
+    CHECK(sja1000_receive(&c, &g) && g.id == 0x705 && g.rtr && g.dlc == 0);
+    CHECK(sja1000_receive(&c, &g) && same_frame(&g, &sdo));
+    CHECK(!c.out_of_step);
+    /* DLC 1: the remote frame comes out whole; the request behind it would
+     * be read one byte early (the model's window starts on the remote
+     * frame's data byte), so it is released unread. */
+    CHECK(sja_model_rx(&m, 0x705, false, true, 1, zero) && inject(&sdo));
+    CHECK(sja1000_receive(&c, &g) && g.id == 0x705 && g.rtr && g.dlc == 1);
+    CHECK(c.out_of_step);
+    CHECK_EQ(sja_model_read(&m, 16), 0x00); /* not the request's 0x08 */
+    CHECK(!sja1000_receive(&c, &g));
+    CHECK_EQ(c.unread, 1);
+    CHECK_EQ(m.rmc, 0);
+    /* and so every later frame: none is misread, none is returned */
+    for (unsigned i = 0; i < 4u; i++) {
+        CHECK(inject(&sdo));
+    }
+    CHECK(!sja1000_receive(&c, &g));
+    CHECK_EQ(c.unread, 5);
+    CLEAN();
+    /* An extended remote frame with a DLC does the same; before it, an
+     * extended data frame is skipped as ever. */
+    up();
+    m.qemu = true;
+    c.rtr_skews = true; /* as sja1000_init finds QEMU's */
+    CHECK(sja_model_rx(&m, 0x1ABCDEu, true, false, 2, zero));
+    CHECK(sja_model_rx(&m, 0x1ABCDEu, true, true, 8, zero) && inject(&sdo));
+    CHECK(!sja1000_receive(&c, &g));
+    CHECK(c.out_of_step);
+    CHECK_EQ(c.unread, 1);
+    CLEAN();
+}
+
 /* One call reads at most what the FIFO holds: behind unlisted frames the
  * listed one comes out; with none listed the call ends with the FIFO empty. */
 static void test_receive_skips_bounded(void)
@@ -1504,6 +1562,7 @@ int main(void)
     RUN(test_transmit_queue);
     RUN(test_receive_fifo_and_overrun);
     RUN(test_receive_skips_bounded);
+    RUN(test_receive_qemu_remote_frame);
     RUN(test_receive_bounded_under_flood);
     RUN(test_receive_reaches_the_last_in_a_full_fifo);
     RUN(test_error_states);
