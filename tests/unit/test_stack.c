@@ -1454,6 +1454,13 @@ static void test_bare_node_defaults(void)
     EXPECT(d, 0x720, "85");
     h_advance(d, 1000000);
     EXPECT_NONE(d);
+    /* No product hooks (ops NULL): the CAN state and the LEDs are the stack's own. */
+    co_node_set_can_state(d->node, CO_CAN_PASSIVE);
+    co_led_pattern_t green;
+    co_led_pattern_t red;
+    co_node_led_patterns(d->node, &green, &red);
+    CHECK_EQ(green, CO_LED_ON);
+    CHECK_EQ(red, CO_LED_FLASH1);
 }
 
 /*
