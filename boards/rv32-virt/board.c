@@ -197,6 +197,21 @@ bool co_port_can_send(void *port, const co_frame_t *f)
     return true;
 }
 
+/* Once, on the serial line: the controller's receive FIFO went out of step
+ * (sja1000_receive: QEMU's model after a remote frame with a DLC above 0),
+ * and the node hears no frame from the bus any more; docs/emulator.md. */
+static void tell_out_of_step(void)
+{
+    static bool told;
+    if (can.out_of_step && !told) {
+        told = true;
+        for (const char *s = "error: CAN receive FIFO out of step: no more frames\r"; *s != '\0';
+             s++) {
+            put(*s);
+        }
+    }
+}
+
 /* The serial line's input lines first; then a frame from the controller,
  * or, without one, a frame line from the serial line. With a controller an
  * SLCAN frame line on the UART is ignored: the bus is the controller's. A
@@ -213,6 +228,7 @@ bool board_can_receive(co_frame_t *f)
             return true;
         }
     }
+    tell_out_of_step();
     return false;
 }
 
