@@ -191,6 +191,10 @@ static void test_rx_ids_conditions(void)
         CHECK(ids[k].id < 0x600u || ids[k].id > 0x6FFu);
     }
     CHECK(!has(ids, n, 0x7FF, true)); /* nor guarding */
+    d->node->node_id = 0;             /* below 1..127: no node-ID either */
+    n = list(d->node, ids);
+    CHECK(!has(ids, n, 0x600, false));
+    CHECK(!has(ids, n, 0x700, true));
     d->node->node_id = 127;
     n = list(d->node, ids);
     CHECK(has(ids, n, 0x67F, false));
@@ -213,6 +217,10 @@ static void test_rx_ids_conditions(void)
     d->node->hbc.time_ms = 0;
     n = list(d->node, ids);
     CHECK(!has(ids, n, 0x701, false));
+    d->node->hbc.node_id = 0; /* a time without a producer: off too */
+    d->node->hbc.time_ms = 100;
+    n = list(d->node, ids);
+    CHECK(!has(ids, n, 0x700, false));
     /* A TPDO whose COB-ID forbids RTR (bit 30 set) is not listed for one. */
     d->node->tpdo[0].valid = true;
     d->node->tpdo[0].rtr_allowed = false;
@@ -221,6 +229,9 @@ static void test_rx_ids_conditions(void)
     d->node->tpdo[0].rtr_allowed = true;
     n = list(d->node, ids);
     CHECK(has(ids, n, d->node->tpdo[0].cob_id, true));
+    d->node->tpdo[0].valid = false; /* an invalid TPDO answers no RTR */
+    n = list(d->node, ids);
+    CHECK(!has(ids, n, d->node->tpdo[0].cob_id, true));
     /* A product without the RTR service (DST X730) lists no TPDO's RTR,
      * even with its COB-ID's bit 30 clear. */
     boot(&dst_x730_xy10);
