@@ -364,6 +364,29 @@ static void test_block_download_refusals(void)
     CHECK_EQ(h_read(d, 0x2000, 0), 100);
     /* Block download to a 70-byte writable object: out of memory at once. */
     SDO(d, "C6 07 20 00 46 00 00 00", "80 07 20 00 05 00 04 05");
+    /* No size indicated: the end's count of unused bytes gives it (4). */
+    SDO(d, "C0 00 20 00 00 00 00 00", "A4 00 20 00 0A 00 00 00");
+    SDO(d, "81 2C 01 00 00 00 00 00", "A2 01 0A 00 00 00 00 00");
+    SDO(d, "CD 00 00 00 00 00 00 00", "A1 00 00 00 00 00 00 00");
+    CHECK_EQ(h_read(d, 0x2000, 0), 300);
+    /* Two bytes, no size indicated: the write itself says "too low". */
+    SDO(d, "C0 00 20 00 00 00 00 00", "A4 00 20 00 0A 00 00 00");
+    SDO(d, "81 2C 01 00 00 00 00 00", "A2 01 0A 00 00 00 00 00");
+    SDO(d, "D5 00 00 00 00 00 00 00", "80 00 20 00 13 00 07 06");
+    CHECK_EQ(h_read(d, 0x2000, 0), 300);
+}
+
+/* Block upload: before the first block only "start upload" (cs 3) is the
+ * client's turn; an ack (cs 2) or an end (cs 1) there is refused. */
+static void test_block_upload_out_of_turn(void)
+{
+    boot();
+    SDO(d, "A4 00 10 00 7F 00 00 00", "C6 00 10 00 04 00 00 00");
+    SDO(d, "A2 00 7F 00 00 00 00 00", "80 00 10 00 01 00 04 05");
+    SDO(d, "A4 00 10 00 7F 00 00 00", "C6 00 10 00 04 00 00 00");
+    SDO(d, "A1 00 00 00 00 00 00 00", "80 00 10 00 01 00 04 05");
+    SDO(d, "A4 00 10 00 7F 00 00 00", "C6 00 10 00 04 00 00 00");
+    SDO(d, "A3 00 00 00 00 00 00 00", "81 91 01 00 00 00 00 00");
 }
 
 /* The block transfer's CRC (CiA 301: CRC-16-CCITT, x^16 + x^12 + x^5 + 1,
@@ -787,6 +810,7 @@ int main(void)
     RUN(test_integer8_limits);
     RUN(test_cobid_odd_base);
     RUN(test_block_download_refusals);
+    RUN(test_block_upload_out_of_turn);
     RUN(test_block_upload_refusals);
     RUN(test_block_crc);
     RUN(test_block_download_segments);
