@@ -1977,6 +1977,8 @@ static void test_tpdo_changed(void)
     CHECK(!co_tpdo_changed(d->node, 1)); /* TPDO2: its default mapping is unusable */
     SDO(d, "2B 01 20 00 03 00 00 00", "60 01 20 00 00 00 00 00");
     CHECK(co_tpdo_changed(d->node, 0));
+    h_rx(d, 0x080, ""); /* a SYNC samples no event-driven TPDO: still changed */
+    CHECK(co_tpdo_changed(d->node, 0));
     SDO(d, "2F 00 18 02 01 00 00 00", "60 00 18 02 00 00 00 00"); /* synchronous */
     CHECK(!co_tpdo_changed(d->node, 0));
 }
