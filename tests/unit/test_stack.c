@@ -1983,6 +1983,31 @@ static void test_tpdo_changed(void)
     CHECK(!co_tpdo_changed(d->node, 0));
 }
 
+/* An event send restarts the event timer (CiA 301: the timer counts from
+ * the last send); a synchronous TPDO takes no event. */
+static void test_tpdo_event_restarts_the_timer(void)
+{
+    boot();
+    h_rx(d, 0x000, "01 10");
+    NEXT_IS(0x190); /* the timer's first send (100 ms) */
+    h_advance(d, 30000);
+    EXPECT_NONE(d);
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 0);
+    NEXT_IS(0x190);
+    h_advance(d, 99999);
+    EXPECT_NONE(d); /* not at 100 ms: 100 ms after the event */
+    h_advance(d, 1);
+    NEXT_IS(0x190);
+    SDO(d, "2F 00 18 02 01 00 00 00", "60 00 18 02 00 00 00 00"); /* synchronous */
+    h_drain(d);
+    co_tpdo_event(d->node, 0);
+    h_advance(d, 1000);
+    EXPECT_NONE(d);
+    h_rx(d, 0x080, "");
+    NEXT_IS(0x190);
+}
+
 /* The inhibit time runs while its end is 1 us .. the inhibit time ahead of
  * the clock (which wraps after 2^32 us). An event 2^32 - 1 us (71.6 min)
  * after the last send finds that end the inhibit time + 1 us "ahead":
@@ -2059,6 +2084,7 @@ int main(void)
     RUN(test_rtr_service_passes_other_frames_on);
     RUN(test_rtr_answered_once);
     RUN(test_tpdo_changed);
+    RUN(test_tpdo_event_restarts_the_timer);
     RUN(test_tpdo_event_a_clock_turn_later);
     return h_finish();
 }
