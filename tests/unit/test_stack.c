@@ -1463,6 +1463,29 @@ static void test_bare_node_defaults(void)
     CHECK_EQ(red, CO_LED_FLASH1);
 }
 
+/* Before co_node_start() (NMT state initialising) a node serves no SDO
+ * and takes no NMT command or SYNC: what a board receives that early is
+ * dropped. */
+static void test_frames_before_start(void)
+{
+    static b_dev_t b;
+    static fake_port_t port;
+    fake_port_init(&port);
+    memset(&b, 0, sizeof(b));
+    void *const ram[CO_CLS_COUNT] = {NULL, &b.vol, NULL, NULL};
+    co_node_init(&b.node, &b_cfg, &port, &b, ram, 0);
+    CHECK_EQ(co_node_nmt_state(&b.node), CO_NMT_INIT);
+    co_frame_t sdo = {
+        .id = (uint16_t)(0x600u + co_node_id(&b.node)), .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}};
+    co_node_receive(&b.node, &sdo, 0);
+    co_frame_t start = {.id = 0x000, .dlc = 2, .data = {0x01, 0x00}};
+    co_node_receive(&b.node, &start, 0);
+    co_frame_t sync = {.id = 0x080, .dlc = 0};
+    co_node_receive(&b.node, &sync, 0);
+    CHECK_EQ(port.ntx, 0u);
+    CHECK_EQ(co_node_nmt_state(&b.node), CO_NMT_INIT);
+}
+
 /*
  * Communication parameters kept in no RAM (constants) yet given their
  * write hooks, as a product that fixes them might leave them: a write is
@@ -2073,6 +2096,7 @@ int main(void)
     RUN(test_sync_cobid_bits);
     RUN(test_emcy_cobid_restricted_and_as_written);
     RUN(test_bare_node_defaults);
+    RUN(test_frames_before_start);
     RUN(test_constant_parameters_refuse_writes);
     RUN(test_tpdo_restart_is_afresh);
     RUN(test_tpdo_unusable_default_mapping_after_reset);
