@@ -1390,7 +1390,17 @@ static const co_od_entry_t b_entries[] = {
 static const co_od_t b_od = {.entries = b_entries,
                              .count = sizeof(b_entries) / sizeof(b_entries[0])};
 
-static const co_service_t *const b_services[] = {&co_guard_service, NULL};
+static uint32_t quiet_poll(co_node_t *node, uint32_t now)
+{
+    (void)node;
+    (void)now;
+    return CO_NEVER;
+}
+
+/* A service that only polls (no receive, no reset), as a product's own may. */
+static const co_service_t quiet_service = {.poll = quiet_poll};
+
+static const co_service_t *const b_services[] = {&co_guard_service, &quiet_service, NULL};
 
 static const co_node_cfg_t b_cfg = {
     .od = &b_od,
