@@ -1508,6 +1508,8 @@ static void test_frames_before_start(void)
 static const co_od_entry_t c_entries[] = {
     {.index = 0x1000, .sub = 0, CO_TYPE_U32, .attr = CO_A_R | CO_A_CONST, .def = 0},
     {.index = 0x1005, .sub = 0, CO_TYPE_U32, .attr = CO_A_RW, .def = 0x80, CO_EXT(.write = co_sync_write_cobid)},
+    {.index = 0x1016, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 1},
+    {.index = 0x1016, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW, .def = 0x00050064, CO_EXT(.write = co_hbc_write_time)},
     {.index = 0x1017, .sub = 0, CO_TYPE_U16, .attr = CO_A_RW, .def = 0, CO_EXT(.write = co_hb_write_time)},
     {.index = 0x1800, .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 2},
     {.index = 0x1800, .sub = 1, CO_TYPE_U32, .attr = CO_A_RW | CO_A_NODEID, .def = 0x80000180u, CO_EXT(.write = co_tpdo_write_cobid)},
@@ -1541,8 +1543,11 @@ static const co_od_entry_t c_entries[] = {
 static const co_od_t c_od = {.entries = c_entries,
                              .count = sizeof(c_entries) / sizeof(c_entries[0])};
 
+static const co_service_t *const c_services[] = {&co_hbc_service, NULL};
+
 static const co_node_cfg_t c_cfg = {
     .od = &c_od,
+    .services = c_services,
     .ram_size = {0, sizeof(b_vol_t), 0, 0},
     .default_node_id = 0x20,
     .inhibit_unit_us = 5000, /* counts as 1000 (co_node_cfg_t) */
@@ -1600,6 +1605,13 @@ static void test_constant_parameters_refuse_writes(void)
     SDO(d, "2F 02 1A 00 02 00 00 00", "60 02 1A 00 00 00 00 00");
     h_rx(d, 0x080, "");
     EXPECT_NONE(d);
+    /* The heartbeat consumer (node 5, 100 ms) runs on through a refused
+     * write of its time: the heartbeat's absence is still an event. */
+    h_rx(d, 0x705, "05");
+    h_advance(d, 50000);
+    SDO(d, "23 16 10 01 C8 00 05 00", "80 16 10 01 02 00 01 06");
+    h_advance(d, 50000);
+    EXPECT(d, 0xA0, "30 81 11 00 00 00 00 00");
 }
 
 static void nmt_restart(void)
