@@ -232,11 +232,12 @@ bool sja1000_init(sja1000_t *c, const sja1000_io_t *io, void *ctx, uint32_t cloc
     if ((rd(c, SJA_CDR) & SJA_CDR_PELICAN) == 0u || rd(c, SJA_ACR0) != 0x5Au) {
         return false;
     }
-    /* RMC counts at most the messages the FIFO holds (none in reset mode).
-     * QEMU's model has no RMC (nor RBSA): it reads 0xFF there, and it is
-     * the model that stores a remote frame's data bytes (sja1000_receive).
-     * No register shows its FIFO's position, so this is the one check. */
-    c->rtr_skews = rd(c, SJA_RMC) > RX_FIFO_FRAMES;
+    /* RMC counts at most the 21 messages the FIFO holds (none in reset
+     * mode). QEMU's model has no RMC (nor RBSA): it reads 0xFF there, and
+     * it is the model that stores a remote frame's data bytes
+     * (sja1000_receive). No register shows its FIFO's position, so this
+     * is the one check. */
+    c->rtr_skews = rd(c, SJA_RMC) == 0xFFu;
     wr(c, SJA_OCR, SJA_OCR_NORMAL);
     open_filter(c);
     if (!reprogram(c, btr0, btr1)) {
