@@ -55,6 +55,16 @@ bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len);
  * beyond the EEPROM (what the bytes hold then is undefined: the store's
  * records survive it, co_store.h). */
 bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len);
+/** The len bytes from addr hold nothing the stack will read again before
+ * it writes them, and its next write there starts a record at addr: a
+ * board whose memory must be erased before it is written (flash) may
+ * erase them now, so that the write that follows needs no erase. The stack
+ * calls it only while no SDO answer is due (at start before the boot-up,
+ * and after CO_STORE_QUIET_US without a request: co_store.h), so that an
+ * erase of tens of milliseconds never delays an answer. Nothing to do for
+ * memory written in place (a file, a real EEPROM). A failure is not
+ * reported: the write that follows erases then, or fails itself. */
+void co_port_nvm_prepare(void *port, uint32_t addr, uint32_t len);
 /** @} */
 
 #endif /* CO_PORT_H */

@@ -15,11 +15,23 @@
  * and offset of every entry of the class), so a firmware whose layout
  * differs treats an old image as invalid instead of misreading it.
  *
+ * No SDO answer waits for a flash erase. The slot a save writes next holds
+ * only what nothing reads again (the record the newest replaced, or a save
+ * cut short), so the store offers it to the board to erase ahead
+ * (co_port_nvm_prepare) while no answer is due: at power-on before the
+ * boot-up, and after a save once no SDO request came for CO_STORE_QUIET_US
+ * (co_store_poll). A save's answer then waits for programming only. A
+ * product that stores every write on its own (cfg->autosave) answers the
+ * write when taken and stores it after that pause (co_node_write), one
+ * record for a burst of writes. A request that arrives while such work
+ * runs waits for it: the pause keeps a master's burst clear of it.
+ *
  * Ownership and errors: the records live in the board's EEPROM from the
  * node's nvm_base on (CO_STORE_NVM_SIZE bytes: co_port.h), the live values
  * in the product's class structs; state is co_store_t in the node. Every
  * call is synchronous (the board's writes return when durable) and runs
- * in the main loop, never from an interrupt. A failed NVM access is never
+ * in the main loop, never from an interrupt; only an autosave is put off
+ * (co_store_poll), never a save a master asked for. A failed NVM access is never
  * retried: a read makes the class CO_STORE_HW (defaults in use), a write
  * answers CO_E_HW; a refused save (signature, write-cycle limit) answers
  * CO_E_STORE. cls must be CO_CLS_PARA or CO_CLS_LSS, and a class the
@@ -66,15 +78,56 @@ typedef enum co_store_status {
     CO_STORE_HW,       /**< NVM read failed: defaults */
 } co_store_status_t;
 
+/** How long the SDO server must have been quiet (no request) before the
+ * store does work that can take a flash erase (co_store_poll): a master's
+ * burst of requests, even one slowed by a loaded host, has shorter gaps,
+ * so its answers never wait for the flash. */
+#define CO_STORE_QUIET_US 200000u
+/** The longest an autosaved write waits for a quiet SDO server: a master
+ * that polls faster than CO_STORE_QUIET_US for longer than this gets one
+ * answer late rather than the write left unstored. */
+#define CO_STORE_DEFER_MAX_US 2000000u
+
 /** Parameter store state in the node. */
 typedef struct co_store {
     uint32_t writes;              /**< save cycles so far (from the newest record) */
+    uint32_t sdo_at;              /**< time of the latest SDO request (co_node_receive) */
+    uint32_t due_at;              /**< time the oldest autosaved write not yet stored was taken */
     uint8_t status[CO_CLS_COUNT]; /**< co_store_status_t of the last restore */
+    uint8_t due;                  /**< work put off (CO_STORE_DUE_SAVE, CO_STORE_DUE_SPARE) */
 } co_store_t;
 
-/** Scan the NVM for the write count. Call once, on a node fresh from
- * co_node_init(), before the first restore (co_node_start does). */
+/** co_store_t.due: bit cls, an autosaved write of class cls waits to be
+ * stored; bit cls + 4, the slot the next save of cls writes may hold an
+ * old record (co_port_nvm_prepare). @{ */
+#define CO_STORE_DUE_SAVE(cls) (1u << (cls))
+#define CO_STORE_DUE_SPARE(cls) (16u << (cls))
+/** @} */
+
+/** Scan the NVM for the write count, and let the board erase ahead the
+ * slot each class's next save writes (co_port_nvm_prepare). Call once, on
+ * a node fresh from co_node_init(), before the first restore and before
+ * the node is on the bus (co_node_start does): an erase there delays the
+ * boot-up, never an answer. */
 void co_store_init(co_node_t *node);
+
+/**
+ * The store's work put off until the SDO server has been quiet for
+ * CO_STORE_QUIET_US (co_store_t.sdo_at): an autosaved write (co_node_write
+ * on a product with cfg->autosave) stored, then the slot the next save of
+ * a class writes offered to the board to erase ahead (co_port_nvm_prepare).
+ * One step a call, so that a request received in between is answered
+ * before the next. Returns the time until it wants to run again
+ * (co_node_poll). A deferred save that fails leaves the value in use and
+ * the class reported as CO_STORE_HW (the product's data-set error).
+ */
+uint32_t co_store_poll(co_node_t *node, uint32_t now);
+
+/** Store now what co_store_poll() would store later (autosaved writes):
+ * before a reset, which restores from the NVM, and at a board's orderly
+ * stop. A power cut before it loses those writes; the stored sets stay
+ * whole (the old ones). */
+void co_store_flush(co_node_t *node);
 
 /**
  * Restore the entries of class cls with index in [lo, hi] from the newest

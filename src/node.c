@@ -38,52 +38,27 @@ bool co_node_tx_drop(co_node_t *node)
 }
 
 /*
- * A write the product stores at once (cfg->autosave): the value, then its
- * class saved. When the save fails, the write is aborted (CO_E_HW or
- * CO_E_STORE), and an aborted write changes nothing (CiA 301: the value
- * was not taken): the class's RAM goes back to the copy taken before,
- * whole, since a hook may change more than its entry (a preset moves its
- * offset too). The hook then runs again with the former value, for what
- * it set going outside the RAM (the heartbeat's timer, a TPDO's state),
- * and the copy is put back once more, as a hook's store may differ from
- * the value it is given (the preset's offset follows the measurement).
- * Not inlined: the copy (at most CO_STORE_MAX_DATA bytes, the largest
- * class a store takes) is on the stack on this path only.
+ * A write the product stores on its own (cfg->autosave, CiA 301 0x1010
+ * bit 1): the value is taken and answered at once; its class is stored
+ * when the SDO server has been quiet for a while (co_store_poll), so that
+ * no answer waits for the flash and a master's burst of writes costs one
+ * record. A reset stores it first (co_node_reset), and so does a board's
+ * orderly stop (co_store_flush). A power cut before that loses the writes
+ * since the last record, which stays whole; a store that fails then is
+ * reported as the product's data-set error (co_store_poll), the value
+ * staying in use.
  */
-static CO_NOINLINE co_res_t write_stored(co_node_t *node, const co_od_entry_t *e,
-                                         const uint8_t *buf, uint32_t len)
-{
-    uint8_t before[CO_STORE_MAX_DATA];
-    co_cls_t cls = (co_cls_t)e->cls;
-    uint8_t *ram = node->ram[cls];
-    /* Bounded for the analyzer: a stored class fits a record (co_store.h). */
-    uint32_t size = co_min_u32(co_cfg(node)->ram_size[cls], sizeof(before));
-    if (ram != NULL) {
-        memcpy(before, ram, size);
-    }
-    co_res_t r = co_od_write(node, e, buf, len);
-    if (r != CO_OK) {
-        return r;
-    }
-    r = co_store_save(node, cls);
-    if (r != CO_OK && ram != NULL) {
-        memcpy(ram, before, size);
-        uint32_t v = 0;
-        co_od_write_fn hook = co_od_write_hook(e);
-        if (hook != NULL && e->type != CO_T_VSTR && co_od_get(node, e, &v) == CO_OK) {
-            (void)hook(node, e, v); /* the former value again: no new rule applies */
-            memcpy(ram, before, size);
-        }
-    }
-    return r;
-}
-
 co_res_t co_node_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len)
 {
-    if (co_cfg(node)->autosave && (e->cls == CO_CLS_PARA || e->cls == CO_CLS_LSS)) {
-        return write_stored(node, e, buf, len); /* the product stores every change */
+    co_res_t r = co_od_write(node, e, buf, len);
+    if (r == CO_OK && co_cfg(node)->autosave && (e->cls == CO_CLS_PARA || e->cls == CO_CLS_LSS)) {
+        co_store_t *s = &node->store;
+        if ((s->due & (CO_STORE_DUE_SAVE(CO_CLS_PARA) | CO_STORE_DUE_SAVE(CO_CLS_LSS))) == 0u) {
+            s->due_at = node->now; /* the oldest write waiting */
+        }
+        s->due |= (uint8_t)CO_STORE_DUE_SAVE(e->cls);
     }
-    return co_od_write(node, e, buf, len);
+    return r;
 }
 
 /* A restore, and the check of a record's values (co_store.h). */
@@ -97,6 +72,7 @@ static void restore(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi)
 void co_node_reset(co_node_t *node, co_reset_t kind)
 {
     co_node_wake(node);
+    co_store_flush(node); /* what the restore below reads must hold the writes taken */
     /* Silent while re-initialising: no state hook for INIT. */
     node->nmt.state = CO_NMT_INIT;
     if (kind == CO_RESET_NODE) {
@@ -233,6 +209,7 @@ uint32_t co_node_poll(co_node_t *node, uint32_t now)
         next = co_min_u32(next, co_cfg(node)->ops->poll(node, now));
     }
     next = co_min_u32(next, co_tpdo_poll(node, now));
+    next = co_min_u32(next, co_store_poll(node, now));
     /* Nothing can fall due before next unless something happens first.
      * No deadline at all: look again after half the clock's range. */
     node->due_never = next == CO_NEVER;

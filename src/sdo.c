@@ -242,6 +242,7 @@ CO_NOINLINE void co_sdo_receive(co_node_t *node, const co_frame_t *f)
     if (f->rtr || f->dlc != 8u || !co_nmt_sdo_allowed(node->nmt.state)) {
         return; /* CiA 301: SDO frames are 8 bytes; no SDO in stopped */
     }
+    node->store.sdo_at = node->now; /* the store's flash work waits for a pause (co_store_poll) */
     const uint8_t *d = f->data;
     co_sdo_t *sdo = &node->sdo;
     /* During a sub-block every frame is a segment: only 0x80 (sequence 0,

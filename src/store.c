@@ -146,6 +146,27 @@ static CO_NOINLINE newest_t newest(co_node_t *node, co_cls_t cls)
     return r;
 }
 
+/* The slot a record of cls is written to next: the other than the newest
+ * valid record's, slot 0 when there is none. */
+static unsigned target(const newest_t *nw)
+{
+    return nw->k == 0 ? 1u : 0u;
+}
+
+/* Offer the slot the next save of cls writes to the board to erase ahead
+ * (co_port_nvm_prepare). Only beside a valid record: the target then holds
+ * an older record or a save cut short, which nothing reads again. With no
+ * valid record (a blank or a corrupt set) nothing is erased, so that a
+ * corrupt set stays reported as such after a power cycle; its save then
+ * erases on its own path. */
+static void prepare(co_node_t *node, co_cls_t cls)
+{
+    newest_t nw = newest(node, cls);
+    if (nw.k >= 0 && !nw.hw) { /* a slot not read could hold the newest */
+        co_port_nvm_prepare(node->port, slot_addr(node, cls, target(&nw)), CO_STORE_SLOT);
+    }
+}
+
 void co_store_init(co_node_t *node)
 {
     /* Every save counts once, in every class's newest record from then on:
@@ -156,6 +177,7 @@ void co_store_init(co_node_t *node)
             if (nw.k >= 0 && nw.writes > node->store.writes) {
                 node->store.writes = nw.writes;
             }
+            prepare(node, (co_cls_t)cls); /* before the boot-up: nobody waits */
         }
     }
 }
@@ -372,8 +394,12 @@ static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags, group
     if (g != NULL) {
         g->from = (nw.k >= 0 && (nw.flags & FLAG_DEFAULTS) == 0u) ? nw.k : -1;
     }
-    /* Into the other slot than the newest record's, one sequence number on. */
-    co_res_t r = write_slot(node, cls, nw.k == 0 ? 1u : 0u, nw.k < 0 ? 1u : nw.seq + 1u, flags, g);
+    /* Into the other slot than the newest record's, one sequence number on.
+     * Then the slot the next save writes holds a record (the one this
+     * replaced, or this one cut short): erased ahead once the SDO server
+     * is quiet (co_store_poll). */
+    co_res_t r = write_slot(node, cls, target(&nw), nw.k < 0 ? 1u : nw.seq + 1u, flags, g);
+    node->store.due |= (uint8_t)CO_STORE_DUE_SPARE(cls);
     if (r != CO_OK) {
         return r;
     }
@@ -384,14 +410,76 @@ static co_res_t write_record(co_node_t *node, co_cls_t cls, uint8_t flags, group
     return CO_OK;
 }
 
+/* Only a product that stores its writes on its own has saves to put off:
+ * a constant in an image of a fixed config, which then drops the rest. */
+static bool autosaves(const co_node_t *node)
+{
+    return co_cfg(node)->autosave;
+}
+
+/* A record of cls is about to replace what an autosave still due would
+ * store (the RAM struct, or the defaults a "load" asks for after it). */
+static void no_save_due(co_node_t *node, co_cls_t cls)
+{
+    if (autosaves(node)) {
+        node->store.due &= (uint8_t)~CO_STORE_DUE_SAVE(cls);
+    }
+}
+
 co_res_t co_store_save(co_node_t *node, co_cls_t cls)
 {
+    no_save_due(node, cls);
     return write_record(node, cls, 0, NULL);
 }
 
 co_res_t co_store_request_defaults(co_node_t *node, co_cls_t cls)
 {
+    no_save_due(node, cls);
     return write_record(node, cls, FLAG_DEFAULTS, NULL);
+}
+
+void co_store_flush(co_node_t *node)
+{
+    if (!autosaves(node)) {
+        return;
+    }
+    for (unsigned cls = CO_CLS_PARA; cls <= CO_CLS_LSS; cls++) {
+        /* A failure cannot be answered any more (the write was): the value
+         * stays in use and the set is reported as one the NVM could not
+         * take, as after a failed read. */
+        if ((node->store.due & CO_STORE_DUE_SAVE(cls)) != 0u &&
+            co_store_save(node, (co_cls_t)cls) != CO_OK) {
+            node->store.status[cls] = CO_STORE_HW;
+        }
+    }
+}
+
+uint32_t co_store_poll(co_node_t *node, uint32_t now)
+{
+    co_store_t *s = &node->store;
+    if (s->due == 0u) {
+        return CO_NEVER;
+    }
+    uint32_t quiet = now - s->sdo_at;
+    uint8_t saves = CO_STORE_DUE_SAVE(CO_CLS_PARA) | CO_STORE_DUE_SAVE(CO_CLS_LSS);
+    if (autosaves(node) && (s->due & saves) != 0u) {
+        /* The saves first; a master that never pauses gets one answer late
+         * after CO_STORE_DEFER_MAX_US rather than the writes left unstored. */
+        uint32_t waited = now - s->due_at;
+        if (quiet < CO_STORE_QUIET_US && waited < CO_STORE_DEFER_MAX_US) {
+            return co_min_u32(CO_STORE_QUIET_US - quiet, CO_STORE_DEFER_MAX_US - waited);
+        }
+        co_store_flush(node);
+        return 0;
+    }
+    if (quiet < CO_STORE_QUIET_US) {
+        return CO_STORE_QUIET_US - quiet;
+    }
+    /* One slot a call: a request received meanwhile is answered first. */
+    co_cls_t cls = (s->due & CO_STORE_DUE_SPARE(CO_CLS_PARA)) != 0u ? CO_CLS_PARA : CO_CLS_LSS;
+    s->due &= (uint8_t)~CO_STORE_DUE_SPARE(cls);
+    prepare(node, cls);
+    return 0;
 }
 
 co_res_t co_store_save_group(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi, bool defaults)

@@ -67,14 +67,43 @@ bool flash_ee_read(const flash_ee_t *fe, uint32_t addr, void *buf, uint32_t len)
     return true;
 }
 
+/* The slot of the page at page holds only erased bytes. Only the slot's
+ * bytes are ever programmed (the rest of its page stays as an erase left
+ * it); a cut erase can leave any of them programmed, so all are read. */
+static bool blank(const flash_ee_t *fe, uint32_t page)
+{
+    for (uint32_t i = 0; i < CO_STORE_SLOT; i += 2u) {
+        uint16_t v;
+        fe->ops->read(fe->ctx, page + i, &v, 2);
+        if (v != 0xFFFFu) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/* Erase the page of the slot at page unless it is blank already. */
+static bool clean(const flash_ee_t *fe, uint32_t page)
+{
+    return blank(fe, page) || fe->ops->erase(fe->ctx, page);
+}
+
+void flash_ee_prepare(const flash_ee_t *fe, uint32_t addr)
+{
+    uint32_t page;
+    if (addr < flash_ee_size(fe) && split(fe, addr, &page) == 0u) {
+        (void)clean(fe, page); /* a failure shows at the write */
+    }
+}
+
 bool flash_ee_write(const flash_ee_t *fe, uint32_t addr, const void *buf, uint32_t len)
 {
     if ((addr & 1u) != 0u || (len & 1u) != 0u || !in_one_slot(fe, addr, len)) {
         return false;
     }
     uint32_t page;
-    if (split(fe, addr, &page) == 0u && !fe->ops->erase(fe->ctx, page)) {
-        return false; /* a record starts: its page is erased first */
+    if (split(fe, addr, &page) == 0u && !clean(fe, page)) {
+        return false; /* a record starts: its page erased first, unless erased ahead */
     }
     const uint8_t *b = buf;
     for (uint32_t i = 0; i < len; i += 2u) {

@@ -5,7 +5,10 @@
  * in a flash page of its own. The store always writes a record from the
  * start of a slot (header, data, CRC, in order), and only into the slot
  * that does not hold the newest record; so a write at a slot's offset 0
- * erases that page first, then half-words are programmed. A power cut at
+ * erases that page first unless the slot is blank, then half-words are
+ * programmed. The store offers that slot ahead, when no SDO answer is due
+ * (co_port_nvm_prepare -> flash_ee_prepare), so that a save's answer waits
+ * for programming only, never for an erase (20-40 ms on an STM32F0). A power cut at
  * any step leaves the other slot's complete record, which the store finds
  * (tests/unit/test_flash_ee.c cuts at every step). Writes must be even in
  * address and length (the record layout is), and never program a half-word
@@ -38,5 +41,8 @@ typedef struct flash_ee {
 uint32_t flash_ee_size(const flash_ee_t *fe);
 bool flash_ee_read(const flash_ee_t *fe, uint32_t addr, void *buf, uint32_t len);
 bool flash_ee_write(const flash_ee_t *fe, uint32_t addr, const void *buf, uint32_t len);
+/* Erase the page of the slot starting at addr unless it is blank (what a
+ * write there would do first); any other addr is ignored. */
+void flash_ee_prepare(const flash_ee_t *fe, uint32_t addr);
 
 #endif /* FLASH_EE_H */

@@ -215,6 +215,12 @@ void app_log_store_status(const app_t *a)
 
 void app_shut_down(app_t *a)
 {
+    /* An orderly stop is not a power cut: what a product stores on its own
+     * after a pause (co_store_poll) is stored now, not lost with the
+     * process. SIGKILL is the power cut, and loses it as a device would. */
+    for (unsigned i = 0; i < a->nnodes; i++) {
+        co_store_flush(a->nodes[i]);
+    }
     if (a->tx.fd >= 0) {
         (void)lp_tx_flush(&a->tx, a->ports, a->nnodes);
         lp_log("%lu frames sent in %lu system calls", a->tx.frames, a->tx.calls);

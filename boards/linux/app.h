@@ -97,7 +97,8 @@ void app_log_states(app_t *a);
 /* Which stored sets could not be used at the start, in the log. */
 void app_log_store_status(const app_t *a);
 
-/* Send what is queued, LEDs off, sockets closed, the counts in the log,
+/* Autosaved writes still waiting for their pause stored (co_store_flush),
+ * what is queued sent, LEDs off, sockets closed, the counts in the log,
  * the EEPROM files' holds given back (app_release_nvm). */
 void app_shut_down(app_t *a);
 

@@ -601,3 +601,11 @@ bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
 {
     return lp_nvm_write(((lp_port_t *)port)->nvm, addr, buf, len);
 }
+
+/* A file is written in place: nothing to erase ahead. */
+void co_port_nvm_prepare(void *port, uint32_t addr, uint32_t len)
+{
+    (void)port;
+    (void)addr;
+    (void)len;
+}

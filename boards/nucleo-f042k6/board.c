@@ -264,6 +264,13 @@ bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
     return flash_ee_write(&eeprom, addr, buf, len);
 }
 
+void co_port_nvm_prepare(void *port, uint32_t addr, uint32_t len)
+{
+    (void)port;
+    (void)len;
+    flash_ee_prepare(&eeprom, addr);
+}
+
 /* ---- the sensor: a fixed test pattern ----------------------------------- */
 
 /* No sensor driver exists for this board: every input sweeps a triangle of

@@ -323,6 +323,16 @@ bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
     return fe != NULL && flash_ee_write(fe, addr, buf, len);
 }
 
+void co_port_nvm_prepare(void *port, uint32_t addr, uint32_t len)
+{
+    (void)port;
+    (void)len;
+    const flash_ee_t *fe = nvm();
+    if (fe != NULL) {
+        flash_ee_prepare(fe, addr);
+    }
+}
+
 /* ---- CAN controller -------------------------------------------------------- */
 
 /*

@@ -67,6 +67,13 @@ bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
     return true;
 }
 
+void co_port_nvm_prepare(void *port, uint32_t addr, uint32_t len)
+{
+    (void)port;
+    (void)addr;
+    (void)len;
+}
+
 static _Alignas(8) unsigned char mem[sizeof(product_any_t)];
 
 static co_node_t *boot(const product_t *p)

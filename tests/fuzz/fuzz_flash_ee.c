@@ -195,6 +195,13 @@ bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
     return flash_ee_write(&g_fe, addr, buf, len);
 }
 
+void co_port_nvm_prepare(void *port, uint32_t addr, uint32_t len)
+{
+    (void)port;
+    (void)len;
+    flash_ee_prepare(&g_fe, addr);
+}
+
 /* Power on: the product built afresh on the flash as it is. */
 static void boot(dev_t *d)
 {

@@ -113,7 +113,7 @@ class Facts:
     defaults: tuple              # their factory values
     set_a: tuple                 # their values of the first save
     set_b: tuple                 # and of the second (the one a power cut hits)
-    autosave: bool               # every SDO write is stored at once
+    autosave: bool               # every SDO write is stored on its own (after a pause)
     corrupt: Corrupt
     node_id_change: NodeIdChange  # None: no way to change it (the template)
     tpdo_cob: ID = ID(0x180)

@@ -397,12 +397,30 @@ def test_emcy_on_injected_fault(dut, facts):
         assert m is not None, "alarm not cleared"
 
 
+# A product that stores its writes on its own (facts.autosave) does so once
+# no SDO request came for a pause (CO_STORE_QUIET_US, 0.2 s, by the device's
+# clock, co_store.h), not before the answer: a test that cuts the power
+# after such a write waits this long first. The device's clock runs at least
+# as fast as the test's; the rest is room for a loaded machine to run it.
+STORE_QUIET_S = 0.2
+STORE_PAUSE_S = STORE_QUIET_S + 0.8
+
+
+def wait_stored(dut, facts):
+    """Wait until the device stored its autosaved writes, then until what it
+    stored would survive a power cut (Target.settle)."""
+    if facts.autosave:
+        time.sleep(STORE_PAUSE_S)
+    dut.target.settle()
+
+
 def test_save_restart_keeps_value(dut, facts):
     dut.power_on(facts.nodes)
     n = facts.nodes[0]
     write_set(dut, n, facts, facts.set_a)
     down(dut, n, 0x1010, 1, SAVE)
     write_set(dut, n, facts, facts.set_b)  # after the save: stored only where autosaved
+    wait_stored(dut, facts)
     assert dut.power_off() == 0
     dut.power_on(facts.nodes)
     want = facts.set_b if facts.autosave else facts.set_a
@@ -435,12 +453,16 @@ def test_power_cut_during_save(dut, facts):
     old, new = facts.set_a, facts.set_b
     landed, cuts = 0, []
     lo, hi, delay = 0.0, save_s, 0.0
+    if facts.autosave:
+        # The write is answered at once and stored after the pause: the cuts
+        # close in on the store's end, judged by what power on finds.
+        lo, hi, delay = 0.0, STORE_PAUSE_S + 2 * save_s, STORE_QUIET_S
     for _ in range(CUTS):
         if facts.autosave:
             # Each write stores itself: the cut hits the last write's store.
             before = (new[0],) + old[1:]
             write_set(dut, n, facts, before)
-            dut.target.settle()
+            wait_stored(dut, facts)
             index, sub, fmt = facts.stored[-1]
             request = expedited(index, sub, struct.pack(fmt, new[-1]))
         else:
@@ -449,13 +471,15 @@ def test_power_cut_during_save(dut, facts):
             request = expedited(0x1010, 1, SAVE)
         sent = dut.power_cut_after(0x600 + n, request, delay)
         answered = any(m.arbitration_id == 0x580 + n for m in sent)
-        landed += not answered
-        cuts.append(f"{delay * 1000:.1f}{'a' if answered else ''}")
         dut.power_on(facts.nodes)
         got = read_set(dut, n, facts)
         assert got in (before, new), f"cut {delay * 1000:.1f} ms after the request: " \
                                      f"stored {got}, want {before} or {new}"
         assert_no_corrupt_set(dut, n, facts)
+        if facts.autosave:
+            answered = got == new  # "a": after the store
+        landed += not answered
+        cuts.append(f"{delay * 1000:.1f}{'a' if answered else ''}")
         old, new = got, (old if got == new else new)
         lo, hi = (lo, delay) if answered else (delay, hi)
         delay = (lo + hi) / 2

@@ -113,6 +113,10 @@ typedef struct fake_port {
     unsigned read_faults; /* reads refused because reads_left ran out */
     uint16_t kbps;        /* last co_port_can_bitrate() */
     unsigned bitrate_calls;
+    unsigned prepares;      /* co_port_nvm_prepare() calls */
+    uint32_t prepared_addr; /* the last one's address */
+    uint32_t prepared_at;   /* the virtual time of the last one (h_dev_t.now) */
+    const uint32_t *clock;  /* the device's virtual clock, for prepared_at */
 } fake_port_t;
 
 void fake_port_init(fake_port_t *p);

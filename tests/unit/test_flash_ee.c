@@ -118,6 +118,13 @@ bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
     return flash_ee_write(ee, addr, buf, len);
 }
 
+void co_port_nvm_prepare(void *port, uint32_t addr, uint32_t len)
+{
+    (void)port;
+    (void)len;
+    flash_ee_prepare(ee, addr);
+}
+
 static _Alignas(8) unsigned char mem[sizeof(dst_dev_t)];
 static co_node_t *node;
 
@@ -185,15 +192,63 @@ static void test_power_cut_at_every_flash_step(void)
     CHECK_EQ(flash.refused, 0); /* never a half-word programmed twice */
 }
 
+/* A save's answer waits for programming only: the slot it writes was
+ * erased ahead, at power-on before the boot-up and whenever the SDO server
+ * has been quiet for CO_STORE_QUIET_US; a request restarts that wait. Every
+ * save keeps the newest set, which comes back after a power cycle. */
+static void test_erase_ahead_when_quiet(void)
+{
+    memset(flash.mem, 0xFF, sizeof(flash.mem));
+    flash.erases = 0;
+    power_on();
+    CHECK_EQ(sdo("2B 17 10 00 64 00 00 00"), 0); /* 0x1017 = 100 ms */
+    CHECK_EQ(sdo("23 10 10 01 73 61 76 65"), 0); /* slot 0 */
+    CHECK_EQ(sdo("2B 17 10 00 C8 00 00 00"), 0); /* 200 ms */
+    CHECK_EQ(sdo("23 10 10 01 73 61 76 65"), 0); /* slot 1 */
+    CHECK_EQ(flash.erases, 0);
+    /* Slot 0 holds the older record now. Quiet for just less than the
+     * wait: nothing erased; a read restarts the wait. */
+    CHECK(co_node_poll(node, CO_STORE_QUIET_US - 1u) > 0u);
+    CHECK_EQ(flash.erases, 0);
+    co_frame_t f = {.id = 0x67F, .dlc = 8};
+    h_hex("40 17 10 00 00 00 00 00", f.data, 8);
+    co_node_receive(node, &f, CO_STORE_QUIET_US - 1u);
+    CHECK_EQ(co_get_u32(&last_tx.data[4]), 200);
+    CHECK_EQ(co_node_poll(node, 2u * CO_STORE_QUIET_US - 2u), 1u);
+    CHECK_EQ(flash.erases, 0);
+    (void)co_node_poll(node, 2u * CO_STORE_QUIET_US - 1u); /* quiet long enough */
+    CHECK_EQ(flash.erases, 1);
+    CHECK_EQ(flash.mem[0], 0xFF); /* slot 0, the older record's */
+    CHECK_EQ(flash.mem[PAGE], 0x43);
+    (void)co_node_poll(node, 3u * CO_STORE_QUIET_US); /* once */
+    CHECK_EQ(flash.erases, 1);
+    CHECK_EQ(sdo("2B 17 10 00 2C 01 00 00"), 0); /* 300 ms */
+    CHECK_EQ(sdo("23 10 10 01 73 61 76 65"), 0); /* slot 0, erased ahead */
+    CHECK_EQ(flash.erases, 1);
+    /* Power on with both slots full: the older one is erased before the
+     * boot-up, the newest restored. */
+    power_on();
+    CHECK_EQ(flash.erases, 2);
+    CHECK_EQ(flash.mem[PAGE], 0xFF);
+    CHECK_EQ(get(0x1017, 0), 300);
+    CHECK_EQ(sdo("2B 17 10 00 90 01 00 00"), 0); /* 400 ms */
+    CHECK_EQ(sdo("23 10 10 01 73 61 76 65"), 0);
+    CHECK_EQ(flash.erases, 2);
+    power_on();
+    CHECK_EQ(get(0x1017, 0), 400);
+    CHECK_EQ(flash.refused, 0);
+}
+
 static void test_pages_and_alignment(void)
 {
     memset(flash.mem, 0xFF, sizeof(flash.mem));
     flash.erases = 0;
     power_on();
     CHECK_EQ(sdo("23 10 10 01 73 61 76 65"), 0);
-    CHECK_EQ(flash.erases, 1); /* one page per save */
     CHECK_EQ(sdo("23 10 10 01 73 61 76 65"), 0);
-    CHECK_EQ(flash.erases, 2);
+    CHECK_EQ(flash.erases, 0); /* both slots were blank */
+    CHECK_EQ(sdo("23 10 10 01 73 61 76 65"), 0);
+    CHECK_EQ(flash.erases, 1); /* no pause to erase ahead: on the save's path */
     /* The two PARA copies live in pages 0 and 1; the LSS set in pages 2, 3. */
     CHECK(flash.mem[0] == 0x43 && flash.mem[PAGE] == 0x43); /* "CoPS" magic */
     CHECK_EQ(flash.mem[2u * PAGE], 0xFF);
@@ -339,6 +394,7 @@ int main(void)
 {
     RUN(test_power_cut_at_every_flash_step);
     RUN(test_pages_and_alignment);
+    RUN(test_erase_ahead_when_quiet);
     RUN(test_unusable_geometry);
     RUN(test_flash_of_zeros_takes_a_save);
     RUN(test_slots_across_pages);

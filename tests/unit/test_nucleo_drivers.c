@@ -613,19 +613,38 @@ static void test_flash_driver(void)
     /* The EEPROM is 8 slots (co_port.h: no size query, a byte beyond is refused). */
     CHECK(co_port_nvm_read(NULL, 8u * CO_STORE_SLOT - 1u, back, 1));
     CHECK(!co_port_nvm_read(NULL, 8u * CO_STORE_SLOT, back, 1));
-    /* A record from a slot's start: its page erased, then half-words. */
+    /* A record from the start of a blank slot: half-words only. */
+    CHECK(co_port_nvm_write(NULL, 0, rec, sizeof(rec)));
+    CHECK_EQ(stm_flash_erases(), 0);
+    CHECK_EQ(stm_flash_programs(), sizeof(rec) / 2u);
+    /* From the start of a slot that holds one: its page erased first. */
     CHECK(co_port_nvm_write(NULL, 0, rec, sizeof(rec)));
     CHECK_EQ(stm_flash_erases(), 1);
-    CHECK_EQ(stm_flash_programs(), sizeof(rec) / 2u);
+    CHECK_EQ(stm_flash_programs(), sizeof(rec));
     CHECK(memcmp(stm_flash_mem() + (EE_BASE - STM_FLASH_BASE), rec, sizeof(rec)) == 0);
     CHECK(co_port_nvm_read(NULL, 0, back, sizeof(back)));
     CHECK(memcmp(back, rec, sizeof(rec)) == 0);
     CHECK_EQ(stm_peek32(FLASH_CR), FLASH_CR_LOCK); /* locked again, nothing selected */
     CHECK_EQ(stm_peek32(FLASH_SR), 0);             /* flags cleared */
     CLEAN();
+    /* Erased ahead (the store, when no answer is due): the slot's page,
+     * once; a blank slot or an address inside a slot is left alone. */
+    CHECK(co_port_nvm_write(NULL, 2u * CO_STORE_SLOT, rec, 8));
+    co_port_nvm_prepare(NULL, 2u * CO_STORE_SLOT, CO_STORE_SLOT);
+    CHECK_EQ(stm_flash_erases(), 2);
+    CHECK(co_port_nvm_read(NULL, 2u * CO_STORE_SLOT, back, 8));
+    CHECK(back[0] == 0xFF && back[7] == 0xFF);
+    co_port_nvm_prepare(NULL, 2u * CO_STORE_SLOT, CO_STORE_SLOT);
+    co_port_nvm_prepare(NULL, 10, CO_STORE_SLOT);
+    co_port_nvm_prepare(NULL, 8u * CO_STORE_SLOT, CO_STORE_SLOT);
+    CHECK_EQ(stm_flash_erases(), 2);
+    CHECK(co_port_nvm_read(NULL, 0, back, sizeof(back)) && memcmp(back, rec, sizeof(rec)) == 0);
+    CHECK(co_port_nvm_write(NULL, 2u * CO_STORE_SLOT, rec, 8)); /* no erase on its path */
+    CHECK_EQ(stm_flash_erases(), 2);
+    CLEAN();
     /* A record continued at an offset: programs only. */
     CHECK(co_port_nvm_write(NULL, 64, rec, 4));
-    CHECK_EQ(stm_flash_erases(), 1);
+    CHECK_EQ(stm_flash_erases(), 2);
     /* A half-word written twice: refused by the driver before the flash
      * sees it (no PGERR, no violation), the flash unchanged. */
     CHECK(!co_port_nvm_write(NULL, 64, back + 10, 2));
@@ -635,7 +654,7 @@ static void test_flash_driver(void)
     CHECK(co_port_nvm_write(NULL, 7u * CO_STORE_SLOT, rec, 8));
     CHECK(memcmp(stm_flash_mem() + 0x7C00u, rec, 8) == 0);
     CHECK(!co_port_nvm_write(NULL, 8u * CO_STORE_SLOT, rec, 2));
-    CHECK_EQ(stm_flash_erases(), 2);
+    CHECK_EQ(stm_flash_erases(), 2); /* slot 7 was blank */
     /* Write protection: erase refused (WRPRTERR), reported, flags cleared. */
     stm_flash_write_protect(6, true); /* 0x08006000..0x08006FFF */
     CHECK(!co_port_nvm_write(NULL, 0, rec, sizeof(rec)));
@@ -723,7 +742,8 @@ static void test_parameters_saved_and_restored(void)
     CHECK_EQ(sdo_over_bus(node, "2B 17 10 00 64 00 00 00", &v), 0x60); /* 0x1017 = 100 ms */
     CHECK_EQ(sdo_over_bus(node, "2B 00 18 05 0A 00 00 00", &v), 0x60); /* 0x1800:5 = 10 ms */
     CHECK_EQ(sdo_over_bus(node, "23 10 10 01 73 61 76 65", &v), 0x60); /* save */
-    CHECK(stm_flash_erases() >= 1u);
+    CHECK_EQ(stm_flash_erases(), 0); /* into a blank slot: programmed only */
+    CHECK(stm_flash_programs() > 0u);
     CLEAN();
     /* Reset the chip (the flash keeps its content) and start again. */
     stm_reset();

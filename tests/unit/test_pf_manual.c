@@ -276,38 +276,94 @@ static void test_v21_to_v24_zero_point_d12_to_d18(void)
     SDO(d, "40 10 60 00 00 00 00 00", "4B 10 60 00 00 00 00 00");
 }
 
-/* An aborted write changes nothing. The P+F stores every write at once;
- * when that save fails (the EEPROM refuses the write) the write is
- * answered 06060000h, and the value, what its hook moved with it (the
- * preset's offset) and what it set going (the heartbeat's timer) stay as
- * they were. */
-static void test_failed_autosave_changes_nothing(void)
+/* The P+F stores every write on its own (CiA 301 0x1010 bit 1), behind
+ * the answer: the write is answered when taken, with no EEPROM write on
+ * the answer's path, and stored once the SDO server has been quiet for
+ * CO_STORE_QUIET_US; a burst of writes costs one record. A power cut
+ * before that keeps the set stored before, whole. */
+static void test_autosave_behind_the_answer(void)
 {
     boot(&pf_inx360d);
-    settle(131700, 0);
+    unsigned before = d->port.nvm_writes;
+    uint32_t saves = d->node->store.writes;
     SDO(d, "2B 17 10 00 F4 01 00 00", "60 17 10 00 00 00 00 00"); /* 500 ms */
+    CHECK_EQ(d->port.nvm_writes, before);
+    h_advance(d, CO_STORE_QUIET_US - 1000u);
     SDO(d, "2F 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00"); /* scaling on */
-    long long out = h_read(d, 0x6010, 0);
-    long long offset = h_read(d, 0x6013, 0);
-    d->port.cut_after = 0; /* every EEPROM write fails from now */
-    SDO(d, "2B 17 10 00 84 03 00 00", "80 17 10 00 00 00 06 06"); /* 900 ms: aborted */
-    SDO(d, "40 17 10 00 00 00 00 00", "4B 17 10 00 F4 01 00 00"); /* still 500 */
-    SDO(d, "2B 12 60 00 64 00 00 00", "80 12 60 00 00 00 06 06"); /* preset 10.0: aborted */
-    CHECK_EQ(h_read(d, 0x6012, 0), 0);
-    CHECK_EQ(h_read(d, 0x6013, 0), offset);
-    CHECK_EQ(h_read(d, 0x6010, 0), out);
-    h_drain(d);
-    h_advance(d, 500000);
-    EXPECT(d, 0x701, "7F"); /* the heartbeat on its 500 ms, not 900 */
-    h_advance(d, 500000);
-    EXPECT(d, 0x701, "7F");
-    /* Writable again: the write is taken and stored. */
-    d->port.cut_after = -1;
+    h_advance(d, CO_STORE_QUIET_US - 1000u);
+    CHECK_EQ(d->port.nvm_writes, before); /* the second request restarted the wait */
+    h_advance(d, 1000u);
+    CHECK(d->port.nvm_writes > before);
+    CHECK_EQ(d->node->store.writes, saves + 1u); /* one record for both */
+    /* Cut before the pause: the stored set, whole. */
+    SDO(d, "2B 17 10 00 84 03 00 00", "60 17 10 00 00 00 00 00"); /* 900 ms */
+    h_advance(d, CO_STORE_QUIET_US - 1000u);
+    h_power_cycle(d);
+    EXPECT(d, 0x701, "00");
+    CHECK_EQ(h_read(d, 0x1017, 0), 500);
+    CHECK_EQ(h_read(d, 0x6011, 0), 2);
+    CHECK_EQ(co_node_store_status(d->node, CO_CLS_PARA), CO_STORE_OK);
+    /* A master that never pauses long enough (a read every 100 ms): the
+     * write is stored CO_STORE_DEFER_MAX_US after it all the same. */
     SDO(d, "2B 17 10 00 84 03 00 00", "60 17 10 00 00 00 00 00");
+    before = d->port.nvm_writes;
+    uint32_t t0 = d->now;
+    while (d->port.nvm_writes == before && d->now - t0 < 2u * CO_STORE_DEFER_MAX_US) {
+        h_advance(d, 100000u);
+        SDO(d, "40 17 10 00 00 00 00 00", "4B 17 10 00 84 03 00 00");
+    }
+    CHECK(d->now - t0 >= CO_STORE_DEFER_MAX_US && d->now - t0 <= CO_STORE_DEFER_MAX_US + 100000u);
     h_power_cycle(d);
     EXPECT(d, 0x701, "00");
     CHECK_EQ(h_read(d, 0x1017, 0), 900);
-    CHECK_EQ(h_read(d, 0x6012, 0), 0);
+}
+
+/* A reset stores a write still waiting for its pause first (its restore
+ * reads the EEPROM), and a "load" (1011h) drops it: the defaults it asks
+ * for are the newest record, not the values in use. */
+static void test_autosave_before_reset_not_after_load(void)
+{
+    boot(&pf_inx360d);
+    SDO(d, "2B 14 60 00 0A 00 00 00", "60 14 60 00 00 00 00 00"); /* 6014h = 10 */
+    h_rx(d, 0x000, "81 01");                                      /* reset node at once */
+    EXPECT(d, 0x701, "00");
+    CHECK_EQ(h_read(d, 0x6014, 0), 10);
+    h_power_cycle(d);
+    EXPECT(d, 0x701, "00");
+    CHECK_EQ(h_read(d, 0x6014, 0), 10);
+    SDO(d, "2B 14 60 00 14 00 00 00", "60 14 60 00 00 00 00 00"); /* 20, waiting */
+    SDO(d, "23 11 10 01 6C 6F 61 64", "60 11 10 01 00 00 00 00"); /* load */
+    h_advance(d, 2u * CO_STORE_QUIET_US);
+    h_power_cycle(d);
+    EXPECT(d, 0x701, "00");
+    CHECK_EQ(h_read(d, 0x6014, 0), 0);
+}
+
+/* When the store behind a write fails (the EEPROM refuses it), the write
+ * was answered already: the value stays in use and the stored set is
+ * reported bad (EMCY 6300h, as for a set that cannot be read) until a
+ * store works again. */
+static void test_failed_autosave_reported(void)
+{
+    boot(&pf_inx360d);
+    SDO(d, "2B 17 10 00 F4 01 00 00", "60 17 10 00 00 00 00 00"); /* 500 ms */
+    h_advance(d, CO_STORE_QUIET_US);
+    d->port.cut_after = 0; /* every EEPROM write fails from now */
+    SDO(d, "2B 17 10 00 84 03 00 00", "60 17 10 00 00 00 00 00"); /* 900 ms: taken */
+    h_drain(d);
+    h_advance(d, CO_STORE_QUIET_US);
+    EXPECT_ID(d, 0x081, "00 63 01 00 00 00 00 00");
+    CHECK_EQ(co_node_store_status(d->node, CO_CLS_PARA), CO_STORE_HW);
+    SDO(d, "40 17 10 00 00 00 00 00", "4B 17 10 00 84 03 00 00"); /* in use */
+    d->port.cut_after = -1;
+    SDO(d, "2B 17 10 00 84 03 00 00", "60 17 10 00 00 00 00 00");
+    h_drain(d);
+    h_advance(d, CO_STORE_QUIET_US);
+    EXPECT_ID(d, 0x081, "00 00 00 00 00 00 00 00"); /* the set is sound again */
+    CHECK_EQ(co_node_store_status(d->node, CO_CLS_PARA), CO_STORE_OK);
+    h_power_cycle(d);
+    EXPECT(d, 0x701, "00");
+    CHECK_EQ(h_read(d, 0x1017, 0), 900);
 }
 
 /* The zero point sets the offset once, at the position of that
@@ -319,6 +375,7 @@ static void test_zero_point_kept_across_power_cycle(void)
     settle(131700, 0);
     SDO(d, "2F 11 60 00 02 00 00 00", "60 11 60 00 00 00 00 00"); /* scaling on */
     SDO(d, "2B 12 60 00 00 00 00 00", "60 12 60 00 00 00 00 00"); /* zero here */
+    h_advance(d, CO_STORE_QUIET_US); /* stored once the master pauses */
     d->truth[0] = 140000;
     h_power_cycle(d);
     EXPECT(d, 0x701, "00");
@@ -390,6 +447,7 @@ static void test_d25_stopped_and_d26_store(void)
     SDO(d, "2B 14 60 00 38 FF 00 00", "60 14 60 00 00 00 00 00");
     SDO(d, "2F 00 20 00 07 00 00 00", "60 00 20 00 00 00 00 00");
     SDO(d, "40 10 10 01 00 00 00 00", "43 10 10 01 03 00 00 00");
+    h_advance(d, CO_STORE_QUIET_US); /* stored once the master pauses */
     h_power_cycle(d);
     EXPECT(d, 0x707, "00");
     SDO(d, "40 14 60 00 00 00 00 00", "4B 14 60 00 38 FF 00 00");
@@ -407,6 +465,7 @@ static void test_eeprom_checksum_6300(void)
 {
     boot(&pf_inx360d);
     SDO(d, "2B 14 60 00 0A 00 00 00", "60 14 60 00 00 00 00 00"); /* autostored */
+    h_advance(d, CO_STORE_QUIET_US);
     for (unsigned s = 0; s < 2; s++) {
         d->port.nvm[s * CO_STORE_SLOT + CO_STORE_HDR + 1] ^= 0xFF;
     }
@@ -454,7 +513,9 @@ int main(void)
     RUN(test_v18_heartbeat_d21);
     RUN(test_v19_v20_guarding_d22_d24);
     RUN(test_v21_to_v24_zero_point_d12_to_d18);
-    RUN(test_failed_autosave_changes_nothing);
+    RUN(test_autosave_behind_the_answer);
+    RUN(test_failed_autosave_reported);
+    RUN(test_autosave_before_reset_not_after_load);
     RUN(test_zero_point_kept_across_power_cycle);
     RUN(test_lateral_zero_point);
     RUN(test_iny_axes_are_their_own);

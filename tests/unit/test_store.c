@@ -160,6 +160,66 @@ static void test_nvm_read_failure(void)
     CHECK_EQ(h_read(d, 0x4001, 0), DST_ERR_CHECKSUM);
 }
 
+/*
+ * The slot the next save writes is offered to the board to erase ahead
+ * (co_port_nvm_prepare; the fake port erases it), never one a restore
+ * needs: at power-on, before the boot-up, the older of two records; after
+ * a save, once no SDO request came for CO_STORE_QUIET_US, the record it
+ * replaced. A set with no valid record (blank, corrupt) is left alone, so
+ * a corrupt set stays reported after a power cycle; and so is a class
+ * whose slots could not be read.
+ */
+static void test_erase_ahead_rules(void)
+{
+    h_boot(d, &dst_x730_xy30, false);
+    CHECK_EQ(d->port.prepares, 0);                                /* blank: nothing to offer */
+    SDO(d, "2B 17 10 00 F4 01 00 00", "60 17 10 00 00 00 00 00"); /* 500 */
+    SAVE_OK();                                                    /* slot 0 */
+    SDO(d, "2B 17 10 00 58 02 00 00", "60 17 10 00 00 00 00 00"); /* 600 */
+    SAVE_OK();                                                    /* slot 1 */
+    CHECK_EQ(d->port.prepares, 0);
+    uint32_t para0 = d->node->nvm_base; /* PARA's slots are the first two */
+    h_advance(d, CO_STORE_QUIET_US - 1000u);
+    SDO(d, "40 17 10 00 00 00 00 00", "4B 17 10 00 58 02 00 00"); /* restarts the wait */
+    uint32_t asked = d->now;
+    h_advance(d, CO_STORE_QUIET_US + 1000u);
+    CHECK_EQ(d->port.prepares, 1);
+    CHECK_EQ(d->port.prepared_addr, para0);
+    CHECK_EQ(d->port.prepared_at - asked, CO_STORE_QUIET_US);
+    CHECK_EQ(d->port.nvm[para0], 0xFF);
+    h_advance(d, 10u * CO_STORE_QUIET_US);
+    CHECK_EQ(d->port.prepares, 1); /* once a save */
+    h_power_cycle(d);
+    CHECK_EQ(h_read(d, 0x1017, 0), 600);
+    CHECK_EQ(d->port.prepares, 2); /* slot 0 again, blank already */
+    CHECK_EQ(d->port.prepared_addr, para0);
+    SDO(d, "2B 17 10 00 BC 02 00 00", "60 17 10 00 00 00 00 00"); /* 700 */
+    SAVE_OK();                                                    /* slot 0 */
+    h_power_cycle(d);                                             /* no pause: both full */
+    CHECK_EQ(d->port.prepares, 3);
+    CHECK_EQ(d->port.prepared_addr, para0 + CO_STORE_SLOT); /* the older, 600 */
+    CHECK_EQ(h_read(d, 0x1017, 0), 700);
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_OK);
+    /* A corrupt set: no slot offered, still corrupt after a power cycle. */
+    d->port.nvm[para0 + CO_STORE_HDR] ^= 0x01u;
+    unsigned n = d->port.prepares;
+    h_power_cycle(d);
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    h_advance(d, 2u * CO_STORE_QUIET_US);
+    h_power_cycle(d);
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    CHECK(d->port.prepares == n || d->port.prepared_addr >= para0 + 2u * CO_STORE_SLOT);
+    /* Slots that cannot be read: nothing offered, nothing erased. */
+    SAVE_OK();
+    n = d->port.prepares;
+    d->port.nvm_read_fails = true;
+    h_power_cycle(d);
+    CHECK_EQ(d->port.prepares, n);
+    d->port.nvm_read_fails = false;
+    h_power_cycle(d);
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_OK);
+}
+
 static void test_write_limit(void)
 {
     h_boot(d, &dst_x730_xy30, false);
@@ -187,5 +247,6 @@ int main(void)
     RUN(test_layout_change_is_not_misread);
     RUN(test_nvm_read_failure);
     RUN(test_write_limit);
+    RUN(test_erase_ahead_rules);
     return h_finish();
 }
