@@ -829,6 +829,7 @@ static void test_emcy_table_and_history(void)
     SDO(d, "23 14 10 00 A0 00 00 80", "60 14 10 00 00 00 00 00"); /* new ID, still off */
     SDO(d, "23 14 10 00 A0 00 00 00", "60 14 10 00 00 00 00 00"); /* enable */
     SDO(d, "23 14 10 00 B0 00 00 00", "80 14 10 00 30 00 09 06"); /* valid: no change */
+    SDO(d, "23 14 10 00 A0 01 00 00", "80 14 10 00 30 00 09 06"); /* 1A0h: all 11 bits count */
     CHECK(co_emcy_send(d->node, 0x1234, 0, NULL));
     EXPECT(d, 0xA0, "34 12 00 00 00 00 00 00");
 }
