@@ -1480,11 +1480,11 @@ static void test_bare_node_defaults(void)
 static void test_frames_before_start(void)
 {
     static b_dev_t b;
-    static fake_port_t port;
-    fake_port_init(&port);
+    fake_port_t *port = &d->port; /* the device's, unused here: no second port in RAM */
+    fake_port_init(port);
     memset(&b, 0, sizeof(b));
     void *const ram[CO_CLS_COUNT] = {NULL, &b.vol, NULL, NULL};
-    co_node_init(&b.node, &b_cfg, &port, &b, ram, 0);
+    co_node_init(&b.node, &b_cfg, port, &b, ram, 0);
     CHECK_EQ(co_node_nmt_state(&b.node), CO_NMT_INIT);
     co_frame_t sdo = {
         .id = (uint16_t)(0x600u + co_node_id(&b.node)), .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}};
@@ -1493,7 +1493,7 @@ static void test_frames_before_start(void)
     co_node_receive(&b.node, &start, 0);
     co_frame_t sync = {.id = 0x080, .dlc = 0};
     co_node_receive(&b.node, &sync, 0);
-    CHECK_EQ(port.ntx, 0u);
+    CHECK_EQ(port->ntx, 0u);
     CHECK_EQ(co_node_nmt_state(&b.node), CO_NMT_INIT);
 }
 
