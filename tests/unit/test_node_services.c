@@ -823,6 +823,8 @@ static void test_tpdo_mapping_count_beyond_entries(void)
 {
     boot();
     SDO(d, "23 00 18 01 C0 01 00 80", "60 00 18 01 00 00 00 00"); /* invalidate TPDO1 */
+    /* Invalid or not, an 11-bit CAN-ID: bit 12 (here 11C0h) is refused. */
+    SDO(d, "23 00 18 01 C0 11 00 80", "80 00 18 01 30 00 09 06");
     SDO(d, "2F 00 1A 00 03 00 00 00", "80 00 1A 00 00 00 02 06"); /* sub 3 is 0 */
     SDO(d, "2F 00 1A 00 04 00 00 00", "80 00 1A 00 00 00 02 06"); /* no sub 4 */
     SDO(d, "2F 00 1A 00 08 00 00 00", "80 00 1A 00 00 00 02 06");
