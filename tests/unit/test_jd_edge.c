@@ -231,6 +231,18 @@ static void test_node_number_at_reset_node_only(void)
     CHECK_EQ(d->port.kbps, 500);
 }
 
+/* A request that names no object is aborted with 0000h sub 00h when no
+ * transfer is in progress (CiA 301), not with its data bytes read as an
+ * index (these once came back as "2211h sub 33"). */
+static void test_stray_sdo_aborts_name_no_object(void)
+{
+    boot(&jd2xxx);
+    SDO(d, "E0 11 22 33 44 55 66 77", "80 00 00 00 01 00 04 05"); /* reserved */
+    SDO(d, "00 11 22 33 44 55 66 77", "80 00 00 00 01 00 04 05"); /* download segment */
+    SDO(d, "61 11 22 33 44 55 66 77", "80 00 00 00 01 00 04 05"); /* upload segment */
+    SDO(d, "A1 11 22 33 44 55 66 77", "80 00 00 00 01 00 04 05"); /* block upload end */
+}
+
 /* 3005h = 1 starts the node on its own right after every
  * boot-up (power-on after a save, and a reset communication); 0 leaves it
  * pre-operational. */
@@ -811,5 +823,6 @@ int main(void)
     RUN(test_accel_cosines);
     RUN(test_lss_stores_across_power_cycles);
     RUN(test_lss_store_edges);
+    RUN(test_stray_sdo_aborts_name_no_object);
     return h_finish();
 }
