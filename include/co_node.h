@@ -144,7 +144,8 @@ typedef struct co_node_cfg {
                                       * 1000, so that 65535 units stay inside the 2^31 us a
                                       * wrapping deadline can span (a larger one counts as 1000) */
     uint32_t store_write_limit;      /**< 0: unlimited */
-    bool autosave;                   /**< every SDO write to a stored entry is stored at once */
+    bool autosave;                   /**< every SDO write to a stored entry is stored on its own,
+                                      * after the SDO server's pause (co_store_poll) */
     bool load_keeps_lss;             /**< 0x1011 "load" leaves node-ID and bit rate alone */
     bool comm_reset_applies_id;      /**< reset communication also activates a new node-ID */
     bool save_includes_lss;          /**< 0x1010 "save" stores the node-ID / bit-rate set too */
@@ -457,10 +458,10 @@ void co_node_leds(co_node_t *node, uint32_t now, bool *green, bool *red, uint32_
  * Write len bytes (little-endian) to entry e of the node's dictionary as an
  * SDO download does: co_od_write() (access, length, limits, write hook),
  * then, where the product stores every change (cfg->autosave), a save of
- * the entry's class (co_store_save()) at once. Returns co_od_write()'s
- * result, or the save's (CO_E_STORE, CO_E_HW) when the value was taken
- * but could not be stored. The SDO server writes through it, so that the
- * dictionary never calls the store (see the layering above).
+ * the entry's class made due: co_store_poll() stores it once the SDO
+ * server has paused (co_store.h), so that the answer never waits for the
+ * flash. Returns co_od_write()'s result. The SDO server writes through it,
+ * so that the dictionary never calls the store (see the layering above).
  */
 co_res_t co_node_write(co_node_t *node, const co_od_entry_t *e, const uint8_t *buf, uint32_t len);
 

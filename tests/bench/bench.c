@@ -129,6 +129,8 @@ BENCH_MEASURED uint32_t bench_poll(co_node_t *n, uint32_t now)
 #define BENCH_TPDO 3
 #define BENCH_IDLE_POLL 4
 #define BENCH_SYNC 5
+#define BENCH_SAVE 6
+#define BENCH_SAVE_JD 7
 #ifdef BENCH_BARE
 #define BENCH_HAS(op) (BENCH_BARE == (op))
 #else
@@ -198,6 +200,38 @@ static void op_sync(long count)
 }
 #endif
 
+#if BENCH_HAS(BENCH_SAVE) || BENCH_HAS(BENCH_SAVE_JD)
+/* 0x1010:1 "save", frame in to answer queued: the CPU's part of a save's
+ * answer (the records built, CRCs, both slots read back), the flash's own
+ * time left out (this port's EEPROM is RAM). Each save a changed value, so
+ * each writes its record. */
+static void saves(const product_t *p, long count)
+{
+    co_node_t *n = boot(p);
+    uint16_t id = (uint16_t)(0x600u + n->node_id);
+    co_frame_t hb = {.id = id, .dlc = 8, .data = {0x2B, 0x17, 0x10, 0x00}};
+    co_frame_t save = {
+        .id = id, .dlc = 8, .data = {0x23, 0x10, 0x10, 0x01, 0x73, 0x61, 0x76, 0x65}};
+    for (long i = 0; i < count; i++) {
+        hb.data[4] = (uint8_t)(100u + (unsigned)(i & 1)); /* the heartbeat 100 or 101 ms */
+        co_node_receive(n, &hb, 0);
+        bench_receive(n, &save, 0);
+    }
+}
+#endif
+#if BENCH_HAS(BENCH_SAVE)
+static void op_save(long count)
+{
+    saves(&dst_x730_xy30, count); /* PARA, and the LSS set when changed (unchanged here) */
+}
+#endif
+#if BENCH_HAS(BENCH_SAVE_JD)
+static void op_save_jd(long count)
+{
+    saves(&jd2xxx, count); /* the largest stored set of the products */
+}
+#endif
+
 /* What an operation must have sent last: a measured figure is only worth
  * something on the path it names, not on an abort or with nothing sent. */
 enum bench_kind { BENCH_ANSWER, BENCH_PDO, BENCH_NOTHING };
@@ -246,6 +280,10 @@ int main(void)
         {"idle-poll", op_idle_poll, BENCH_NOTHING};
 #elif BENCH_HAS(BENCH_SYNC)
         {"sync", op_sync, BENCH_PDO};
+#elif BENCH_HAS(BENCH_SAVE)
+        {"save", op_save, BENCH_ANSWER};
+#elif BENCH_HAS(BENCH_SAVE_JD)
+        {"save-jd", op_save_jd, BENCH_ANSWER};
 #else
 #error "BENCH_BARE: no such operation"
 #endif
@@ -261,9 +299,12 @@ int main(int argc, char **argv)
         {"tpdo", op_tpdo, BENCH_PDO},
         {"idle-poll", op_idle_poll, BENCH_NOTHING},
         {"sync", op_sync, BENCH_PDO},
+        {"save", op_save, BENCH_ANSWER},
+        {"save-jd", op_save_jd, BENCH_ANSWER},
     };
     if (argc != 3) {
-        fprintf(stderr, "usage: bench sdo-expedited|sdo-segment|tpdo|idle-poll|sync N\n");
+        fprintf(stderr,
+                "usage: bench sdo-expedited|sdo-segment|tpdo|idle-poll|sync|save|save-jd N\n");
         return 2;
     }
     const char *op = argv[1];

@@ -17,7 +17,9 @@ set(CO_BENCH_OPS
   "sdo-segment 2 pf_iny_cfg"
   "tpdo 3 dst_x730_cfg"
   "idle-poll 4 dst_x730_cfg"
-  "sync 5 jd2_cfg")
+  "sync 5 jd2_cfg"
+  "save 6 dst_x730_cfg"
+  "save-jd 7 jd2_cfg")
 set(CO_BENCH_DIR ${PROJECT_SOURCE_DIR}/tests/bench)
 add_custom_target(bench_m0 ALL)
 foreach(entry ${CO_BENCH_OPS})
