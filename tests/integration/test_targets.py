@@ -484,7 +484,8 @@ def test_power_cut_during_save(dut, facts):
         lo, hi = (lo, delay) if answered else (delay, hi)
         delay = (lo + hi) / 2
     print(f"{dut.target.name} {facts.family}: save {save_s * 1000:.1f} ms; cuts at "
-          f"{' '.join(cuts)} ms (a: after the answer); {landed}/{CUTS} before it")
+          f"{' '.join(cuts)} ms (a: after the {'store' if facts.autosave else 'answer'}); "
+          f"{landed}/{CUTS} before it")
     assert landed >= 1, "every cut came after the save's answer: this proved nothing"
 
 
