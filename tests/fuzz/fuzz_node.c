@@ -193,6 +193,7 @@ static uint64_t guard_life_us(co_node_t *n)
 static uint64_t config_bound(co_node_t *n)
 {
     uint64_t b = CO_SDO_TIMEOUT_US;
+    b = max64(b, CO_STORE_QUIET_US); /* the store's pause (co_store_poll) */
     b = max64(b, (uint64_t)n->hb.period_ms * 1000u);
     for (unsigned j = 0; j < CO_TPDO_MAX; j++) {
         b = max64(b, (uint64_t)n->tpdo[j].event_ms * 1000u);
