@@ -158,13 +158,15 @@ static unsigned target(const newest_t *nw)
  * an older record or a save cut short, which nothing reads again. With no
  * valid record (a blank or a corrupt set) nothing is erased, so that a
  * corrupt set stays reported as such after a power cycle; its save then
- * erases on its own path. */
-static void prepare(co_node_t *node, co_cls_t cls)
+ * erases on its own path. Returns the newest record found, which
+ * co_store_init needs too (one read of both slots). */
+static newest_t prepare(co_node_t *node, co_cls_t cls)
 {
     newest_t nw = newest(node, cls);
     if (nw.k >= 0 && !nw.hw) { /* a slot not read could hold the newest */
         co_port_nvm_prepare(node->port, slot_addr(node, cls, target(&nw)), CO_STORE_SLOT);
     }
+    return nw;
 }
 
 void co_store_init(co_node_t *node)
@@ -173,11 +175,11 @@ void co_store_init(co_node_t *node)
      * the count is the largest of them (co_node_init() zeroed it). */
     for (unsigned cls = CO_CLS_PARA; cls <= CO_CLS_LSS; cls++) {
         if (stored_class(node, (co_cls_t)cls)) {
-            newest_t nw = newest(node, (co_cls_t)cls);
+            /* The slot offered before the boot-up: nobody waits. */
+            newest_t nw = prepare(node, (co_cls_t)cls);
             if (nw.k >= 0 && nw.writes > node->store.writes) {
                 node->store.writes = nw.writes;
             }
-            prepare(node, (co_cls_t)cls); /* before the boot-up: nobody waits */
         }
     }
 }
@@ -478,7 +480,7 @@ uint32_t co_store_poll(co_node_t *node, uint32_t now)
     /* One slot a call: a request received meanwhile is answered first. */
     co_cls_t cls = (s->due & CO_STORE_DUE_SPARE(CO_CLS_PARA)) != 0u ? CO_CLS_PARA : CO_CLS_LSS;
     s->due &= (uint8_t)~CO_STORE_DUE_SPARE(cls);
-    prepare(node, cls);
+    (void)prepare(node, cls);
     return 0;
 }
 
