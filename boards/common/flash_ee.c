@@ -88,12 +88,13 @@ static bool clean(const flash_ee_t *fe, uint32_t page)
     return blank(fe, page) || fe->ops->erase(fe->ctx, page);
 }
 
+/* What a write at addr does before its first byte: an empty write, which
+ * cleans the page when addr starts a slot and does nothing anywhere else
+ * (no code of its own: the MCU images count every byte). A failure shows
+ * at the write. */
 void flash_ee_prepare(const flash_ee_t *fe, uint32_t addr)
 {
-    uint32_t page;
-    if (addr < flash_ee_size(fe) && split(fe, addr, &page) == 0u) {
-        (void)clean(fe, page); /* a failure shows at the write */
-    }
+    (void)flash_ee_write(fe, addr, NULL, 0);
 }
 
 bool flash_ee_write(const flash_ee_t *fe, uint32_t addr, const void *buf, uint32_t len)
