@@ -71,6 +71,10 @@ bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
     if (addr + len > FAKE_NVM_SIZE) {
         return false;
     }
+    if (p->fail_writes > 0u) {
+        p->fail_writes--;
+        return false; /* a write the EEPROM refuses; the next may work */
+    }
     const uint8_t *b = buf;
     for (uint32_t i = 0; i < len; i++) {
         if (p->cut_after == 0) {

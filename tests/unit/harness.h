@@ -106,7 +106,8 @@ typedef struct fake_port {
     unsigned rd;                /* frames consumed by h_next() */
     bool tx_full;               /* co_port_can_send() refuses */
     uint8_t nvm[FAKE_NVM_SIZE];
-    long cut_after; /* bytes that may still be written; -1 = no power cut */
+    long cut_after;       /* bytes that may still be written; -1 = no power cut */
+    unsigned fail_writes; /* the next this many writes fail (nothing written), then they work */
     unsigned nvm_writes;
     bool nvm_read_fails;
     long reads_left;      /* NVM reads that still succeed; -1 = all (a read fault after that) */

@@ -464,6 +464,43 @@ static void test_group_save(void)
     CHECK_EQ(h_read(d, 0x1800, 5), 500);
 }
 
+/* A corrupt stored set is reported until a full save makes it sound
+ * (co_store.h): a group save (1010h sub 2..4) writes a record but leaves
+ * the report, as the rest of the set is not what RAM holds. */
+static void test_only_a_full_save_clears_a_corrupt_set(void)
+{
+    boot(&gsh_a);
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    d->port.nvm[d->node->nvm_base + CO_STORE_HDR] ^= 0x01u; /* PARA's record, slot 0 */
+    h_power_cycle(d);
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    SDO(d, "23 10 10 02 73 61 76 65", "60 10 10 02 00 00 00 00"); /* communication group */
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_CORRUPT);
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00"); /* save all */
+    CHECK_EQ(d->node->store.status[CO_CLS_PARA], CO_STORE_OK);
+}
+
+/* Where 0x1010 stores the LSS set too (the GSH-A keeps its node-ID among
+ * the saved parameters), a save whose parameters could not be written
+ * stops there: answered 06060000h, the LSS set not written either, though
+ * the EEPROM would have taken it (one refused write, then working). */
+static void test_failed_save_stores_no_lss_set(void)
+{
+    boot(&gsh_a);
+    uint16_t boot_up = (uint16_t)(0x700u + d->node->node_id);
+    SDO(d, "2F 01 30 00 14 00 00 00", "60 01 30 00 00 00 00 00"); /* node-ID 20 next time */
+    d->port.fail_writes = 1;
+    SDO(d, "23 10 10 01 73 61 76 65", "80 10 10 01 00 00 06 06");
+    d->port.fail_writes = 1;
+    SDO(d, "23 10 10 04 73 61 76 65", "80 10 10 04 00 00 06 06"); /* the group with 3001h */
+    h_power_cycle(d);
+    EXPECT_ID(d, boot_up, "00"); /* the node-ID stored before */
+    SDO(d, "2F 01 30 00 14 00 00 00", "60 01 30 00 00 00 00 00");
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00"); /* both written */
+    h_power_cycle(d);
+    EXPECT_ID(d, 0x714, "00");
+}
+
 /* The write-cycle count (the 100 000 limit's, section 7) survives a restart
  * whole: a save writes the parameters and the LSS record (example 1 saves
  * 0x3001), and the count read back at start takes the LSS record's too (tools/mutate's
@@ -499,6 +536,8 @@ int main(void)
     RUN(test_redundant_channels_are_independent);
     RUN(test_channel2_node_id_default_after_a_bad_set);
     RUN(test_group_save);
+    RUN(test_only_a_full_save_clears_a_corrupt_set);
+    RUN(test_failed_save_stores_no_lss_set);
     RUN(test_write_count_across_restart);
     return h_finish();
 }
