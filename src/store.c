@@ -68,7 +68,8 @@ uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls)
     return h ^ co_cfg(node)->ram_size[cls];
 }
 
-static uint32_t slot_addr(const co_node_t *node, co_cls_t cls, unsigned copy)
+/* Not inlined: six callers; 24 bytes less in every MCU image. */
+static CO_NOINLINE uint32_t slot_addr(const co_node_t *node, co_cls_t cls, unsigned copy)
 {
     unsigned c = (cls == CO_CLS_PARA) ? 0u : 1u;
     return node->nvm_base + (c * 2u + copy) * CO_STORE_SLOT;
