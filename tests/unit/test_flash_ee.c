@@ -239,6 +239,32 @@ static void test_erase_ahead_when_quiet(void)
     CHECK_EQ(flash.refused, 0);
 }
 
+/* A slot is taken as erased only when every byte of it is: an erase cut
+ * short can leave any byte programmed, and one left there makes the write
+ * erase the page first. Nothing past the slot is read: with pages the
+ * size of a slot, the next page's record does not make a blank slot look
+ * used (no erase it does not need). */
+static void test_blank_means_every_byte(void)
+{
+    memset(flash.mem, 0xFF, sizeof(flash.mem));
+    flash.erases = 0;
+    flash.steps_left = -1;
+    uint8_t rec[CO_STORE_HDR];
+    memset(rec, 0x5A, sizeof(rec));
+    flash.mem[2] = 0x00; /* one byte a cut erase left programmed */
+    CHECK(flash_ee_write(&fe, 0, rec, sizeof(rec)));
+    CHECK_EQ(flash.erases, 1);
+    CHECK(memcmp(flash.mem, rec, sizeof(rec)) == 0);
+    static const flash_ee_t tight = {
+        .ops = &sim_ops, .ctx = NULL, .base = 0, .page_size = CO_STORE_SLOT, .pages = 4};
+    memset(flash.mem, 0xFF, sizeof(flash.mem));
+    flash.erases = 0;
+    flash.mem[CO_STORE_SLOT] = 0x43; /* slot 1, right behind slot 0: a record */
+    CHECK(flash_ee_write(&tight, 0, rec, sizeof(rec)));
+    CHECK_EQ(flash.erases, 0);
+    CHECK_EQ(flash.refused, 0);
+}
+
 static void test_pages_and_alignment(void)
 {
     memset(flash.mem, 0xFF, sizeof(flash.mem));
@@ -395,6 +421,7 @@ int main(void)
     RUN(test_power_cut_at_every_flash_step);
     RUN(test_pages_and_alignment);
     RUN(test_erase_ahead_when_quiet);
+    RUN(test_blank_means_every_byte);
     RUN(test_unusable_geometry);
     RUN(test_flash_of_zeros_takes_a_save);
     RUN(test_slots_across_pages);

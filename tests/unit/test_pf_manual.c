@@ -339,6 +339,18 @@ static void test_autosave_before_reset_not_after_load(void)
     CHECK_EQ(h_read(d, 0x6014, 0), 0);
 }
 
+/* A write the node refuses (an abort) changes nothing, so nothing is
+ * stored for it after the pause either. */
+static void test_refused_write_stores_nothing(void)
+{
+    boot(&pf_inx360d);
+    h_advance(d, 2u * CO_STORE_QUIET_US);
+    unsigned before = d->port.nvm_writes;
+    SDO(d, "2F 00 20 00 80 00 00 00", "80 00 20 00 31 00 09 06"); /* node-ID 128 */
+    h_advance(d, 2u * CO_STORE_QUIET_US);
+    CHECK_EQ(d->port.nvm_writes, before);
+}
+
 /* When the store behind a write fails (the EEPROM refuses it), the write
  * was answered already: the value stays in use and the stored set is
  * reported bad (EMCY 6300h, as for a set that cannot be read) until a
@@ -515,6 +527,7 @@ int main(void)
     RUN(test_v21_to_v24_zero_point_d12_to_d18);
     RUN(test_autosave_behind_the_answer);
     RUN(test_failed_autosave_reported);
+    RUN(test_refused_write_stores_nothing);
     RUN(test_autosave_before_reset_not_after_load);
     RUN(test_zero_point_kept_across_power_cycle);
     RUN(test_lateral_zero_point);
