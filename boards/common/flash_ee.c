@@ -33,20 +33,6 @@ static uint32_t split(const flash_ee_t *fe, uint32_t addr, uint32_t *page)
     return addr;
 }
 
-/* Physical address of logical EEPROM byte addr. */
-static uint32_t phys(const flash_ee_t *fe, uint32_t addr)
-{
-    uint32_t page;
-    uint32_t off = split(fe, addr, &page);
-    return page + off;
-}
-
-static bool in_one_slot(const flash_ee_t *fe, uint32_t addr, uint32_t len)
-{
-    uint32_t page;
-    return addr < flash_ee_size(fe) && len <= CO_STORE_SLOT - split(fe, addr, &page);
-}
-
 bool flash_ee_read(const flash_ee_t *fe, uint32_t addr, void *buf, uint32_t len)
 {
     uint8_t *b = buf;
@@ -99,17 +85,23 @@ void flash_ee_prepare(const flash_ee_t *fe, uint32_t addr)
 
 bool flash_ee_write(const flash_ee_t *fe, uint32_t addr, const void *buf, uint32_t len)
 {
-    if ((addr & 1u) != 0u || (len & 1u) != 0u || !in_one_slot(fe, addr, len)) {
+    if ((addr & 1u) != 0u || (len & 1u) != 0u || addr >= flash_ee_size(fe)) {
         return false;
     }
-    uint32_t page;
-    if (split(fe, addr, &page) == 0u && !clean(fe, page)) {
+    uint32_t page; /* split only after the size check: it walks slot by slot */
+    uint32_t off = split(fe, addr, &page);
+    if (len > CO_STORE_SLOT - off) {
+        return false; /* a write stays in one slot */
+    }
+    if (off == 0u && !clean(fe, page)) {
         return false; /* a record starts: its page erased first, unless erased ahead */
     }
+    /* The write lies in one slot (checked above): its bytes follow each
+     * other in the slot's page. */
     const uint8_t *b = buf;
     for (uint32_t i = 0; i < len; i += 2u) {
         uint16_t v = (uint16_t)(b[i] | (uint16_t)(b[i + 1u] << 8));
-        if (!fe->ops->program16(fe->ctx, phys(fe, addr + i), v)) {
+        if (!fe->ops->program16(fe->ctx, page + off + i, v)) {
             return false;
         }
     }
