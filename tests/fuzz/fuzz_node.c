@@ -291,15 +291,21 @@ bool co_port_nvm_read(void *port, uint32_t addr, void *buf, uint32_t len)
     return true;
 }
 
+/* Invariant 7: node k's records live in [k, k + 1) x CO_STORE_NVM_SIZE;
+ * what names the access (writes, erases) for the report. */
+static void check_area(const port_t *p, uint32_t addr, uint32_t len, const char *what)
+{
+    uint32_t base = p->k * CO_STORE_NVM_SIZE;
+    FZ_CHECK(addr >= base && addr <= base + CO_STORE_NVM_SIZE &&
+                 len <= base + CO_STORE_NVM_SIZE - addr,
+             "node %u %s EEPROM bytes %u..%u outside its area", p->k, what, addr, addr + len);
+}
+
 bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
 {
     port_t *p = port;
     dev_t *d = p->dev;
-    /* Invariant 7: node k's records live in [k, k + 1) x CO_STORE_NVM_SIZE. */
-    uint32_t base = p->k * CO_STORE_NVM_SIZE;
-    FZ_CHECK(addr >= base && addr <= base + CO_STORE_NVM_SIZE &&
-                 len <= base + CO_STORE_NVM_SIZE - addr,
-             "node %u writes EEPROM bytes %u..%u outside its area", p->k, addr, addr + len);
+    check_area(p, addr, len, "writes");
     const uint8_t *b = buf;
     for (uint32_t i = 0; i < len; i++) {
         if (d->cut_after == 0) {
@@ -321,10 +327,7 @@ void co_port_nvm_prepare(void *port, uint32_t addr, uint32_t len)
 {
     port_t *p = port;
     dev_t *d = p->dev;
-    uint32_t base = p->k * CO_STORE_NVM_SIZE;
-    FZ_CHECK(addr >= base && addr <= base + CO_STORE_NVM_SIZE &&
-                 len <= base + CO_STORE_NVM_SIZE - addr,
-             "node %u erases EEPROM bytes %u..%u outside its area", p->k, addr, addr + len);
+    check_area(p, addr, len, "erases");
     if (d->cut_after == 0) {
         d->cut_hit = true;
         return;
