@@ -19,8 +19,9 @@
  * only what nothing reads again (the record the newest replaced, or a save
  * cut short), so the store offers it to the board to erase ahead
  * (co_port_nvm_prepare) while no answer is due: at power-on before the
- * boot-up, and after a save once no SDO request came for CO_STORE_QUIET_US
- * (co_store_poll). A save's answer then waits for programming only. A
+ * boot-up, and after a save once no SDO or LSS request came for
+ * CO_STORE_QUIET_US (co_store_poll; to any node of the same flash:
+ * co_store_share_pause). A save's answer then waits for programming only. A
  * product that stores every write on its own (cfg->autosave) answers the
  * write when taken and stores it after that pause (co_node_write), one
  * record for a burst of writes. A request that arrives while such work
@@ -91,7 +92,7 @@ typedef enum co_store_status {
 /** Parameter store state in the node. */
 typedef struct co_store {
     uint32_t writes;              /**< save cycles so far (from the newest record) */
-    uint32_t sdo_at;              /**< time of the latest SDO request (co_node_receive) */
+    uint32_t sdo_at;              /**< time of the latest SDO or LSS request (co_node_receive) */
     uint32_t due_at;              /**< time the oldest autosaved write not yet stored was taken */
     uint8_t status[CO_CLS_COUNT]; /**< co_store_status_t of the last restore */
     uint8_t due;                  /**< work put off (CO_STORE_DUE_SAVE, CO_STORE_DUE_SPARE) */
@@ -122,6 +123,14 @@ void co_store_init(co_node_t *node);
  * the class reported as CO_STORE_HW (the product's data-set error).
  */
 uint32_t co_store_poll(co_node_t *node, uint32_t now);
+
+/** Nodes that share one flash (the two nodes of a redundant device in one
+ * image) share one pause: an erase ahead blocks the processor, so one
+ * node's erase would delay the other node's answers. Call it, with every
+ * such node, after a frame has been given to each of them and before any
+ * is polled (boards/common/mcu_main.c): a request to one restarts the wait
+ * of all. */
+void co_store_share_pause(co_node_t *const nodes[], unsigned n);
 
 /** Store now what co_store_poll() would store later (autosaved writes):
  * before a reset, which restores from the NVM, and at a board's orderly

@@ -168,6 +168,8 @@ bool co_lss_receive(co_node_t *node, const co_frame_t *f)
     if (f->dlc != 8u) {
         return true;
     }
+    /* An LSS master's answers wait for no erase either (co_store_poll). */
+    node->store.sdo_at = node->now;
     co_lss_t *l = &node->lss;
     const uint8_t *d = f->data;
     uint8_t cs = d[0];

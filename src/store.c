@@ -485,6 +485,19 @@ uint32_t co_store_poll(co_node_t *node, uint32_t now)
     return 0;
 }
 
+void co_store_share_pause(co_node_t *const nodes[], unsigned n)
+{
+    uint32_t at = nodes[0]->store.sdo_at;
+    for (unsigned i = 1; i < n; i++) {
+        if (co_time_before(at, nodes[i]->store.sdo_at)) {
+            at = nodes[i]->store.sdo_at;
+        }
+    }
+    for (unsigned i = 0; i < n; i++) {
+        nodes[i]->store.sdo_at = at;
+    }
+}
+
 co_res_t co_store_save_group(co_node_t *node, co_cls_t cls, uint16_t lo, uint16_t hi, bool defaults)
 {
     group_t g = {.lo = lo, .hi = hi, .defaults = defaults, .from = -1};

@@ -107,6 +107,11 @@ int main(void)
         while (board_can_receive(&f)) {
             for (unsigned i = 0; i < p->nodes; i++) {
                 co_node_receive(nodes[i], &f, now);
+            }
+            if (p->nodes > 1u) { /* one flash: a request to one node delays every node's erase */
+                co_store_share_pause(nodes, p->nodes);
+            }
+            for (unsigned i = 0; i < p->nodes; i++) {
                 co_node_poll(nodes[i], now); /* what the frame left to do, before the next one */
             }
         }

@@ -196,11 +196,18 @@ void h_advance(h_dev_t *d, uint32_t us)
     }
 }
 
+/* As boards/common/mcu_main.c: the frame to every node, their shared
+ * pause, then what it left to do. */
 void h_rx_frame(h_dev_t *d, const co_frame_t *f)
 {
     for (unsigned i = 0; i < d->nnodes; i++) {
         co_node_poll(d->nodes[i], d->now);
+    }
+    for (unsigned i = 0; i < d->nnodes; i++) {
         co_node_receive(d->nodes[i], f, d->now);
+    }
+    co_store_share_pause(d->nodes, d->nnodes);
+    for (unsigned i = 0; i < d->nnodes; i++) {
         co_node_poll(d->nodes[i], d->now);
     }
 }

@@ -464,6 +464,28 @@ static void test_group_save(void)
     CHECK_EQ(h_read(d, 0x1800, 5), 500);
 }
 
+/* The two nodes of the redundant version share one flash, so they share
+ * the pause an erase ahead waits for (co_store_share_pause): a request to
+ * channel 2 keeps channel 1's erase out of its burst too. */
+static void test_redundant_nodes_share_the_pause(void)
+{
+    boot(&gsh_a_redundant);
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00"); /* slot 0 the older */
+    unsigned n = d->port.prepares;
+    h_advance(d, CO_STORE_QUIET_US - 1000u);
+    h_rx(d, 0x614, "40 00 18 05 00 00 00 00"); /* channel 2 */
+    EXPECT_ID(d, 0x594, "4B 00 18 05 64 00 00 00");
+    uint32_t asked = d->now;
+    h_advance(d, CO_STORE_QUIET_US - 1000u);
+    CHECK_EQ(d->port.prepares, n); /* channel 1 quiet long enough, channel 2 not */
+    h_advance(d, 2000u);
+    CHECK_EQ(d->port.prepares, n + 2u); /* channel 1's older records, both classes */
+    /* Not before the pause (the harness clock steps 1 us at a sample). */
+    CHECK(d->port.prepared_at - asked >= CO_STORE_QUIET_US);
+    CHECK(d->port.prepared_addr < d->nodes[1]->nvm_base);
+}
+
 /* A corrupt stored set is reported until a full save makes it sound
  * (co_store.h): a group save (1010h sub 2..4) writes a record but leaves
  * the report, as the rest of the set is not what RAM holds. */
@@ -535,6 +557,7 @@ int main(void)
     RUN(test_rtr_answered);
     RUN(test_redundant_channels_are_independent);
     RUN(test_channel2_node_id_default_after_a_bad_set);
+    RUN(test_redundant_nodes_share_the_pause);
     RUN(test_group_save);
     RUN(test_only_a_full_save_clears_a_corrupt_set);
     RUN(test_failed_save_stores_no_lss_set);

@@ -231,6 +231,25 @@ static void test_node_number_at_reset_node_only(void)
     CHECK_EQ(d->port.kbps, 500);
 }
 
+/* An LSS request counts as an SDO request for the pause an erase ahead
+ * waits for (co_store_poll): an LSS master's answers wait for no erase. */
+static void test_lss_request_delays_the_erase_ahead(void)
+{
+    boot(&jd2xxx);
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00");
+    SDO(d, "23 10 10 01 73 61 76 65", "60 10 10 01 00 00 00 00"); /* slot 0 the older */
+    unsigned n = d->port.prepares;
+    h_advance(d, CO_STORE_QUIET_US - 1000u);
+    h_rx(d, 0x7E5, "5E 00 00 00 00 00 00 00"); /* inquire node-ID: not answered in waiting */
+    EXPECT_NONE(d);
+    uint32_t asked = d->now;
+    h_advance(d, CO_STORE_QUIET_US - 1000u);
+    CHECK_EQ(d->port.prepares, n);
+    h_advance(d, 2000u);
+    CHECK(d->port.prepares > n);
+    CHECK_EQ(d->port.prepared_at - asked, CO_STORE_QUIET_US);
+}
+
 /* A request that names no object is aborted with 0000h sub 00h when no
  * transfer is in progress (CiA 301), not with its data bytes read as an
  * index (these once came back as "2211h sub 33"). */
@@ -823,6 +842,7 @@ int main(void)
     RUN(test_accel_cosines);
     RUN(test_lss_stores_across_power_cycles);
     RUN(test_lss_store_edges);
+    RUN(test_lss_request_delays_the_erase_ahead);
     RUN(test_stray_sdo_aborts_name_no_object);
     return h_finish();
 }
