@@ -315,6 +315,7 @@ class Arguments(unittest.TestCase):
             with open(ids, "w") as fh:
                 fh.write("src/sync.c nosuch@0#0:a:b\n")
             cases = [(["--gate", "src=95,src=90"], "src given twice"),
+                     (["--gate", "src=95", "--gate", "src=90"], "src given twice"),
                      (["--gate", "nosuch=9"], "want DIR=PCT"),
                      (["--jobs", "0"], "--jobs wants 1 or more"),
                      (["--sample", "0"], "--sample wants 1 or more"),
