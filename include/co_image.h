@@ -53,15 +53,15 @@
 
 /** A header, decoded (co_image_parse). */
 typedef struct co_image_hdr {
-    uint32_t length;      /**< bytes of the whole image, header included */
-    uint32_t crc;         /**< CRC-32 of bytes CO_IMAGE_CRC_FROM .. length - 1 */
-    uint32_t board;       /**< CO_IMAGE_BOARD_* */
-    uint32_t device_type; /**< 1000h */
-    uint32_t vendor;      /**< 1018h:1 */
-    uint32_t product;     /**< 1018h:2 */
-    uint32_t revision;    /**< 1018h:3 */
-    uint32_t program_id;  /**< 1F56h:1 */
-    uint32_t load_addr;   /**< where the payload's first byte runs from (0: Linux) */
+    uint32_t length;               /**< bytes of the whole image, header included */
+    uint32_t crc;                  /**< CRC-32 of bytes CO_IMAGE_CRC_FROM .. length - 1 */
+    uint32_t board;                /**< CO_IMAGE_BOARD_* */
+    uint32_t device_type;          /**< 1000h */
+    uint32_t vendor;               /**< 1018h:1 */
+    uint32_t product;              /**< 1018h:2 */
+    uint32_t revision;             /**< 1018h:3 */
+    uint32_t program_id;           /**< 1F56h:1 */
+    uint32_t load_addr;            /**< where the payload's first byte runs from (0: Linux) */
     char id[CO_IMAGE_ID_LEN + 1u]; /**< product ID, NUL-terminated here */
 } co_image_hdr_t;
 
