@@ -136,6 +136,9 @@ typedef struct co_node_cfg {
     co_sdo_proto_fn sdo_segmented;
     co_sdo_proto_fn sdo_block;
     /** @} */
+    /** Downloads of the table's DOMAIN entries (co_sdo_domain_fn), or NULL:
+     * refused with 0x08000022. */
+    co_sdo_domain_fn sdo_domain;
     uint16_t ram_size[CO_CLS_COUNT]; /**< sizeof each class struct (0: none) */
     uint8_t default_node_id;         /**< what a blank EEPROM boots with (co_node_set_factory_id) */
     uint8_t default_bitrate;         /**< product's code for its default bit rate */

@@ -44,6 +44,7 @@ typedef enum co_type {
     CO_T_U16 = 0x06,
     CO_T_U32 = 0x07,
     CO_T_VSTR = 0x09,
+    CO_T_DOMAIN = 0x0F, /**< bytes of any length, streamed (co_node_cfg_t.sdo_domain) */
 } co_type_t;
 
 /** Attribute bits of an entry. */
@@ -240,6 +241,8 @@ static inline uint32_t co_od_size(const co_od_entry_t *e)
 #define CO_TYPE_I16 .type = CO_T_I16, .size = 2
 #define CO_TYPE_I32 .type = CO_T_I32, .size = 4
 #define CO_TYPE_STR(s) .type = CO_T_VSTR, .size = sizeof(s) - 1u, .cdata = (s)
+/** A DOMAIN: no value of its own; a download streams to co_node_cfg_t.sdo_domain. */
+#define CO_TYPE_DOMAIN .type = CO_T_DOMAIN, .size = 0
 /** @} */
 /** The manual's name of an entry, always its last field. The names serve
  * people and EDS files; an MCU image that prints no EDS builds with

@@ -11,6 +11,7 @@
 #define CO_PORT_H
 
 #include "co_common.h"
+#include "co_image.h"
 
 /**
  * Queue one frame for transmission. Must not block.
@@ -65,6 +66,64 @@ bool co_port_nvm_write(void *port, uint32_t addr, const void *buf, uint32_t len)
  * memory written in place (a file, a real EEPROM). A failure is not
  * reported: the write that follows erases then, or fails itself. */
 void co_port_nvm_prepare(void *port, uint32_t addr, uint32_t len);
+/** @} */
+
+/** @name Program download (co_progdl.h)
+ * Only an image that links the service needs them: the loader side
+ * (co_progdl_service: the bootloaders, the Linux program) all but
+ * co_port_prog_handover, the application side (a product image run by a
+ * bootloader) co_port_prog_handover alone. The program area holds the
+ * image (co_image.h) as downloaded, header included, at offsets from 0;
+ * where it lies in flash, and what "installed" means there, is the
+ * board's. None of these is called while an SDO answer waits, unless
+ * said; none is called from an interrupt. @{
+ */
+/** The loader's state, which the board owns and set up with
+ * co_progdl_init(): the same pointer at every call, never NULL. Called at
+ * every access to 1F50h-1F57h and every poll of the service. */
+struct co_progdl *co_port_progdl(void *port);
+/** Whether the image header h (complete, its format checked) is for this
+ * board and product and fits its area: CO_PROGDL_OK; CO_PROGDL_FORMAT
+ * (another board or product ID); CO_PROGDL_ADDRESS (h->length more than
+ * the area, or a load address this board does not run from). The stack
+ * checks 1000h and 1018h:1-2 itself. Reads h only, never blocks. */
+uint8_t co_port_prog_check(void *port, const co_image_hdr_t *h);
+/** Clear (1F51h:1 = 3): make the installed program invalid, for the
+ * bootloader and for a power cut alike, before its answer: at most one
+ * page erased (the answer is due within 100 ms). False: the flash failed
+ * (06060000h, status 5). */
+bool co_port_prog_clear(void *port);
+/** Write len (1 .. CO_SDO_BUF) bytes of the image, buf, at offset at of
+ * the area, durable when it returns true. Writes come in order after a
+ * clear, each where the last ended, from 0; the first write into a page
+ * erases it (one erase at most: pages are larger than CO_SDO_BUF), inside
+ * the SDO answer. at + len never exceeds the length the board accepted
+ * (co_port_prog_check). False: the flash failed (06060000h, status 5). */
+bool co_port_prog_write(void *port, uint32_t at, const void *buf, uint32_t len);
+/** Read len (1 .. CO_PROGDL_VERIFY_STEP) bytes of the area from at into
+ * buf, for the check after the download (1F57h busy). False: the flash
+ * failed (status 5). */
+bool co_port_prog_read(void *port, uint32_t at, void *buf, uint32_t len);
+/** The image h describes is in the area whole, its CRC checked as read
+ * back: make it the installed program, the one the next start boots
+ * (a board that boots whatever checks needs nothing here). Called from a
+ * poll, no answer waiting. False: the flash failed (status 5, no
+ * program). */
+bool co_port_prog_commit(void *port, const co_image_hdr_t *h);
+/** Start (1F51h:1 = 1), after its answer went out: boot the installed
+ * program (a bootloader resets into it; the Linux program runs it and
+ * boots up as it). Need not return. */
+void co_port_prog_start(void *port);
+/** Stop (1F51h:1 = 0) while started, after its answer went out: the
+ * running program stops, and the node stays, 1F51h:1 reading 0 (the Linux
+ * program stops its product's work). Need not return (a reset into the
+ * bootloader). */
+void co_port_prog_stop(void *port);
+/** The application side's stop (1F51h:1 = 0), called while its answer is
+ * being made: the board sets the flag its bootloader reads and resets
+ * once the answer has left (the board's main loop, after
+ * co_node_receive() returned). Must return. */
+void co_port_prog_handover(void *port);
 /** @} */
 
 #endif /* CO_PORT_H */

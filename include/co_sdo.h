@@ -59,6 +59,23 @@ typedef struct co_sdo {
  * it is none of its own (the server then aborts with 0x05040001). */
 typedef bool (*co_sdo_proto_fn)(co_node_t *node, const uint8_t *d);
 
+/**
+ * Where a download of a DOMAIN entry e goes (co_node_cfg_t.sdo_domain): the
+ * server holds no more than CO_SDO_BUF bytes of it and hands them over in
+ * order, at = the offset of buf's first byte in the object. A download
+ * begins with a call at 0 with no bytes (buf NULL, len 0, end false),
+ * which may refuse it (the initiate is answered with the abort); then each
+ * full buffer; then the rest with end true, before the answer to the last
+ * segment or the block end. Any result but CO_OK ends the transfer with
+ * that abort code. A transfer that ends otherwise (the client's abort,
+ * the timeout, a new request) is not reported: the next call at 0 begins
+ * anew. An expedited download is a begin and an end. Without a function
+ * (NULL) every download of a DOMAIN is refused with 08000022h (the
+ * application side of program download, co_progdl.h).
+ */
+typedef co_res_t (*co_sdo_domain_fn)(co_node_t *node, const co_od_entry_t *e, uint32_t at,
+                                     const uint8_t *buf, uint32_t len, bool end);
+
 /** SDO segmented transfer (sdo_segment.c): set as co_node_cfg_t.sdo_segmented
  * to offer it. Needed by any product with an object of more than 4 bytes.
  * Without it the server still takes segmented downloads of at most 4 bytes
