@@ -80,8 +80,9 @@ bool co_image_parse(const uint8_t b[CO_IMAGE_HDR_SIZE], co_image_hdr_t *h);
  * final XOR 0xFFFFFFFF, as zlib's crc32()) continued over len bytes:
  * start with crc 0 and hand each call the previous result, in any
  * pieces. Bitwise, no table (flash before speed: about 8 instructions a
- * bit).
+ * bit). data: len readable bytes (NULL only with len 0), not kept. The
+ * stored parameter records (co_store.h) use the same CRC.
  */
-uint32_t co_crc32(uint32_t crc, const uint8_t *data, uint32_t len);
+uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len);
 
 #endif /* CO_IMAGE_H */

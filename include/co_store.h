@@ -43,6 +43,7 @@
 #define CO_STORE_H
 
 #include "co_common.h"
+#include "co_image.h" /* co_crc32: a record's CRC is the program image's */
 #include "co_od.h"
 
 /** Bytes of one slot in NVM; a class's RAM struct must fit with the header. @{ */
@@ -200,9 +201,6 @@ bool co_store_limit_reached(const co_node_t *node);
 
 /** Layout hash of class cls in the node's dictionary. */
 uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls);
-
-/** CRC-32 (IEEE 802.3, reflected, init and xor 0xFFFFFFFF), chainable. */
-uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len);
 
 /**
  * Write hook for 0x1010 sub 1 "save all parameters": value must be the

@@ -35,19 +35,6 @@ typedef struct newest {
     uint32_t len;
 } newest_t;
 
-CO_NOINLINE uint32_t co_crc32(uint32_t crc, const void *data, uint32_t len)
-{
-    const uint8_t *p = data;
-    crc = ~crc;
-    for (uint32_t i = 0; i < len; i++) {
-        crc ^= p[i];
-        for (unsigned b = 0; b < 8u; b++) {
-            crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
-        }
-    }
-    return ~crc;
-}
-
 uint32_t co_store_layout_hash(const co_node_t *node, co_cls_t cls)
 {
     /* FNV-1a over (index, sub, size, offset) of every entry with RAM in cls.
