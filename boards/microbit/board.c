@@ -16,6 +16,7 @@
  */
 #include "board.h"
 
+#include "boot.h"
 #include "co_port.h"
 #include "flash_ee.h"
 #include "nrf51.h"
@@ -287,4 +288,13 @@ bool board_init(void)
     UART_INTENSET = UART_INT_RXDRDY;
     NVIC_ISER = (1u << UART_IRQ) | (1u << TIMER0_IRQ);
     return true;
+}
+
+/* A system reset (ARMv6-M SYSRESETREQ). The UART sends each byte before
+ * the next is written (put), so the answer to a stop has left. */
+void board_reset(void)
+{
+    SCB_AIRCR = 0x05FA0004u; /* the key, and a system reset */
+    for (;;) {
+    }
 }

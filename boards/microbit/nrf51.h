@@ -68,5 +68,6 @@
 
 /* Cortex-M0 core */
 #define NVIC_ISER REG(0xE000E100u)
+#define SCB_AIRCR REG(0xE000ED0Cu)
 
 #endif /* NRF51_H */

@@ -12,6 +12,7 @@
  */
 #include "board.h"
 
+#include "boot.h"
 #include "co_port.h"
 #include "flash_ee.h"
 #include "stm32f042.h"
@@ -315,4 +316,17 @@ bool board_init(void)
     WR32(SYST_CSR, 7u); /* processor clock, interrupt, enable */
     WR32(NVIC_ISER, 1u << CAN_IRQ);
     return true;
+}
+
+/* A system reset (ARMv6-M SYSRESETREQ) once the transmit mailboxes are
+ * empty, so that a frame just queued (the answer to a stop) is on the bus
+ * first; bounded: a bus that takes none (no ACK) does not hold the reset. */
+void board_reset(void)
+{
+    for (uint32_t n = 0; n < 100000u && (RD32(CAN_TSR) & (7u * CAN_TSR_TME0)) != 7u * CAN_TSR_TME0;
+         n++) {
+    }
+    WR32(SCB_AIRCR, SCB_AIRCR_SYSRESETREQ);
+    for (;;) {
+    }
 }

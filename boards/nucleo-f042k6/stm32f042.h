@@ -119,6 +119,8 @@
 #define SYST_RVR 0xE000E014u
 #define SYST_CVR 0xE000E018u
 #define NVIC_ISER 0xE000E100u
+#define SCB_AIRCR 0xE000ED0Cu
+#define SCB_AIRCR_SYSRESETREQ 0x05FA0004u /* the key, and a system reset */
 
 #define SYSCLK_HZ 48000000u
 

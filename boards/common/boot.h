@@ -1,0 +1,94 @@
+/*
+ * boot.h - the bootloader of the MCU boards and its hand-over with the
+ * application (docs/program-download.md, "Bootloaders and flash layouts").
+ *
+ * The bootloader (boot_main.c) is a node of this stack with NMT,
+ * heartbeat, SDO and the loader side of program download only. It runs
+ * under the installed product's node-ID, bit rate and identity, which it
+ * takes, best first, from:
+ *  1. the hand-over block: RAM at a fixed address (each board's link
+ *     scripts name it _boot_handover), written by the application just
+ *     before it resets into the bootloader on 1F51h:1 = 0 (stop);
+ *  2. the boot-info record, one flash page of its own, which the
+ *     bootloader writes from a hand-over whose identity it does not hold
+ *     yet, before anything of the application is erased: a power cut in
+ *     the middle of an update leaves a bootloader that still answers with
+ *     the product's 1000h and 1018h, as a CiA 302-2 master wants before it
+ *     downloads again;
+ *  3. neither (a board that was never updated and holds no valid
+ *     application): node-ID BOOT_DEFAULT_ID at BOOT_DEFAULT_KBPS, identity
+ *     0.
+ * Both carry the same bytes (boot_ident_t) with a magic and a CRC-32, so
+ * that RAM left from a power-on or a page half written reads as none.
+ */
+#ifndef BOOT_H
+#define BOOT_H
+
+#include <stddef.h>
+
+#include "co_common.h"
+#include "co_image.h"
+#include "flash_ee.h"
+
+#define BOOT_HANDOVER_MAGIC 0x4F564448u /* "HDVO": the hand-over block */
+#define BOOT_INFO_MAGIC 0x464E4942u     /* "BINF": the boot-info record */
+#define BOOT_DEFAULT_ID 127u            /* a blank board's node-ID (CiA 301's last) */
+#define BOOT_DEFAULT_KBPS 250u          /* and bit rate (CiA 301's default) */
+
+/* What the bootloader runs as. Little-endian words, 4-aligned, the same
+ * layout in RAM (hand-over) and flash (boot-info). */
+typedef struct boot_ident {
+    uint32_t magic;           /* BOOT_HANDOVER_MAGIC or BOOT_INFO_MAGIC */
+    uint32_t device_type;     /* 1000h */
+    uint32_t vendor;          /* 1018h:1 */
+    uint32_t product;         /* 1018h:2 */
+    uint32_t revision;        /* 1018h:3 */
+    uint32_t serial;          /* 1018h:4 */
+    uint8_t node_id;          /* the active node-ID, 1..127 */
+    uint8_t pad;              /* 0 */
+    uint16_t kbps;            /* the active bit rate, kbit/s */
+    char id[CO_IMAGE_ID_LEN]; /* product ID, from the installed image's header
+                               * (the bootloader's; a hand-over leaves it 0) */
+    uint32_t crc;             /* co_crc32 of the bytes before it */
+} boot_ident_t;
+
+/* Bytes of boot_ident_t covered by its CRC. */
+#define BOOT_IDENT_CRC_LEN ((uint32_t)offsetof(boot_ident_t, crc))
+
+/* Whether b holds a record with magic: the magic, the CRC, a node-ID of
+ * 1..127 and a bit rate. */
+bool boot_ident_valid(const boot_ident_t *b, uint32_t magic);
+
+/* Fill in b's magic and CRC. */
+void boot_ident_seal(boot_ident_t *b, uint32_t magic);
+
+/* ---- What a board provides to the bootloader -------------------------------
+ * One line each; none is called from an interrupt. */
+
+/* The application area: an image (header, then payload) from its base,
+ * erased a page at a time, pages the pages of the area (flash_ee.h's
+ * description reused: ops, ctx, base, page_size, pages). NULL: the board
+ * has no flash for it (the bootloader then holds no program). */
+const flash_ee_t *board_boot_area(void);
+/* The boot-info page: its first page only. NULL: none. */
+const flash_ee_t *board_boot_info(void);
+/* Whether h (an image header, its format checked) is for this board:
+ * CO_PROGDL_OK; CO_PROGDL_FORMAT for another board's code;
+ * CO_PROGDL_ADDRESS for a load address the board does not run from or a
+ * length beyond the area. */
+uint8_t board_boot_check(const co_image_hdr_t *h);
+/* Run the application whose image h describes (checked whole): never
+ * returns. The board makes the payload runnable (rv32-virt copies it to
+ * its load address) and enters it as its reset would. */
+_Noreturn void board_boot_app(const co_image_hdr_t *h);
+/* Reset the device, the CPU and the peripherals (RAM keeps its contents,
+ * as after a warm reset): never returns. */
+_Noreturn void board_reset(void);
+
+/* The application's side (boards/common/handover.c): write the hand-over
+ * block with identity b and reset into the bootloader. Never returns. The
+ * block may lie over the application's own memory: nothing of it is used
+ * after. */
+_Noreturn void boot_handover(const boot_ident_t *b);
+
+#endif /* BOOT_H */
