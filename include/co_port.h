@@ -93,9 +93,11 @@ uint8_t co_port_prog_check(void *port, const co_image_hdr_t *h);
  * page erased (the answer is due within 100 ms). False: the flash failed
  * (06060000h, status 5). */
 bool co_port_prog_clear(void *port);
-/** Write len (1 .. CO_SDO_BUF) bytes of the image, buf, at offset at of
- * the area, durable when it returns true. Writes come in order after a
- * clear, each where the last ended, from 0; the first write into a page
+/** Write len bytes of the image, buf, at offset at of the area, durable
+ * when it returns true. The first write is the header, CO_IMAGE_HDR_SIZE
+ * bytes at 0, once checked; then the rest in order, each where the last
+ * ended, at most CO_SDO_BUF bytes each and, but for the last, a multiple
+ * of 4 bytes long (so each starts at a multiple of 4). The first write into a page
  * erases it (one erase at most: pages are larger than CO_SDO_BUF), inside
  * the SDO answer. at + len never exceeds the length the board accepted
  * (co_port_prog_check). False: the flash failed (06060000h, status 5). */

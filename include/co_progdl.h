@@ -155,21 +155,22 @@ co_res_t co_progdl_app_write_control(co_node_t *node, const co_od_entry_t *e, ui
  * The table lines, in index order (between 1F4xh and 1F8xh, or whatever a
  * table holds around them): a product's table puts one of these where
  * its 1F5xh objects go. Access: 1F50h:1 wo DOMAIN, 1F51h:1 rw U8, 1F56h:1
- * and 1F57h:1 ro U32, every sub 0 const U8 1. @{
+ * and 1F57h:1 ro U32. The loader side has every array's sub 0 (const U8
+ * 1). The application side has sub 1 alone: the four sub 0 lines would
+ * cost the DST X730 image 64 of the 192 bytes of flash the whole of its
+ * side may take (tools/footprint.py), and no master reads them (CiA 302-2
+ * names sub 1, the program's number, in every access); reading one is
+ * 06090011h. @{
  */
 /* clang-format off */
 #define CO_PROGDL_SUB0_(idx, nm) \
     {.index = (idx), .sub = 0, CO_TYPE_U8, .attr = CO_A_R | CO_A_CONST, .def = 1, CO_NAME(nm)}
 #define CO_PROGDL_APP_ENTRIES \
-    CO_PROGDL_SUB0_(0x1F50, "Program data"), \
     {.index = 0x1F50, .sub = 1, CO_TYPE_DOMAIN, .attr = CO_A_W, CO_NAME("Program number 1")}, \
-    CO_PROGDL_SUB0_(0x1F51, "Program control"), \
     {.index = 0x1F51, .sub = 1, CO_TYPE_U8, .attr = CO_A_RW, .def = CO_PROGDL_STARTED, \
-     CO_EXT(.write = co_progdl_app_write_control), CO_NAME("Program number 1")}, \
-    CO_PROGDL_SUB0_(0x1F56, "Program software identification"), \
+     CO_EXT(.min = 0, .max = 3, .write = co_progdl_app_write_control), CO_NAME("Program number 1")}, \
     {.index = 0x1F56, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = CO_PROGRAM_ID, \
      CO_NAME("Program number 1")}, \
-    CO_PROGDL_SUB0_(0x1F57, "Flash status identification"), \
     {.index = 0x1F57, .sub = 1, CO_TYPE_U32, .attr = CO_A_R, .def = 0, CO_NAME("Program number 1")}
 #define CO_PROGDL_LOADER_ENTRIES \
     CO_PROGDL_SUB0_(0x1F50, "Program data"), \
@@ -186,5 +187,20 @@ co_res_t co_progdl_app_write_control(co_node_t *node, const co_od_entry_t *e, ui
      CO_EXT(.read = co_progdl_read_status), CO_NAME("Program number 1")}
 /* clang-format on */
 /** @} */
+
+/**
+ * What a family's table puts where its 1F5xh objects go: the application
+ * side in a product image for a board, which its bootloader runs (the MCU
+ * images' build defines CO_PROGDL_APP: boards/CMakeLists.txt); nothing
+ * elsewhere, so that the Linux program without its option, and the unit
+ * tests of the manuals, keep exactly the manual's dictionary (the Linux
+ * program adds the loader side at run time: boards/linux/prog.c). With a
+ * trailing comma where it has lines.
+ */
+#ifdef CO_PROGDL_APP
+#define CO_PROGDL_TABLE CO_PROGDL_APP_ENTRIES,
+#else
+#define CO_PROGDL_TABLE
+#endif
 
 #endif /* CO_PROGDL_H */

@@ -40,18 +40,24 @@ typedef struct co_node co_node_t;
 
 /** SDO server state in the node: one transfer at a time. */
 typedef struct co_sdo {
-    uint8_t state;           /**< idle / segmented download / segmented upload */
-    uint8_t toggle;          /**< expected toggle bit of the next segment (0 or 0x10) */
-    bool restart;            /**< a segment arrived: the timeout restarts at next poll */
-    const co_od_entry_t *e;  /**< the entry transferred */
-    uint32_t size;           /**< bytes of the transfer */
-    uint32_t pos;            /**< bytes done */
-    uint32_t deadline;       /**< end of the timeout */
-    uint8_t blksize;         /**< block transfer: segments per block */
-    uint8_t seq;             /**< block download: last good seqno; upload: segments sent */
-    bool crc;                /**< block transfer: both sides use the CRC */
-    bool sized;              /**< block download: the client indicated the size */
-    uint32_t blk_start;      /**< block upload: byte position of the current block */
+    uint8_t state;          /**< idle / segmented download / segmented upload */
+    uint8_t toggle;         /**< expected toggle bit of the next segment (0 or 0x10) */
+    bool restart;           /**< a segment arrived: the timeout restarts at next poll */
+    const co_od_entry_t *e; /**< the entry transferred */
+    union {
+        uint32_t size;  /**< bytes of the transfer */
+        uint32_t crc16; /**< a DOMAIN's block download: CRC-16 of the bytes handed over */
+    };
+    uint32_t pos;      /**< bytes done */
+    uint32_t deadline; /**< end of the timeout */
+    uint8_t blksize;   /**< block transfer: segments per block */
+    uint8_t seq;       /**< block download: last good seqno; upload: segments sent */
+    bool crc;          /**< block transfer: both sides use the CRC */
+    bool sized;        /**< block download: the client indicated the size */
+    union {
+        uint32_t blk_start; /**< block upload: byte position of the current block */
+        uint32_t done;      /**< a DOMAIN's download: bytes handed over (co_sdo_domain_fn) */
+    };
     uint8_t buf[CO_SDO_BUF]; /**< the data of a segmented or block download, a block upload */
 } co_sdo_t;
 
@@ -65,7 +71,9 @@ typedef bool (*co_sdo_proto_fn)(co_node_t *node, const uint8_t *d);
  * order, at = the offset of buf's first byte in the object. A download
  * begins with a call at 0 with no bytes (buf NULL, len 0, end false),
  * which may refuse it (the initiate is answered with the abort); then each
- * full buffer; then the rest with end true, before the answer to the last
+ * full piece (the largest multiple of 28 bytes within CO_SDO_BUF: 56 of
+ * 64; a block download's blocks are sized to fill one each, and the piece
+ * goes before the block's acknowledge); then the rest with end true, before the answer to the last
  * segment or the block end. Any result but CO_OK ends the transfer with
  * that abort code. A transfer that ends otherwise (the client's abort,
  * the timeout, a new request) is not reported: the next call at 0 begins

@@ -87,7 +87,9 @@ const co_od_entry_t *sdo_find(co_node_t *node, const uint8_t *d)
 
 /*
  * The object a download initiate (segmented or block) names: it must exist,
- * be writable, fit the buffer, and match an indicated size. NULL after
+ * be writable, fit the buffer, and match an indicated size; a DOMAIN, which
+ * streams through the buffer, must be taken by its handler (a size
+ * indicated is the handler's to check against what arrives). NULL after
  * answering with the abort.
  */
 const co_od_entry_t *sdo_download_target(co_node_t *node, const uint8_t *d, bool sized)
@@ -98,6 +100,7 @@ const co_od_entry_t *sdo_download_target(co_node_t *node, const uint8_t *d, bool
     }
     uint32_t size = co_get_u32(&d[4]);
     co_res_t r = (e->attr & CO_A_W) == 0u        ? CO_E_RO
+                 : e->type == CO_T_DOMAIN        ? sdo_domain_begin(node, e)
                  : sized && size > co_od_size(e) ? CO_E_LEN_HIGH
                  : sized && size < co_od_size(e) ? CO_E_LEN_LOW
                  : co_od_size(e) > CO_SDO_BUF    ? CO_E_OOM
@@ -130,6 +133,7 @@ static void download_initiate(co_node_t *node, const uint8_t *d)
     uint32_t size = co_od_size(e);
     uint32_t given = co_get_u32(&d[4]);
     co_res_t r = (e->attr & CO_A_W) == 0u                   ? CO_E_RO
+                 : e->type == CO_T_DOMAIN                   ? sdo_domain_begin(node, e)
                  : (d[0] & 0x03u) != 0x01u || given == size ? CO_OK
                  : given > size                             ? CO_E_LEN_HIGH
                                                             : CO_E_LEN_LOW;
@@ -138,7 +142,14 @@ static void download_initiate(co_node_t *node, const uint8_t *d)
     } else if ((d[0] & 0x02u) != 0u) {
         /* Size not indicated (0x22): the object's own size, at most 4. */
         uint32_t len = (d[0] & 0x01u) != 0u ? 4u - ((d[0] >> 2) & 0x03u) : co_min_u32(size, 4u);
-        r = co_node_write(node, e, &d[4], len);
+        co_sdo_domain_fn fn = co_cfg(node)->sdo_domain;
+        if (fn != NULL && e->type == CO_T_DOMAIN) {
+            /* Begun above (sdo_domain_begin): these bytes are all of it; a
+             * DOMAIN has no size of its own, so 4 where none is indicated. */
+            r = fn(node, e, 0, &d[4], (d[0] & 0x01u) != 0u ? len : 4u, true);
+        } else {
+            r = co_node_write(node, e, &d[4], len);
+        }
         if (r != CO_OK) {
             sdo_abort(node, d, r);
         } else {

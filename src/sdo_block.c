@@ -40,7 +40,8 @@ static void block_download_initiate(co_node_t *node, const uint8_t *d)
     sdo->pos = 0;
     sdo->seq = 0;
     sdo->crc = (d[0] & 0x04u) != 0u;
-    sdo->blksize = (uint8_t)BLKSIZE;
+    /* A DOMAIN's blocks fill a piece each (sdo_internal.h). */
+    sdo->blksize = (uint8_t)(e->type == CO_T_DOMAIN ? SDO_DOMAIN_BLKSIZE : BLKSIZE);
     sdo_restart(sdo);
     uint8_t out[8] = {0xA4, d[1], d[2], d[3], sdo->blksize, 0, 0, 0}; /* CRC supported */
     sdo_reply(node, out);
@@ -53,7 +54,12 @@ static void block_download_segment(co_node_t *node, const uint8_t *d)
     bool c = (d[0] & 0x80u) != 0u;
     bool last = c;
     sdo_restart(sdo);
-    if (seqno == (uint8_t)(sdo->seq + 1u)) {
+    bool domain = sdo->e->type == CO_T_DOMAIN;
+    if (seqno == (uint8_t)(sdo->seq + 1u) && domain) {
+        /* Never more than the piece: a block is sized to what it lacks. */
+        (void)sdo_domain_take(node, &d[1], 7u);
+        sdo->seq = seqno;
+    } else if (seqno == (uint8_t)(sdo->seq + 1u)) {
         if (sdo->pos > CO_SDO_BUF) { /* earlier segments brought more than the buffer */
             uint8_t mux[4];
             sdo_mux(sdo, mux);
@@ -69,6 +75,23 @@ static void block_download_segment(co_node_t *node, const uint8_t *d)
         last = false; /* out of sequence: ignored; the acknowledge says what came */
     }
     if (c || seqno >= sdo->blksize) {
+        if (domain && !last) {
+            /* A full piece goes to the handler before the acknowledge: the
+             * client waits for it, so a flash erase there loses no frame.
+             * The next block is what the piece lacks (all of it when one
+             * went). */
+            if (sdo->pos == SDO_DOMAIN_PIECE) {
+                sdo->crc16 = co_crc16_ccitt((uint16_t)sdo->crc16, sdo->buf, sdo->pos);
+                co_res_t r = sdo_domain_hand(node, false);
+                if (r != CO_OK) {
+                    uint8_t mux[4];
+                    sdo_mux(sdo, mux);
+                    sdo_abort(node, mux, r);
+                    return;
+                }
+            }
+            sdo->blksize = (uint8_t)((SDO_DOMAIN_PIECE - sdo->pos) / 7u);
+        }
         uint8_t ack[8] = {0xA2, sdo->seq, sdo->blksize, 0, 0, 0, 0, 0};
         sdo_reply(node, ack);
         if (last) {
@@ -76,6 +99,31 @@ static void block_download_segment(co_node_t *node, const uint8_t *d)
         }
         sdo->seq = 0;
     }
+}
+
+/* The end of a DOMAIN's block download: the last segment's unused bytes
+ * dropped, the CRC of the whole checked (its earlier pieces' part kept in
+ * crc16), the rest handed over before the answer. */
+static void domain_end(co_node_t *node, const uint8_t *d, const uint8_t mux[4], uint32_t unused)
+{
+    co_sdo_t *sdo = &node->sdo;
+    sdo->state = SDO_IDLE;
+    if (unused > sdo->pos) {
+        sdo_abort(node, mux, CO_E_LEN);
+        return;
+    }
+    sdo->pos -= unused;
+    if (sdo->crc && co_crc16_ccitt((uint16_t)sdo->crc16, sdo->buf, sdo->pos) != co_get_u16(&d[1])) {
+        sdo_abort(node, mux, CO_E_CRC);
+        return;
+    }
+    co_res_t r = sdo_domain_hand(node, true);
+    if (r != CO_OK) {
+        sdo_abort(node, mux, r);
+        return;
+    }
+    uint8_t out[8] = {0xA1, 0, 0, 0, 0, 0, 0, 0};
+    sdo_reply(node, out);
 }
 
 static void block_download_end(co_node_t *node, const uint8_t *d)
@@ -88,6 +136,10 @@ static void block_download_end(co_node_t *node, const uint8_t *d)
         return;
     }
     uint32_t unused = (d[0] >> 2) & 0x07u;
+    if (sdo->e->type == CO_T_DOMAIN) {
+        domain_end(node, d, mux, unused);
+        return;
+    }
     uint32_t len = sdo->pos - unused;
     sdo->state = SDO_IDLE;
     if (len > CO_SDO_BUF || (sdo->sized && len != sdo->size)) {

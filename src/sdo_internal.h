@@ -59,4 +59,42 @@ const co_od_entry_t *sdo_find(co_node_t *node, const uint8_t *d);
  * answering with the abort. */
 const co_od_entry_t *sdo_download_target(co_node_t *node, const uint8_t *d, bool sized);
 
+/* ---- DOMAIN downloads (co_node_cfg_t.sdo_domain, sdo_domain.c) ----
+ * The bytes collect in sdo->buf and go to the handler a piece at a time,
+ * sdo->done counting what it has; sdo->pos is what the buffer holds. */
+
+/* Bytes of a piece: the largest multiple of 28 (4 segments of 7 bytes)
+ * within the buffer, so that a block of SDO_DOMAIN_BLKSIZE segments fills
+ * one piece exactly and every piece but the last is a multiple of 4 bytes
+ * long and starts at a multiple of 4 (a flash written in words). A
+ * buffer below 28 bytes takes no DOMAIN download (CO_E_OOM). */
+#define SDO_DOMAIN_PIECE (CO_SDO_BUF / 28u * 28u)
+#define SDO_DOMAIN_BLKSIZE (SDO_DOMAIN_PIECE / 7u)
+
+/* A download of the DOMAIN e begins: the handler's answer (it may refuse
+ * it), 08000022h without a handler (the application side of program
+ * download), 05040005h with a buffer too small for a piece. Inline: where
+ * the config is fixed without a handler (CO_FIXED_CFG), it is the
+ * constant abort. */
+static inline co_res_t sdo_domain_begin(co_node_t *node, const co_od_entry_t *e)
+{
+    co_sdo_domain_fn fn = co_cfg(node)->sdo_domain;
+    if (fn == NULL) {
+        return CO_E_STATE;
+    }
+    if (SDO_DOMAIN_PIECE == 0u) {
+        return CO_E_OOM;
+    }
+    node->sdo.pos = 0;
+    node->sdo.done = 0;
+    return fn(node, e, 0, NULL, 0, false);
+}
+/* Take the n bytes at src: a full buffer goes to the handler first, so
+ * that what it gets is never the download's end, which only the caller
+ * knows. A refusal is the handler's code. */
+co_res_t sdo_domain_take(co_node_t *node, const uint8_t *src, uint32_t n);
+/* Hand what the buffer holds to the handler (end: the download's last
+ * bytes); the buffer is empty after it. */
+co_res_t sdo_domain_hand(co_node_t *node, bool end);
+
 #endif /* SDO_INTERNAL_H */

@@ -33,11 +33,39 @@ static bool initiate_download(co_node_t *node, const uint8_t *d)
     return e == NULL || begin(node, d, SDO_DOWNLOAD, e);
 }
 
+/* A segment of a DOMAIN's download (co_sdo_domain_fn), n bytes: the
+ * handler has the last ones before the answer. */
+static void domain_segment(co_node_t *node, const uint8_t *d, const uint8_t mux[4], uint32_t n)
+{
+    co_sdo_t *sdo = &node->sdo;
+    bool last = (d[0] & 0x01u) != 0u;
+    co_res_t r = sdo_domain_take(node, &d[1], n);
+    if (r == CO_OK && last) {
+        r = sdo_domain_hand(node, true);
+    }
+    if (r != CO_OK) {
+        sdo_abort(node, mux, r);
+        return;
+    }
+    uint8_t ack[8] = {(uint8_t)(0x20u | sdo->toggle), 0, 0, 0, 0, 0, 0, 0};
+    sdo->toggle ^= 0x10u;
+    if (last) {
+        sdo->state = SDO_IDLE;
+    } else {
+        sdo_restart(sdo);
+    }
+    sdo_reply(node, ack);
+}
+
 /* A segment with the expected toggle bit; mux names the transfer. */
 static void download_segment(co_node_t *node, const uint8_t *d, const uint8_t mux[4])
 {
     co_sdo_t *sdo = &node->sdo;
     uint32_t n = 7u - ((d[0] >> 1) & 0x07u);
+    if (sdo->e->type == CO_T_DOMAIN) {
+        domain_segment(node, d, mux, n);
+        return;
+    }
     if (sdo->pos + n > sdo->size) {
         sdo_abort(node, mux, CO_E_LEN_HIGH);
         return;
