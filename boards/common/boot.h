@@ -28,7 +28,9 @@
 
 #include "co_common.h"
 #include "co_image.h"
+#include "co_node.h"
 #include "flash_ee.h"
+#include "product.h"
 
 #define BOOT_HANDOVER_MAGIC 0x4F564448u /* "HDVO": the hand-over block */
 #define BOOT_INFO_MAGIC 0x464E4942u     /* "BINF": the boot-info record */
@@ -85,10 +87,18 @@ _Noreturn void board_boot_app(const co_image_hdr_t *h);
  * as after a warm reset): never returns. */
 _Noreturn void board_reset(void);
 
-/* The application's side (boards/common/handover.c): write the hand-over
- * block with identity b and reset into the bootloader. Never returns. The
- * block may lie over the application's own memory: nothing of it is used
- * after. */
+/* ---- The application's side (boot_ident.c) ---------------------------------- */
+
+/* Write the hand-over block with identity b and reset into the
+ * bootloader. Never returns. The block may lie over the application's own
+ * memory: nothing of it is used after. */
 _Noreturn void boot_handover(const boot_ident_t *b);
+
+/* The main loop's call after each frame's answer (mcu_main.c): when a
+ * stop asked for it (co_port_prog_handover), hand over node's node-ID,
+ * bit rate (product p's table) and identity (1000h, 1018h:1-4). A node
+ * without a node-ID (LSS unconfigured) or a bit rate hands over a block
+ * the bootloader does not take: it boots the application again. */
+void boot_handover_poll(co_node_t *node, const product_t *p);
 
 #endif /* BOOT_H */

@@ -241,13 +241,6 @@ void co_port_prog_stop(void *port)
     board_reset();
 }
 
-/* The application side's call: not linked into a loader; here for a
- * service file that holds both sides. */
-void co_port_prog_handover(void *port)
-{
-    (void)port;
-}
-
 /* The bit rate the bootloader runs at is the one it was given (boot.h),
  * whatever code the stack asks for: its table has none. */
 bool co_port_can_bitrate(void *port, uint16_t kbps)

@@ -10,8 +10,6 @@
 #include "co_node.h"
 #include "product.h"
 
-#include <string.h>
-
 #ifdef PRODUCT_HEADER
 #include PRODUCT_HEADER /* the product family's instance type, for PRODUCT_INST_SIZE */
 #endif
@@ -34,37 +32,6 @@ bool co_port_can_bitrate(void *port, uint16_t kbps)
 {
     (void)port;
     return board_can_bitrate(kbps != 0u ? kbps : 250u);
-}
-
-/* The application side of program download (co_progdl.h): a stop
- * (1F51h:1 = 0) asks for the hand-over; the main loop makes it once the
- * answer has gone out. */
-static bool handover_due;
-
-void co_port_prog_handover(void *port)
-{
-    (void)port;
-    handover_due = true;
-}
-
-/* Hand over to the bootloader (boot.h): node 0's node-ID, bit rate and
- * identity, then the reset. A node without a node-ID (LSS unconfigured)
- * or a bit rate hands over nothing the bootloader takes: it boots this
- * application again. */
-static CO_NOINLINE _Noreturn void handover(co_node_t *node, const product_t *p)
-{
-    boot_ident_t b;
-    memset(&b, 0, sizeof b);
-    uint32_t *w = &b.device_type; /* 1000h, then 1018h:1..4 */
-    for (uint8_t i = 0; i < 5u; i++) {
-        const co_od_entry_t *e = co_node_entry(node, i == 0u ? 0x1000u : 0x1018u, i);
-        if (e != NULL) {
-            (void)co_od_get(node, e, &w[i]);
-        }
-    }
-    b.node_id = co_node_id(node);
-    b.kbps = product_kbps(p, co_node_bitrate(node));
-    boot_handover(&b);
 }
 
 /* The LEDs; not inlined, so that its locals are not part of main's frame,
@@ -148,9 +115,6 @@ int main(void)
             for (unsigned i = 0; i < p->nodes; i++) {
                 co_node_poll(nodes[i], now); /* what the frame left to do, before the next one */
             }
-            if (handover_due) {
-                handover(nodes[0], p);
-            }
         }
 #ifdef BOARD_RX_FILTER
         /* Before the board sends what the frames just received produced
@@ -165,6 +129,7 @@ int main(void)
 #ifdef BOARD_RX_FILTER
         rx_filter(nodes, p->nodes);
 #endif
+        boot_handover_poll(nodes[0], p); /* after a stop, its answer on its way (board_can_state) */
         board_sleep(co_min_u32(wait, leds(nodes[0], now)));
     }
 }

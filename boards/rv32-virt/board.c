@@ -335,83 +335,6 @@ void co_port_nvm_prepare(void *port, uint32_t addr, uint32_t len)
     }
 }
 
-/* ---- bootloader ------------------------------------------------------------ */
-
-/*
- * Bank 1 beyond the EEPROM (docs/program-download.md, "Bootloaders and
- * flash layouts"): erase block EEPROM_SLOTS holds the boot-info record,
- * the APP_BLOCKS blocks after it the application area (an image: header,
- * then the payload, which the bootloader copies to the load address in
- * RAM and runs there: code cannot run from a flash bank that answers
- * status reads while the EEPROM beside it is written). No flash file: no
- * area (NULL), as no EEPROM.
- */
-#define APP_BLOCKS 4u
-#define SIFIVE_TEST (*(volatile uint32_t *)0x00100000u) /* QEMU's reset and power device */
-#define SIFIVE_TEST_RESET 0x7777u
-
-extern uint8_t _app_load[], _app_max[]; /* layout.ld */
-
-static flash_ee_t boot_flash(uint32_t block, uint32_t blocks)
-{
-    const flash_ee_t *fe = nvm();
-    if (fe == NULL || flash.block_size * (EEPROM_SLOTS + 1u + APP_BLOCKS) > flash.size) {
-        return (flash_ee_t){0};
-    }
-    return (flash_ee_t){.ops = &cfi_flash_ops,
-                        .ctx = &flash,
-                        .base = flash.base + block * flash.block_size,
-                        .page_size = flash.block_size,
-                        .pages = blocks};
-}
-
-const flash_ee_t *board_boot_area(void)
-{
-    static flash_ee_t area;
-    area = boot_flash(EEPROM_SLOTS + 1u, APP_BLOCKS);
-    return area.ops != NULL ? &area : NULL;
-}
-
-const flash_ee_t *board_boot_info(void)
-{
-    static flash_ee_t info;
-    info = boot_flash(EEPROM_SLOTS, 1u);
-    return info.ops != NULL ? &info : NULL;
-}
-
-uint8_t board_boot_check(const co_image_hdr_t *h)
-{
-    if (h->board != CO_IMAGE_BOARD_RV32_VIRT) {
-        return CO_PROGDL_FORMAT;
-    }
-    const flash_ee_t *a = board_boot_area();
-    if (a == NULL || h->load_addr != (uint32_t)(uintptr_t)_app_load ||
-        h->length > a->pages * a->page_size ||
-        h->length - CO_IMAGE_HDR_SIZE > (uint32_t)(uintptr_t)_app_max) {
-        return CO_PROGDL_ADDRESS;
-    }
-    return CO_PROGDL_OK;
-}
-
-void board_boot_app(const co_image_hdr_t *h)
-{
-    const flash_ee_t *a = board_boot_area();
-    a->ops->read(a->ctx, a->base + CO_IMAGE_HDR_SIZE, _app_load, h->length - CO_IMAGE_HDR_SIZE);
-    /* The instructions just stored are fetched next (Zifencei for this one
-     * instruction, as Zicsr above). */
-    __asm__ volatile(".option push\n.option arch, +zifencei\nfence.i\n.option pop" ::: "memory");
-    ((void (*)(void))(uintptr_t)_app_load)();
-    for (;;) {
-    }
-}
-
-void board_reset(void)
-{
-    SIFIVE_TEST = SIFIVE_TEST_RESET;
-    for (;;) {
-    }
-}
-
 /* ---- CAN controller -------------------------------------------------------- */
 
 /*
@@ -566,4 +489,90 @@ static bool can_bitrate(uint16_t kbps)
 static bool can_rx_waiting(void)
 {
     return can_ready() && (sja_read(&sja_port, SJA_SR) & SJA_SR_RBS) != 0u;
+}
+
+/* ---- bootloader ------------------------------------------------------------ */
+
+/*
+ * Bank 1 beyond the EEPROM (docs/program-download.md, "Bootloaders and
+ * flash layouts"): erase block EEPROM_SLOTS holds the boot-info record,
+ * the APP_BLOCKS blocks after it the application area (an image: header,
+ * then the payload, which the bootloader copies to the load address in
+ * RAM and runs there: code cannot run from a flash bank that answers
+ * status reads while the EEPROM beside it is written). No flash file: no
+ * area (NULL), as no EEPROM.
+ */
+#define APP_BLOCKS 4u
+#define SIFIVE_TEST (*(volatile uint32_t *)0x00100000u) /* QEMU's reset and power device */
+#define SIFIVE_TEST_RESET 0x7777u
+
+extern uint8_t _app_load[], _app_max[]; /* layout.ld */
+
+static flash_ee_t boot_flash(uint32_t block, uint32_t blocks)
+{
+    const flash_ee_t *fe = nvm();
+    if (fe == NULL || flash.block_size * (EEPROM_SLOTS + 1u + APP_BLOCKS) > flash.size) {
+        return (flash_ee_t){0};
+    }
+    return (flash_ee_t){.ops = &cfi_flash_ops,
+                        .ctx = &flash,
+                        .base = flash.base + block * flash.block_size,
+                        .page_size = flash.block_size,
+                        .pages = blocks};
+}
+
+const flash_ee_t *board_boot_area(void)
+{
+    static flash_ee_t area;
+    area = boot_flash(EEPROM_SLOTS + 1u, APP_BLOCKS);
+    return area.ops != NULL ? &area : NULL;
+}
+
+const flash_ee_t *board_boot_info(void)
+{
+    static flash_ee_t info;
+    info = boot_flash(EEPROM_SLOTS, 1u);
+    return info.ops != NULL ? &info : NULL;
+}
+
+uint8_t board_boot_check(const co_image_hdr_t *h)
+{
+    if (h->board != CO_IMAGE_BOARD_RV32_VIRT) {
+        return CO_PROGDL_FORMAT;
+    }
+    const flash_ee_t *a = board_boot_area();
+    if (a == NULL || h->load_addr != (uint32_t)(uintptr_t)_app_load ||
+        h->length > a->pages * a->page_size ||
+        h->length - CO_IMAGE_HDR_SIZE > (uint32_t)(uintptr_t)_app_max) {
+        return CO_PROGDL_ADDRESS;
+    }
+    return CO_PROGDL_OK;
+}
+
+void board_boot_app(const co_image_hdr_t *h)
+{
+    const flash_ee_t *a = board_boot_area();
+    a->ops->read(a->ctx, a->base + CO_IMAGE_HDR_SIZE, _app_load, h->length - CO_IMAGE_HDR_SIZE);
+    /* The instructions just stored are fetched next (Zifencei for this one
+     * instruction, as Zicsr above). */
+    __asm__ volatile(".option push\n.option arch, +zifencei\nfence.i\n.option pop" ::: "memory");
+    ((void (*)(void))(uintptr_t)_app_load)();
+    for (;;) {
+    }
+}
+
+/* The frames queued (the answer to a stop) leave first: the controller is
+ * serviced until its queue is empty and its transmit buffer released,
+ * within a bound (a bus that acknowledges nothing does not hold the
+ * reset). The serial line sends each character before the next. */
+void board_reset(void)
+{
+    for (uint32_t n = 0; n < 100000u && can_ready() &&
+                         (can.tx_len != 0u || (sja_read(&sja_port, SJA_SR) & SJA_SR_TBS) == 0u);
+         n++) {
+        (void)sja1000_service(&can);
+    }
+    SIFIVE_TEST = SIFIVE_TEST_RESET;
+    for (;;) {
+    }
 }

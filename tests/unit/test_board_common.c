@@ -12,6 +12,7 @@
 #include <setjmp.h>
 
 #include "board.h"
+#include "boot.h"
 #include "co_filter.h"
 #include "co_port.h"
 #include "dst.h"
@@ -212,7 +213,7 @@ static struct board {
     unsigned sleeps_at_filter; /* board_sleep() calls before the last board_can_filter() */
 } bd;
 
-static void board_reset(bool init_ok, bool bitrate_ok, uint32_t run_us)
+static void bd_reset(bool init_ok, bool bitrate_ok, uint32_t run_us)
 {
     memset(&bd, 0, sizeof(bd));
     bd.init_ok = init_ok;
@@ -235,6 +236,20 @@ static void deliver(co_frame_t f, uint32_t at)
 static bool rx_pending(void)
 {
     return bd.irx < bd.nrx;
+}
+
+/* The hand-over to the bootloader (boot.h): the block it writes, and the
+ * reset that follows, which leaves the loop. */
+boot_ident_t _boot_handover;
+static unsigned resets;         /* board_reset() calls */
+static unsigned tx_at_reset;    /* frames sent when it came */
+static bool handover_on_answer; /* the next SDO answer asks for the hand-over */
+
+void board_reset(void)
+{
+    resets++;
+    tx_at_reset = bd.ntx;
+    longjmp(bd.out, 1);
 }
 
 bool board_init(void)
@@ -374,6 +389,9 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
     if (bd.ntxq >= TXQ_MAX) {
         return false;
     }
+    if (handover_on_answer && frame->id == 0x5FFu) {
+        co_port_prog_handover(NULL); /* as 1F51h:1's write hook does while it answers */
+    }
     bd.txq[bd.ntxq++] = *frame;
     return true;
 }
@@ -422,7 +440,7 @@ static unsigned sent_on(uint16_t id, uint32_t t, uint32_t start)
 /* One second of a DST X730 (node 0x7F, 250 kbit/s) across the clock's wrap. */
 static void test_main_loop_runs_the_product(void)
 {
-    board_reset(true, true, 1000000u);
+    bd_reset(true, true, 1000000u);
     memset(nvm, 0xFF, sizeof(nvm));
     uint32_t start = bd.now;
     deliver((co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}}, start + 500000u);
@@ -461,7 +479,7 @@ static void test_main_loop_runs_the_product(void)
  * consumes NMT, SYNC and its SDO request, nothing else. */
 static void test_main_loop_receive_list(void)
 {
-    board_reset(true, true, 100000u);
+    bd_reset(true, true, 100000u);
     memset(nvm, 0xFF, sizeof(nvm));
     if (setjmp(bd.out) == 0) {
         (void)mcu_main_any();
@@ -477,7 +495,7 @@ static void test_main_loop_receive_list(void)
  * node before the start. */
 static void test_main_loop_serial_from_board(void)
 {
-    board_reset(true, true, 200000u);
+    bd_reset(true, true, 200000u);
     memset(nvm, 0xFF, sizeof(nvm));
     uint32_t start = bd.now;
     deliver((co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x40, 0x18, 0x10, 0x04}}, start + 100000u);
@@ -517,7 +535,7 @@ static void test_uid_serial(void)
 /* NMT start through the loop: TPDO1 follows (X730 default event timer). */
 static void test_main_loop_nmt_start(void)
 {
-    board_reset(true, true, 1000000u);
+    bd_reset(true, true, 1000000u);
     memset(nvm, 0xFF, sizeof(nvm));
     uint32_t start = bd.now;
     deliver((co_frame_t){.id = 0x000, .dlc = 2, .data = {0x01, 0x7F}}, start + 100000u);
@@ -534,14 +552,14 @@ static void test_main_loop_nmt_start(void)
  * stays where it was; the node runs all the same. */
 static void test_main_loop_bitrate_refused(void)
 {
-    board_reset(true, true, 100000u);
+    bd_reset(true, true, 100000u);
     memset(nvm, 0xFF, sizeof(nvm));
     if (setjmp(bd.out) == 0) {
         (void)mcu_main_any();
     }
     CHECK_EQ(bd.nkbps, 1);
     CHECK_EQ(bd.kbps[0], 250);
-    board_reset(true, false, 100000u);
+    bd_reset(true, false, 100000u);
     memset(nvm, 0xFF, sizeof(nvm));
     if (setjmp(bd.out) == 0) {
         (void)mcu_main_any();
@@ -553,7 +571,7 @@ static void test_main_loop_bitrate_refused(void)
 /* The port function: an unusable code (0 kbit/s) gets the common default. */
 static void test_port_bitrate_default(void)
 {
-    board_reset(true, true, 0);
+    bd_reset(true, true, 0);
     CHECK(co_port_can_bitrate(NULL, 500));
     CHECK(co_port_can_bitrate(NULL, 0));
     CHECK_EQ(bd.nkbps, 2);
@@ -565,7 +583,7 @@ static void test_port_bitrate_default(void)
  * fixed config: red LED for ever, nothing sent, the sensor never read. */
 static void test_main_loop_refuses_to_run(void)
 {
-    board_reset(false, true, 1000000u);
+    bd_reset(false, true, 1000000u);
     bd.red_limit = 3;
     if (setjmp(bd.out) == 0) {
         (void)mcu_main_any();
@@ -574,7 +592,7 @@ static void test_main_loop_refuses_to_run(void)
     CHECK_EQ(bd.leds, 3);
     CHECK_EQ(bd.ntx, 0);
     CHECK_EQ(bd.samples, 0);
-    board_reset(true, true, 1000000u);
+    bd_reset(true, true, 1000000u);
     bd.red_limit = 3;
     if (setjmp(bd.out) == 0) {
         (void)mcu_main_fixed();
@@ -584,7 +602,7 @@ static void test_main_loop_refuses_to_run(void)
     CHECK_EQ(bd.ntx, 0);
     CHECK_EQ(bd.samples, 0);
     CHECK_EQ(bd.nkbps, 0);
-    board_reset(true, true, 1000000u);
+    bd_reset(true, true, 1000000u);
     bd.red_limit = 3;
     if (setjmp(bd.out) == 0) {
         (void)mcu_main_two_fixed();
@@ -594,7 +612,7 @@ static void test_main_loop_refuses_to_run(void)
     CHECK_EQ(bd.samples, 0);
     CHECK_EQ(bd.nkbps, 0);
     /* Built with its own config, the image runs. */
-    board_reset(true, true, 100000u);
+    bd_reset(true, true, 100000u);
     memset(nvm, 0xFF, sizeof(nvm));
     bd.red_limit = 1;
     if (setjmp(bd.out) == 0) {
@@ -624,7 +642,7 @@ static unsigned first_on(uint16_t id, uint32_t t, uint32_t start)
  * whose controller sends from board_can_state, as rv32-virt's SJA1000). */
 static void test_main_loop_frames_of_one_pass(void)
 {
-    board_reset(true, true, 400000u);
+    bd_reset(true, true, 400000u);
     memset(nvm, 0xFF, sizeof(nvm));
     uint32_t start = bd.now;
     deliver((co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x2F, 0xF0, 0x20, 0x00, 0x06}},
@@ -655,7 +673,7 @@ static void test_main_loop_frames_of_one_pass(void)
  * controller is error active). */
 static void test_main_loop_can_state(void)
 {
-    board_reset(true, true, 300000u);
+    bd_reset(true, true, 300000u);
     memset(nvm, 0xFF, sizeof(nvm));
     bd.passive_from = 100000u;
     bd.passive_until = 300000u;
@@ -672,7 +690,7 @@ static void test_main_loop_can_state(void)
  * receive list; the sleep waits for the earlier of their deadlines. */
 static void test_main_loop_two_nodes(void)
 {
-    board_reset(true, true, 1000000u);
+    bd_reset(true, true, 1000000u);
     memset(nvm, 0xFF, sizeof(nvm));
     uint32_t start = bd.now;
     deliver((co_frame_t){.id = 0x613, .dlc = 8, .data = {0x40, 0x18, 0x10, 0x04}}, start + 100000u);
@@ -704,7 +722,7 @@ static void test_main_loop_two_nodes(void)
  * node after its reset, behind the boot-up. */
 static void test_main_loop_reset_between_frames(void)
 {
-    board_reset(true, true, 300000u);
+    bd_reset(true, true, 300000u);
     memset(nvm, 0xFF, sizeof(nvm));
     uint32_t start = bd.now;
     deliver((co_frame_t){.id = 0x60A,
@@ -737,7 +755,7 @@ static void test_main_loop_reset_between_frames(void)
  * the filtered output is on its way there). */
 static void test_main_loop_feeds_samples(void)
 {
-    board_reset(true, true, 400000u);
+    bd_reset(true, true, 400000u);
     memset(nvm, 0xFF, sizeof(nvm));
     uint32_t start = bd.now;
     bd.x_change_at = 100000u;
@@ -757,6 +775,44 @@ static void test_main_loop_feeds_samples(void)
     }
 }
 
+/* A stop (1F51h:1 = 0, the application side of program download) asks
+ * for the hand-over (co_port_prog_handover): the loop makes it after the
+ * answer of that frame went out, with the node's node-ID, bit rate and
+ * identity in a block the bootloader takes (boot_ident_valid), then
+ * resets. */
+static void test_main_loop_hands_over(void)
+{
+    bd_reset(true, true, 1000000u);
+    memset(nvm, 0xFF, sizeof(nvm));
+    memset(&_boot_handover, 0, sizeof _boot_handover);
+    resets = 0;
+    uint32_t start = bd.now;
+    deliver((co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}}, start + 300000u);
+    handover_on_answer = true;
+    if (setjmp(bd.out) == 0) {
+        (void)mcu_main_any();
+    }
+    handover_on_answer = false;
+    CHECK_EQ(resets, 1);
+    CHECK(tx_at_reset >= 2u);
+    if (tx_at_reset >= 2u) { /* the answer first, at once */
+        CHECK_EQ(bd.tx[tx_at_reset - 1u].id, 0x5FF);
+        CHECK_EQ(bd.tx_at[tx_at_reset - 1u] - start, 300000);
+    }
+    CHECK(boot_ident_valid(&_boot_handover, BOOT_HANDOVER_MAGIC));
+    CHECK(!boot_ident_valid(&_boot_handover, BOOT_INFO_MAGIC));
+    CHECK_EQ(_boot_handover.node_id, 0x7F);
+    CHECK_EQ(_boot_handover.kbps, 250);
+    CHECK_EQ(_boot_handover.device_type, 0x0008019Au); /* the X730's 1000h */
+    CHECK_EQ(_boot_handover.vendor, 0x93u);
+    CHECK_EQ(_boot_handover.product, 0x64u);
+    CHECK_EQ(_boot_handover.revision, 0x1u);
+    CHECK_EQ(_boot_handover.serial, board_serial(0));
+    /* One byte changed: the bootloader takes no block. */
+    _boot_handover.kbps = 500;
+    CHECK(!boot_ident_valid(&_boot_handover, BOOT_HANDOVER_MAGIC));
+}
+
 int main(void)
 {
     RUN(test_libc_min);
@@ -773,5 +829,6 @@ int main(void)
     RUN(test_main_loop_two_nodes);
     RUN(test_main_loop_reset_between_frames);
     RUN(test_main_loop_feeds_samples);
+    RUN(test_main_loop_hands_over);
     return h_finish();
 }
