@@ -269,6 +269,7 @@ static size_t read_file(const char *path, uint8_t *buf, size_t cap)
 }
 
 static h_dev_t dev;
+static char **file_args; /* FILE BOARD PROGRAM_ID LOAD_ADDR */
 
 /*
  * test_image --file FILE BOARD PROGRAM_ID LOAD_ADDR: FILE, made by
@@ -277,14 +278,15 @@ static h_dev_t dev;
  * what its product's dictionary answers (1000h, 1018h:1-3, read over SDO
  * from the product booted in the harness).
  */
-static int check_file(char **arg)
+static void test_file(void)
 {
     static uint8_t buf[256u * 1024u];
+    char **arg = file_args;
     size_t n = read_file(arg[0], buf, sizeof buf);
     co_image_hdr_t h;
     if (n < CO_IMAGE_HDR_SIZE || !co_image_parse(buf, &h)) {
-        fprintf(stderr, "%s: no image header\n", arg[0]);
-        return 1;
+        FAIL("no image header");
+        return;
     }
     CHECK_EQ(h.length, n);
     CHECK_EQ(h.crc, co_crc32(0, buf + CO_IMAGE_CRC_FROM, (uint32_t)(n - CO_IMAGE_CRC_FROM)));
@@ -293,8 +295,8 @@ static int check_file(char **arg)
     CHECK_EQ(h.load_addr, strtoul(arg[3], NULL, 0));
     const product_t *p = product_find(h.id);
     if (p == NULL) {
-        fprintf(stderr, "%s: product %s is not in the registry\n", arg[0], h.id);
-        return 1;
+        FAIL("the image's product is not in the registry");
+        return;
     }
     h_boot(&dev, p, false);
     CHECK_EQ(h_read(&dev, 0x1000, 0), h.device_type);
@@ -303,7 +305,6 @@ static int check_file(char **arg)
     CHECK_EQ(h_read(&dev, 0x1018, 3), h.revision);
     printf("%s: %s, %lu bytes, CRC %08lX\n", arg[0], h.id, (unsigned long)h.length,
            (unsigned long)h.crc);
-    return h_finish();
 }
 #endif
 
@@ -331,7 +332,9 @@ int main(void)
 int main(int argc, char **argv)
 {
     if (argc == 6 && strcmp(argv[1], "--file") == 0) {
-        return check_file(argv + 2);
+        file_args = argv + 2;
+        RUN(test_file);
+        return h_finish();
     }
     if (argc != 1) {
         fprintf(stderr, "usage: test_image [--file IMAGE BOARD PROGRAM_ID LOAD_ADDR]\n");
