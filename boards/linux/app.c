@@ -86,7 +86,10 @@ void app_sample(app_t *a, uint32_t t)
 {
     for (unsigned k = 0; k < a->ninst; k++) {
         sim_t *sm = &a->inst[k].sim;
-        sim_step(sm, t);
+        sim_step(sm, t); /* the world moves on */
+        if (a->inst[k].progdl && !lp_prog_running(&a->inst[k].prog)) {
+            continue; /* but a halted program does not read the sensor */
+        }
         a->inst[k].prod->sample(a->inst[k].mem, sm->values, sm->faults);
     }
 }
@@ -245,6 +248,9 @@ void app_shut_down(app_t *a)
 void app_release_nvm(app_t *a)
 {
     for (unsigned k = 0; k < a->ninst; k++) {
+        if (a->inst[k].progdl) {
+            lp_prog_close(&a->inst[k].prog); /* a download's file: the next start removes it */
+        }
         lp_nvm_unlock(&a->inst[k].nvm); /* the EEPROM files free for the next user */
     }
 }

@@ -17,6 +17,7 @@
 #include "nvm_file.h"
 #include "product.h"
 #include "product_registry.h"
+#include "prog.h"
 #include "sim.h"
 
 /* Nodes in one process at most: one bus holds CO_NODE_ID_MAX node-IDs. */
@@ -36,6 +37,8 @@ typedef struct app_inst {
     sim_t sim;
     lp_nvm_t nvm;
     uint8_t nvm_mem[PRODUCT_MAX_NODES * CO_STORE_NVM_SIZE];
+    bool progdl;    /* --program-download: prog is in use */
+    lp_prog_t prog; /* its program area and loader (prog.h) */
     _Alignas(max_align_t) unsigned char mem[sizeof(product_any_t)];
 } app_inst_t;
 

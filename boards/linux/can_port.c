@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "co_port.h"
+#include "co_progdl.h"
 #include "log.h"
 
 /* ---- CAN: link watch ---------------------------------------------------- */
@@ -453,6 +454,11 @@ bool co_port_can_bitrate(void *port, uint16_t kbps)
     return true;
 }
 
+bool lp_halted_may_send(uint32_t id)
+{
+    return (id >= 0x580u && id <= 0x5FFu) || (id >= 0x700u && id <= 0x77Fu) || id == 0x7E4u;
+}
+
 bool co_port_can_send(void *port, const co_frame_t *frame)
 {
     lp_port_t *p = port;
@@ -462,6 +468,10 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
     if (lp_can_state(p) == CO_CAN_BUSOFF) {
         p->tx_off++; /* a controller off the bus sends nothing */
         return false;
+    }
+    if (p->progdl != NULL && co_progdl_state(p->progdl) != CO_PROGDL_STARTED &&
+        !lp_halted_may_send(frame->id)) {
+        return true; /* the program is halted: what it would send is not made */
     }
     /* Every frame waits for the pass's end (lp_tx_flush): microseconds,
      * and one system call for all nodes. */

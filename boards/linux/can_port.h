@@ -70,6 +70,11 @@ typedef struct lp_port {
     uint16_t kbps; /* the node's bit rate (co_port_can_bitrate; vcan has none) */
     bool kbps_set; /* kbps was given (at the node's start) */
     lp_nvm_t *nvm;
+    /* The instance's program download (prog.h; --program-download), NULL:
+     * off; set after lp_open. While its state is not "started" the port
+     * sends only what a bootloader sends (lp_halted_may_send). */
+    struct lp_prog *prog;
+    const struct co_progdl *progdl;
     co_frame_t txq[LP_TXQ]; /* frames the kernel could not take yet */
     unsigned txh, txn;
     unsigned long tx_lost; /* frames dropped because txq was full */
@@ -104,6 +109,12 @@ typedef struct lp_port {
     const co_node_t *filt_node; /* the node filtered for (lp_filter), or NULL */
     unsigned long filt_changes; /* times the filter was (re)installed */
 } lp_port_t;
+
+/* Whether a node whose program is halted (stopped, or no valid program:
+ * co_progdl.h) sends frame ID id: its SDO answers (580h-5FFh), its
+ * boot-up, heartbeat and guarding answers (700h-77Fh) and LSS answers
+ * (7E4h), what a bootloader sends. PDOs and EMCY are the program's. */
+bool lp_halted_may_send(uint32_t id);
 
 /*
  * Open a non-blocking raw CAN socket on iface, error frames and the drop

@@ -15,6 +15,7 @@
 #include "eds.h"
 #include "log.h"
 #include "products_json.h"
+#include "prog.h"
 #include "sim.h"
 
 static void usage(FILE *f)
@@ -70,7 +71,13 @@ static void usage(FILE *f)
             "                     hex). Without it each node's is derived from its product,\n"
             "                     interface and factory node-ID: one per node, never 0, the\n"
             "                     same at every start\n"
-            "  --eds              print the product's EDS (CiA 306) and exit\n"
+            "  --program-download\n"
+            "                     each instance takes a new program over CAN (CiA 302-3:\n"
+            "                     1F50h, 1F51h, 1F56h, 1F57h on its first node), kept in\n"
+            "                     FILE.prog beside its EEPROM file FILE (needs --nvm or\n"
+            "                     --nvm-dir); without it the manual's dictionary alone\n"
+            "  --eds              print the product's EDS (CiA 306) and exit (with\n"
+            "                     --program-download: the objects of program download too)\n"
             "  --list-products    print every product ID with a description (with\n"
             "                     --product: that one only)\n"
             "  --json             with --list-products: a JSON array instead, one object a\n"
@@ -328,6 +335,7 @@ int cli_parse(int argc, char **argv, options_t *o)
         {"control", required_argument, NULL, 'C'},
         {"log-time", required_argument, NULL, 'T'},
         {"serial", required_argument, NULL, 'S'},
+        {"program-download", no_argument, NULL, 'P'},
         {NULL, 0, NULL, 0},
     };
     opterr = 0; /* our own one-line messages */
@@ -420,6 +428,9 @@ int cli_parse(int argc, char **argv, options_t *o)
         case 'E':
             o->eds = true;
             break;
+        case 'P':
+            o->progdl = true;
+            break;
         case 'L':
             list = true;
             break;
@@ -480,6 +491,10 @@ int cli_parse(int argc, char **argv, options_t *o)
     if (o->nvm_path != NULL && o->prod == NULL) {
         return USAGE_ERROR("--nvm is the --product node's EEPROM file: use --nvm-dir with --node");
     }
+    if (o->progdl && o->nvm_dir == NULL && (o->nvm_path == NULL || o->nspec > 0u)) {
+        return USAGE_ERROR("--program-download needs an EEPROM file for every instance (--nvm "
+                           "for --product alone, else --nvm-dir): its program is kept beside it");
+    }
     if (o->led_line_opt != NULL && o->led_chip == NULL) {
         return USAGE_ERROR("%s needs --led-chip", o->led_line_opt);
     }
@@ -501,9 +516,20 @@ int cli_parse(int argc, char **argv, options_t *o)
 }
 
 /* --eds: the product's EDS on stdout; returns the exit status. */
-int cli_print_eds(const product_t *prod)
+int cli_print_eds(const product_t *prod, bool progdl)
 {
-    if (eds_write(stdout, prod) != 0) {
+    /* static: the loader's copy of a dictionary is some kilobytes */
+    static lp_prog_t g;
+    product_t with = *prod;
+    if (progdl) {
+        char err[200];
+        if (lp_prog_build(&g, prod->cfg, err, sizeof(err)) != 0) {
+            fprintf(stderr, "canopen-sensor: %s\n", err);
+            return 1;
+        }
+        with.cfg = &g.cfg;
+    }
+    if (eds_write(stdout, &with) != 0) {
         fprintf(stderr, "canopen-sensor: %s: EDS overrides that apply to no entry\n", prod->id);
         return 1;
     }

@@ -60,6 +60,7 @@ typedef struct options {
     int led_red;
     bool eds;
     bool quit_on_eof;
+    bool progdl;     /* --program-download (prog.h) */
     uint64_t seed;   /* --seed: the simulator's noise (instance k: seed + k) */
     uint32_t serial; /* --serial: node i's 0x1018 sub 4 is serial + i; 0: derived */
 } options_t;
@@ -72,8 +73,9 @@ typedef struct options {
  */
 int cli_parse(int argc, char **argv, options_t *o);
 
-/* --eds: the product's EDS on standard output; returns the exit status. */
-int cli_print_eds(const product_t *prod);
+/* --eds: the product's EDS on standard output (with progdl, its loader's
+ * dictionary: prog.h); returns the exit status. */
+int cli_print_eds(const product_t *prod, bool progdl);
 
 /* A wrong command line: "canopen-sensor: <cause> (see --help)" on stderr. */
 void cli_usage_error(const char *fmt, ...) __attribute__((format(printf, 1, 2)));

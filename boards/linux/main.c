@@ -38,7 +38,7 @@ int main(int argc, char **argv)
         return rc;
     }
     if (o.eds) {
-        return cli_print_eds(o.prod);
+        return cli_print_eds(o.prod, o.progdl);
     }
     static app_t a;
     static loop_t l;

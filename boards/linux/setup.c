@@ -183,6 +183,26 @@ static int open_inst_ports(app_t *a, const options_t *o, unsigned k, uint32_t t)
     return CLI_GO_ON;
 }
 
+/* Instance k's program download (--program-download): the loader's
+ * dictionary on its first node, its program area beside its EEPROM file.
+ * Returns CLI_GO_ON or 1. */
+static int open_inst_prog(app_t *a, unsigned k)
+{
+    app_inst_t *in = &a->inst[k];
+    char err[600];
+    if (lp_prog_build(&in->prog, co_cfg(a->nodes[in->first]), err, sizeof(err)) != 0 ||
+        lp_prog_open(&in->prog, in->prod->id, in->nvm.real, &a->nodes[in->first], in->prod->nodes,
+                     err, sizeof(err)) != 0) {
+        return cli_start_failure(CLI_FAILED, err);
+    }
+    in->progdl = true;
+    for (unsigned i = 0; i < in->prod->nodes; i++) {
+        a->ports[in->first + i].prog = &in->prog;
+        a->ports[in->first + i].progdl = &in->prog.pd;
+    }
+    return CLI_GO_ON;
+}
+
 /* Instance k of the command line, created (not started). */
 static int add_inst(app_t *a, const options_t *o, unsigned k)
 {
@@ -237,6 +257,12 @@ int setup_run(app_t *a, loop_t *l, const options_t *o)
     uint32_t t = loop_now_us();
     for (unsigned k = 0; k < a->ninst; k++) {
         rc = open_inst_ports(a, o, k, t);
+        if (rc != CLI_GO_ON) {
+            return rc;
+        }
+    }
+    for (unsigned k = 0; k < a->ninst && o->progdl; k++) {
+        rc = open_inst_prog(a, k);
         if (rc != CLI_GO_ON) {
             return rc;
         }

@@ -205,10 +205,12 @@ class Sensor:
     must be taken, command() for the raw answer of a line a test expects to be
     refused, get() for the node's true inputs. Standard input is /dev/null
     (--on-eof run) unless stdin=True: then write_stdin() types on it, for the
-    tests of standard input itself."""
+    tests of standard input itself. args: more options for its command line
+    (--program-download)."""
 
-    def __init__(self, product, tmp_path, nvm=True, iface=IFACE, stdin=False):
+    def __init__(self, product, tmp_path, nvm=True, iface=IFACE, stdin=False, args=()):
         self.product = product
+        self.args = list(args)
         self.iface = iface
         self.nvm = str(tmp_path / "eeprom.bin") if nvm else None
         self.log = tmp_path / "sensor.log"
@@ -228,6 +230,7 @@ class Sensor:
                "--control", f"unix:{self.control_path}", "--on-eof", "run"]
         if self.nvm:
             cmd += ["--nvm", self.nvm]
+        cmd += self.args
         if self.control_path.exists():
             self.control_path.unlink()  # a power cut's stale socket
         # Decision: standard input is /dev/null and --on-eof run, so the

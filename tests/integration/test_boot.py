@@ -1,0 +1,174 @@
+"""The rv32-virt bootloader (boards/common/boot.h) in QEMU, over the serial
+line (SLCAN), with the `canopen` master: it boots a valid application; it
+stays, with the product's identity, when the application is invalid; an
+update from the running application (stop: hand-over, clear, download by
+block and by segmented SDO, start) ends in the new application's boot-up;
+a power cut after the clear leaves a bootloader that takes the next
+download. docs/program-download.md, "Bootloaders and flash layouts".
+
+The bootloader and the application images come from build-rv32-virt
+(bin/boot.elf, bin/fw-ID-app.elf; ctest's fixture emu.images_rv32-virt
+builds them); the images are wrapped here with tools/mkimage, each with
+its own program identification."""
+import os
+import pathlib
+import signal
+import subprocess
+import time
+
+import can
+import canopen
+import pytest
+from targets import free_port
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+# CO_RV32_BUILD: another build directory of the board (default build-rv32-virt).
+BUILD = pathlib.Path(os.environ.get("CO_RV32_BUILD", ROOT / "build-rv32-virt")) / "bin"
+PRODUCT = "dst-x730-xy30"
+NODE = 0x7F
+STATUS_NO_VALID = 1 << 1  # 1F57h:1, status 1 in bits 1-7
+
+
+def need(path):
+    if not path.exists():
+        pytest.fail(f"{path} is missing: build the rv32-virt images (docs/emulator.md)")
+
+
+def image(tmp_path, program_id, corrupt=False):
+    """The application wrapped by tools/mkimage; corrupt: one payload byte
+    changed afterwards (its CRC no longer checks)."""
+    elf = BUILD / f"fw-{PRODUCT}-app.elf"
+    need(elf)
+    out = tmp_path / f"app-{program_id}.img"
+    subprocess.run([str(ROOT / "tools" / "mkimage"), "--product", PRODUCT, "--board", "rv32-virt",
+                    "--program-id", str(program_id), "--elf", str(elf), "-o", str(out)],
+                   check=True, capture_output=True,
+                   env={**os.environ, "CANOPEN_SENSOR": os.environ.get(
+                       "CANOPEN_SENSOR", str(ROOT / "build" / "bin" / "canopen-sensor"))})
+    if corrupt:
+        data = bytearray(out.read_bytes())
+        data[100] ^= 0xFF
+        out.write_bytes(bytes(data))
+    return out
+
+
+class Device:
+    """tools/emu --boot: the bootloader, the flash file kept across starts."""
+
+    def __init__(self, tmp_path):
+        need(BUILD / "boot.elf")
+        self.flash = tmp_path / "flash.bin"
+        self.log = open(tmp_path / "emu.log", "a")
+        self.proc = None
+
+    def start(self, install=None):
+        port = free_port()
+        cmd = [str(ROOT / "tools" / "emu"), "--board", "rv32-virt", "--product", PRODUCT,
+               "--port", str(port), "--flash", str(self.flash), "--boot",
+               "--image", str(BUILD / "boot.elf")]
+        if install is not None:
+            cmd += ["--install", str(install)]
+        self.proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=self.log,
+                                     stderr=subprocess.PIPE, text=True, start_new_session=True)
+        for line in self.proc.stderr:
+            self.log.write(line)
+            if line.startswith("emu: ready"):
+                break
+        else:
+            pytest.fail(f"tools/emu did not start: see {self.log.name}")
+        self.bus = can.Bus(interface="slcan", channel=f"socket://127.0.0.1:{port}",
+                           sleep_after_open=0)
+        self.net = canopen.Network(self.bus)
+        self.net.notifier = can.Notifier(self.bus, self.net.listeners, 0.1)
+        self.bootups = []
+        self.net.subscribe(0x700 + NODE, lambda i, d, t: self.bootups.append(bytes(d)))
+        self.node = self.net.add_node(NODE, canopen.ObjectDictionary())
+        self.node.sdo.RESPONSE_TIMEOUT = 1.0
+        time.sleep(0.5)
+
+    def cut(self):
+        """A power cut: the emulator's process group killed."""
+        self.net.notifier.stop()
+        self.bus.shutdown()
+        os.killpg(self.proc.pid, signal.SIGKILL)
+        self.proc.wait()
+
+    def u32(self, index, sub):
+        return int.from_bytes(self.node.sdo.upload(index, sub), "little")
+
+    def control(self, value):
+        self.node.sdo.download(0x1F51, 1, bytes([value]))
+
+    def download(self, path, block):
+        data = path.read_bytes()
+        with self.node.sdo.open(0x1F50, 1, "wb", size=len(data), block_transfer=block) as f:
+            f.write(data)
+        end = time.monotonic() + 5
+        while self.u32(0x1F57, 1) & 1 and time.monotonic() < end:
+            time.sleep(0.1)  # busy: the image re-read from flash
+
+
+@pytest.fixture
+def device(tmp_path):
+    d = Device(tmp_path)
+    yield d
+    if d.proc is not None and d.proc.poll() is None:
+        d.cut()
+
+
+def test_boots_a_valid_application(device, tmp_path):
+    device.start(install=image(tmp_path, 5))
+    assert device.bootups == [b"\x00"]
+    assert device.u32(0x1000, 0) == 0x0008019A  # the application's own dictionary
+    assert device.u32(0x1F51, 1) == 1  # started: the application side answers
+
+
+def test_stays_without_a_valid_application(device, tmp_path):
+    device.start(install=image(tmp_path, 5, corrupt=True))
+    assert device.bootups == [b"\x00"]
+    assert device.u32(0x1F51, 1) == 3
+    assert device.u32(0x1F57, 1) == STATUS_NO_VALID
+    assert device.u32(0x1F56, 1) == 0
+
+
+@pytest.mark.parametrize("block", [True, False], ids=["block", "segmented"])
+def test_update_from_the_application(device, tmp_path, block):
+    device.start(install=image(tmp_path, 5))
+    device.bootups.clear()
+    device.control(0)  # stop: the hand-over, then the bootloader's boot-up
+    time.sleep(0.5)
+    assert device.bootups == [b"\x00"]
+    assert device.u32(0x1000, 0) == 0x0008019A  # the product's identity, handed over
+    assert device.u32(0x1018, 1) == 0x93
+    assert device.u32(0x1F51, 1) == 0  # stopped: a valid program is installed
+    assert device.u32(0x1F56, 1) == 5  # its header's identification
+    device.control(3)
+    assert device.u32(0x1F51, 1) == 3
+    device.download(image(tmp_path, 6), block)
+    assert device.u32(0x1F57, 1) == 0
+    assert device.u32(0x1F56, 1) == 6
+    device.bootups.clear()
+    device.control(1)
+    time.sleep(1.0)
+    assert device.bootups == [b"\x00"]
+    assert device.u32(0x1F51, 1) == 1  # the new application runs
+
+
+def test_power_cut_after_the_clear(device, tmp_path):
+    device.start(install=image(tmp_path, 5))
+    device.control(0)
+    time.sleep(0.5)
+    device.control(3)
+    device.cut()
+    device.start()  # power on: no hand-over, no valid program
+    assert device.bootups == [b"\x00"]
+    assert device.u32(0x1000, 0) == 0x0008019A  # from the boot-info page
+    assert device.u32(0x1018, 2) == 0x64
+    assert device.u32(0x1F51, 1) == 3
+    assert device.u32(0x1F57, 1) == STATUS_NO_VALID
+    device.control(3)
+    device.download(image(tmp_path, 7), True)
+    assert device.u32(0x1F56, 1) == 7
+    device.control(1)
+    time.sleep(1.0)
+    assert device.u32(0x1F51, 1) == 1

@@ -1,0 +1,63 @@
+"""canopen-sensor --program-download without CAN: its command line, and
+the EDS that shows the objects of program download only with it (off
+keeps exactly the manual's dictionary). On the bus: test_progdl.py."""
+import pathlib
+import subprocess
+import sys
+
+import canopen
+import pytest
+
+from conftest import BINARY
+
+OBJECTS = ("[1F50]", "[1F50sub1]", "[1F51sub1]", "[1F56sub1]", "[1F57sub1]")
+
+
+def run(*args):
+    return subprocess.run([BINARY, *args], capture_output=True, text=True, timeout=10)
+
+
+def test_help_names_the_option():
+    r = run("--help")
+    assert r.returncode == 0 and "--program-download" in r.stdout
+
+
+@pytest.mark.parametrize("args", [
+    ("--product", "jd2xxx", "--iface", "vcan0"),
+    ("--node", "jd2xxx", "--iface", "vcan0"),
+    ("--product", "jd2xxx", "--nvm", "x.nvm", "--node", "inx360d", "--iface", "vcan0"),
+])
+def test_needs_an_eeprom_file_for_every_instance(args):
+    r = run(*args, "--program-download")
+    assert r.returncode == 2, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "--program-download needs an EEPROM file for every instance" \
+        in lines[0], r.stderr
+
+
+def test_given_twice():
+    r = run("--product", "jd2xxx", "--eds", "--program-download", "--program-download")
+    assert r.returncode == 2 and "--program-download given twice" in r.stderr
+
+
+@pytest.mark.parametrize("pid", ["dst-x730-xy30", "gsh-a-redundant", "jd2xxx", "inx360d"])
+def test_eds(pid, tmp_path):
+    plain = run("--product", pid, "--eds")
+    with_pd = run("--product", pid, "--eds", "--program-download")
+    assert plain.returncode == 0 and with_pd.returncode == 0, plain.stderr + with_pd.stderr
+    assert not any(o in plain.stdout for o in OBJECTS)
+    assert all(o in with_pd.stdout for o in OBJECTS)
+    path = tmp_path / "pd.eds"
+    path.write_text(with_pd.stdout)
+    dcfchk = pathlib.Path(sys.executable).with_name("dcfchk")
+    r = subprocess.run([str(dcfchk), "-n", "5", "-p", str(path)], capture_output=True, text=True)
+    assert r.returncode == 0 and "Warning" not in r.stderr and "Error" not in r.stderr, \
+        r.stdout + r.stderr
+    od = canopen.import_od(str(path), 5)
+    assert od[0x1F51][1].access_type == "rw" and od[0x1F56][1].access_type == "ro"
+    assert od[0x1F50][1].data_type == 0x0F and od[0x1F50][1].access_type == "wo"
+    # Everything else as without the option.
+    assert len(with_pd.stdout.splitlines()) > len(plain.stdout.splitlines())
+    for line in plain.stdout.splitlines():
+        if line.startswith("[") or line.startswith("ParameterName"):
+            assert line in with_pd.stdout, line
