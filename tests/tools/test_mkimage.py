@@ -236,6 +236,17 @@ class Refusals(Base):
                      "--program", PROGRAM, *common)
         self.refused(1, ["no such program"], "--product", "dst-x730-xy30", "--board", "linux",
                      "--program", self.tmp / "none", *common)
+        # Without --program: $CANOPEN_SENSOR, as the other tools take it.
+        os.environ["CANOPEN_SENSOR"] = str(self.tmp / "elsewhere")
+        try:
+            self.refused(1, [f"{self.tmp / 'elsewhere'}: no such program"], "--product",
+                         "dst-x730-xy30", "--board", "linux", *common)
+            os.environ["CANOPEN_SENSOR"] = PROGRAM
+            self.assertEqual(mkimage("--product", "dst-x730-xy30", "--board", "linux",
+                                     *common).returncode, 0)
+            (self.tmp / "o.img").unlink()
+        finally:
+            del os.environ["CANOPEN_SENSOR"]
         eds = self.tmp / "x.eds"
         eds.write_text("[DeviceInfo]\nOrderCode=dst-x730-xy30\n[1000]\nDefaultValue=0x1\n"
                        "[1018sub1]\nDefaultValue=2\n[1018sub3]\nDefaultValue=4\n")
