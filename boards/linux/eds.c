@@ -78,14 +78,16 @@ static void entry_body(FILE *f, const product_t *p, const co_od_entry_t *e, cons
         fprintf(f, "DefaultValue=%.*s\n", (int)e->size, (const char *)e->cdata);
     } else if ((e->attr & CO_A_NODEID) != 0u) {
         fprintf(f, "DefaultValue=$NODEID+0x%lX\n", (unsigned long)e->def);
-    } else if ((e->attr & CO_A_SERIAL) != 0u || co_od_read_hook(e) != NULL) {
+    } else if ((e->attr & CO_A_SERIAL) != 0u || co_od_read_hook(e) != NULL ||
+               e->type == CO_T_DOMAIN) {
         /* No DefaultValue (CiA 306 lets an entry omit it) for 1018h:04,
          * the unit's serial: a device-specific value here would make a
          * master that checks it at boot (1F88h) reject every other unit;
          * nor for what is computed at run time (a live input, an error
          * state), so that a master that compares or writes defaults finds
-         * none that the device does not read. (One branch: two empty ones
-         * are a clone to clang-tidy.) */
+         * none that the device does not read; nor for a DOMAIN (1F50h:1,
+         * the program data), which has no value to read. (One branch: two
+         * empty ones are a clone to clang-tidy.) */
     } else if (o != NULL && o->nodeid) {
         fprintf(f, "; the device's default is each node's own node-ID: %s\n", o->reason);
         fprintf(f, "DefaultValue=$NODEID+0x%lX\n", (unsigned long)o->value);

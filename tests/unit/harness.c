@@ -7,6 +7,7 @@
 
 #include "co_filter.h"
 #include "co_port.h"
+#include "co_progdl.h"
 
 /* ---- the fake port ------------------------------------------------- */
 
@@ -16,6 +17,10 @@ void fake_port_init(fake_port_t *p)
     memset(p->nvm, 0xFF, sizeof(p->nvm));
     p->cut_after = -1;
     p->reads_left = -1;
+    memset(p->prog.area, 0xFF, sizeof(p->prog.area));
+    p->prog.limit = FAKE_PROG_SIZE;
+    p->prog.cut_after = -1;
+    p->prog.flip_at = -1;
 }
 
 bool co_port_can_bitrate(void *port, uint16_t kbps)
@@ -102,6 +107,121 @@ void co_port_nvm_prepare(void *port, uint32_t addr, uint32_t len)
     }
 }
 
+/* ---- program download (co_port.h) ---------------------------------- */
+
+struct co_progdl *co_port_progdl(void *port)
+{
+    fake_port_t *p = port;
+    if (p->prog.pd == NULL) {
+        h_failures++;
+        fprintf(stderr, "fake port: program download without a co_progdl_t (fake_prog_t.pd)\n");
+        abort();
+    }
+    return p->prog.pd;
+}
+
+uint8_t co_port_prog_check(void *port, const co_image_hdr_t *h)
+{
+    fake_prog_t *g = &((fake_port_t *)port)->prog;
+    if (h->board != g->board || g->id == NULL || strcmp(h->id, g->id) != 0) {
+        return CO_PROGDL_FORMAT;
+    }
+    if (h->length > g->limit || h->load_addr != 0u) {
+        return CO_PROGDL_ADDRESS;
+    }
+    g->accepted = h->length;
+    return CO_PROGDL_OK;
+}
+
+/* As a bootloader's: the header's page erased, so no image is found. */
+bool co_port_prog_clear(void *port)
+{
+    fake_prog_t *g = &((fake_port_t *)port)->prog;
+    g->clears++;
+    if (g->fail_clear) {
+        return false;
+    }
+    memset(g->area, 0xFF, FAKE_PROG_PAGE);
+    g->erases++;
+    g->erased_to = 1;
+    g->accepted = 0; /* no header checked since */
+    return true;
+}
+
+bool co_port_prog_write(void *port, uint32_t at, const void *buf, uint32_t len)
+{
+    fake_prog_t *g = &((fake_port_t *)port)->prog;
+    g->writes++;
+    if (at + len > g->accepted) {
+        h_failures++; /* the stack broke co_port_prog_write's contract */
+        fprintf(stderr, "fake port: image bytes %u..%u written, the header said %u\n", (unsigned)at,
+                (unsigned)(at + len - 1u), (unsigned)g->accepted);
+    }
+    if (g->fail_write || at + len > FAKE_PROG_SIZE || len == 0u) {
+        return false;
+    }
+    const uint8_t *b = buf;
+    for (uint32_t i = 0; i < len; i++) {
+        uint32_t page = (at + i) / FAKE_PROG_PAGE;
+        if (page >= g->erased_to) { /* the first write into a page erases it */
+            memset(&g->area[(size_t)page * FAKE_PROG_PAGE], 0xFF, FAKE_PROG_PAGE);
+            g->erases++;
+            g->erased_to = page + 1u;
+        }
+        if (g->cut_after == 0) {
+            return false; /* power is gone */
+        }
+        if (g->cut_after > 0) {
+            g->cut_after--;
+        }
+        g->area[at + i] &= (long)at + (long)i == g->flip_at ? (uint8_t)(b[i] ^ 1u) : b[i];
+    }
+    return true;
+}
+
+bool co_port_prog_read(void *port, uint32_t at, void *buf, uint32_t len)
+{
+    fake_prog_t *g = &((fake_port_t *)port)->prog;
+    g->reads++;
+    if (g->fail_read || at + len > FAKE_PROG_SIZE) {
+        return false;
+    }
+    memcpy(buf, &g->area[at], len);
+    return true;
+}
+
+bool co_port_prog_commit(void *port, const co_image_hdr_t *h)
+{
+    fake_prog_t *g = &((fake_port_t *)port)->prog;
+    g->commits++;
+    if (g->fail_commit) {
+        return false;
+    }
+    g->committed_id = h->program_id;
+    return true;
+}
+
+void co_port_prog_start(void *port)
+{
+    fake_port_t *p = port;
+    p->prog.starts++;
+    p->prog.start_ntx = p->ntx;
+}
+
+void co_port_prog_stop(void *port)
+{
+    fake_port_t *p = port;
+    p->prog.stops++;
+    p->prog.stop_ntx = p->ntx;
+}
+
+void co_port_prog_handover(void *port)
+{
+    fake_port_t *p = port;
+    p->prog.handovers++;
+    p->prog.handover_ntx = p->ntx;
+}
+
 /* ---- device under test --------------------------------------------- */
 
 static void create(h_dev_t *d)
@@ -119,6 +239,9 @@ static void create(h_dev_t *d)
 #endif
     d->nnodes = d->prod->nodes;
     d->node = d->nodes[0];
+    if (d->cfg != NULL) {
+        d->node->cfg = d->cfg; /* co_node_init keeps the pointer alone; not started yet */
+    }
     /* One sample before start, as a board reads its sensor before booting. */
     d->prod->sample(d->mem, d->truth, d->fault);
     for (unsigned i = 0; i < d->nnodes; i++) {

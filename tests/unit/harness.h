@@ -100,6 +100,35 @@ extern unsigned h_tx_high_water;
  * (the union of every family's instance type, from their declarations). */
 #define H_INST_MAX sizeof(product_any_t)
 
+/* The fake program area (co_port.h, "Program download"): pages erased
+ * (0xFF) before written; a write ANDs its bytes in, as flash programs
+ * only 1 -> 0 bits, so a page written twice without an erase reads wrong. */
+#ifndef FAKE_PROG_SIZE
+#ifdef HARNESS_BARE
+#define FAKE_PROG_SIZE 64u /* no bare test downloads a program (test_progdl is the host's) */
+#else
+#define FAKE_PROG_SIZE 4096u
+#endif
+#endif
+#define FAKE_PROG_PAGE (FAKE_PROG_SIZE < 1024u ? FAKE_PROG_SIZE : 1024u)
+
+typedef struct fake_prog {
+    struct co_progdl *pd; /* co_port_progdl's answer: the test's state */
+    uint8_t area[FAKE_PROG_SIZE];
+    uint32_t board;     /* the board code co_port_prog_check accepts */
+    const char *id;     /* the product ID it accepts */
+    uint32_t limit;     /* image bytes the area takes (co_port_prog_check) */
+    uint32_t accepted;  /* the length co_port_prog_check last accepted */
+    uint32_t erased_to; /* pages 0 .. erased_to - 1 erased since the last clear */
+    unsigned clears, erases, writes, reads, commits;
+    bool fail_clear, fail_write, fail_read, fail_commit; /* that call fails */
+    long cut_after;        /* image bytes that may still be written; -1: no power cut */
+    long flip_at;          /* the area byte that programs with bit 0 wrong; -1: none */
+    uint32_t committed_id; /* the last commit's program ID */
+    unsigned starts, stops, handovers;
+    unsigned start_ntx, stop_ntx, handover_ntx; /* frames sent when the last one was called */
+} fake_prog_t;
+
 typedef struct fake_port {
     co_frame_t tx[FAKE_TX_MAX]; /* ring of sent frames, index = count % FAKE_TX_MAX */
     unsigned ntx;               /* frames sent */
@@ -118,6 +147,7 @@ typedef struct fake_port {
     uint32_t prepared_addr; /* the last one's address */
     uint32_t prepared_at;   /* the virtual time of the last one (h_dev_t.now) */
     const uint32_t *clock;  /* the device's virtual clock, for prepared_at */
+    fake_prog_t prog;       /* program download's area and calls */
 } fake_port_t;
 
 void fake_port_init(fake_port_t *p);
@@ -136,6 +166,10 @@ typedef struct h_dev {
     uint32_t fault;                        /* bit i: the product's fault i */
     uint8_t factory_id[PRODUCT_MAX_NODES]; /* co_node_set_factory_id() at each boot; 0: none */
     uint32_t serial[PRODUCT_MAX_NODES];    /* co_node_set_serial() at each boot; 0: none */
+    /* The config node 0 runs instead of its product's, set between create
+     * and start at each boot (a board's derived config, as the Linux
+     * program's program download); NULL: the product's. */
+    const co_node_cfg_t *cfg;
 } h_dev_t;
 
 /* The product instance (aligned for any type: cast it to the family's type). */
