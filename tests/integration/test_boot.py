@@ -123,6 +123,20 @@ def test_boots_a_valid_application(device, tmp_path):
     assert device.u32(0x1F51, 1) == 1  # started: the application side answers
 
 
+def test_factory_image_written_once(device, tmp_path):
+    """Without --install tools/emu writes the product's image from beside
+    the bootloader (bin/ID.img) into a fresh flash file; a flash that went
+    through an update keeps its cleared area (the power cut test below)."""
+    need(BUILD / f"{PRODUCT}.img")
+    device.start()
+    assert device.bootups == [b"\x00"]
+    assert device.u32(0x1F51, 1) == 1  # the application runs
+    device.cut()
+    device.start()  # the same flash, its image kept
+    assert device.bootups == [b"\x00"]
+    assert device.u32(0x1F51, 1) == 1
+
+
 def test_stays_without_a_valid_application(device, tmp_path):
     device.start(install=image(tmp_path, 5, corrupt=True))
     assert device.bootups == [b"\x00"]
