@@ -14,8 +14,10 @@ from stack_depth import depth
 # DST X730 on the Nucleo's Cortex-M0. Flash was 10 KB (10 240 B) until the
 # store erased its next slot ahead so that no SDO answer waits for a flash
 # erase (co_store.h): that costs the X730 about 170 B it did not have, so
-# the target is 10 368 B (10.125 KiB); RAM stays 1 KB with the stack.
-TARGET_FLASH, TARGET_RAM = 10368, 1024
+# the target was 10 368 B (10.125 KiB), and program download's application
+# side (its 1F5xh objects, the hand-over to the bootloader: co_progdl.h)
+# is given 128 B more: 10 496 B. RAM stays 1 KB with the stack.
+TARGET_FLASH, TARGET_RAM = 10496, 1024
 TARGET_BOARD = "nucleo-f042k6"
 # RAM of the Cortex-M0 boards: every image's RAM and worst-case stack must fit.
 BOARD_RAM = {"nucleo-f042k6": 6 * 1024,  # STM32F042K6
@@ -95,7 +97,7 @@ def main(argv):
     if overflow:
         return 1
     if check and failed:
-        print("footprint: a DST X730 image misses its target (10 368 B flash, 1 KB RAM with"
+        print("footprint: a DST X730 image misses its target (10 496 B flash, 1 KB RAM with"
               " the stack)", file=sys.stderr)
         return 1
     return 0

@@ -10,6 +10,7 @@
  *
  * The table must stay sorted by (index, sub-index).
  */
+#include "co_progdl.h"
 #include "dst.h"
 /* clang-format off */
 
@@ -92,6 +93,8 @@
     /* The manual prints 0x60200020; 0x6020 is 16 bits (bytes 3-4). */ \
     {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = CONST, .def = 0x60200010u, CO_NAME("2nd mapped object")}, \
     {.index = 0x1A00, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x21000020u, CO_NAME("3rd mapped object")}, \
+    /* Program download (CiA 302-3): the MCU image's side of its bootloader. */ \
+    CO_PROGDL_TABLE \
     /* 0 slow, 1 medium, 2 fast; active after "save". Default 0 as the \
      * table says (example 10 starts from 2). */ \
     {.index = 0x2001, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(filter), .def = 0, CO_EXT(.min = 0, .max = 2), CO_NAME("Filter setting")}, \

@@ -4,6 +4,7 @@
  * channels; the channels differ only in their default node-ID (0x13,
  * 0x14). Sorted by (index, sub-index).
  */
+#include "co_progdl.h"
 #include "gsh.h"
 #include "product_eds.h"
 /* clang-format off */
@@ -64,6 +65,8 @@
     {.index = 0x1A00, .sub = 3, CO_TYPE_U32, .attr = CONST, .def = 0x21100010u, CO_NAME("3rd object")}, /* bytes 5-6 */ \
     {.index = 0x1A00, .sub = 4, CO_TYPE_U32, .attr = CONST, .def = 0x21110008u, CO_NAME("4th object")}, /* byte 7 */ \
     {.index = 0x1A00, .sub = 5, CO_TYPE_U32, .attr = CONST, .def = 0x21120008u, CO_NAME("5th object")}, /* byte 8 */ \
+    /* Program download (CiA 302-3): the MCU image's side of its bootloader. */ \
+    CO_PROGDL_TABLE \
     /* The PDO's bytes 5-8 as objects (the manual has none), \
      * manufacturer-specific indices no other product uses: the alarm word \
      * now (GSH_ALARM_*), the counter and the checksum of the last PDO sent \

@@ -4,6 +4,7 @@
  * (sections 8.9 and 9, the overview of section 10). Values the manual does
  * not give are marked "(?)"; sorted by (index, sub-index).
  */
+#include "co_progdl.h"
 #include "jd.h"
 /* clang-format off */
 
@@ -113,6 +114,7 @@ static const co_od_entry_t jd2_entries[] = {
     JD_TPDO(1, 0x280, 1), /* TPDO2 inhibit default 1, as printed (manual, 8.9.2) */
     JD_MAP(0, 2, 0x60200010u),
     JD_MAP(1, 2, 0x60200010u),
+    CO_PROGDL_TABLE /* program download: the MCU image's side (co_progdl.h) */
     JD_MFR_HEAD,
     {.index = 0x2601, .sub = 0, CO_TYPE_I16, .attr = RW, CO_EXT(.write = jd_write_preset, .read = jd_read_preset), CO_NAME("Preset Y-axis")},
     JD_MFR_TAIL,
@@ -128,6 +130,7 @@ static const co_od_entry_t jd1_entries[] = {
     JD_TPDO(1, 0x280, 1),
     JD_MAP(0, 1, 0x60200010u),
     JD_MAP(1, 1, 0x60200010u),
+    CO_PROGDL_TABLE /* program download: the MCU image's side (co_progdl.h) */
     JD_MFR_HEAD,
     JD_MFR_TAIL,
     /* Z, 0..N-1 as UNSIGNED16 (0..360 deg clockwise, manual section 8.2). */

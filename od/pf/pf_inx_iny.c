@@ -10,6 +10,7 @@
  *          identity; a real unit or P+F's EDS would)
  * Tables sorted by (index, sub-index).
  */
+#include "co_progdl.h"
 #include "pf.h"
 /* clang-format off */
 
@@ -71,6 +72,7 @@ static const co_od_entry_t inx_entries[] = {
     PF_COMMON_1000_TO_1800(0x0000019Au /* high word [ph] */, "INX360D-F99-B16-V15"),
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(map_count), .def = 1, CO_EXT(.write = co_tpdo_write_map), CO_NAME("TPDO1 mapping parameter")}, /* [inf] the INY frame without Y */
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = RW, PARA(map[0]), .def = 0x60100010u, CO_EXT(.write = co_tpdo_write_map), CO_NAME("1st mapped object")}, /* [inf] the INY frame without Y */
+    CO_PROGDL_TABLE /* program download: the MCU image's side (co_progdl.h) */
     PF_2000_TO_6000,
     PF_AXIS(0x6010, 0, "long16"),
 };
@@ -80,6 +82,7 @@ static const co_od_entry_t iny_entries[] = {
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(map_count), .def = 2, CO_EXT(.write = co_tpdo_write_map), CO_NAME("TPDO1 mapping parameter")},
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = RW, PARA(map[0]), .def = 0x60100010u, CO_EXT(.write = co_tpdo_write_map), CO_NAME("1st mapped object")}, /* [inf] the INY frame (section 7.1.1) */
     {.index = 0x1A00, .sub = 2, CO_TYPE_U32, .attr = RW, PARA(map[1]), .def = 0x60200010u, CO_EXT(.write = co_tpdo_write_map), CO_NAME("2nd mapped object")}, /* [inf] the INY frame (section 7.1.1) */
+    CO_PROGDL_TABLE /* program download: the MCU image's side (co_progdl.h) */
     PF_2000_TO_6000,
     PF_AXIS(0x6010, 0, "long16"),
     PF_AXIS(0x6020, 1, "lateral16"),

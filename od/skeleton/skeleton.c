@@ -7,6 +7,7 @@
  * Here the choices are CiA 301 / CiA 410 defaults throughout.
  */
 #include "skeleton.h"
+#include "co_progdl.h"
 
 #include <string.h>
 
@@ -126,6 +127,7 @@ static const co_od_entry_t skel_entries[] = {
     {.index = 0x1800, .sub = 5, CO_TYPE_U16, .attr = RW, PARA(event_ms), .def = 0, CO_EXT(.write = co_tpdo_write_comm), CO_NAME("Event timer")},
     {.index = 0x1A00, .sub = 0, CO_TYPE_U8, .attr = CONST, .def = 1, CO_NAME("TPDO1 mapping parameter")},
     {.index = 0x1A00, .sub = 1, CO_TYPE_U32, .attr = CONST, .def = 0x60100010u, CO_NAME("1st mapped object")},
+    CO_PROGDL_TABLE /* program download: the MCU image's side (co_progdl.h) */
     {.index = 0x6000, .sub = 0, CO_TYPE_U16, .attr = RW, PARA(incl.resolution), .def = 10, CO_EXT(.write = skel_write_resolution), CO_NAME("Resolution")}, /* 0.01 deg */
     {.index = 0x6010, .sub = 0, CO_TYPE_I16, .attr = RO | CO_A_PDO, CO_EXT(.read = skel_read_slope), CO_NAME("Slope long16")},
     {.index = 0x6011, .sub = 0, CO_TYPE_U8, .attr = RW, PARA(incl.op[0]), .def = 0, CO_EXT(.min = 0, .max = 3), CO_NAME("Slope long16 operating parameter")},
