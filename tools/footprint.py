@@ -19,6 +19,9 @@ from stack_depth import depth
 # is given 128 B more: 10 496 B. RAM stays 1 KB with the stack.
 TARGET_FLASH, TARGET_RAM = 10496, 1024
 TARGET_BOARD = "nucleo-f042k6"
+# The Cortex-M0 boards' bootloader (boot.elf, where built): the first 4 KiB
+# of flash (docs/program-download.md, "Bootloaders and flash layouts").
+BOOT_FLASH = 4096
 # RAM of the Cortex-M0 boards: every image's RAM and worst-case stack must fit.
 BOARD_RAM = {"nucleo-f042k6": 6 * 1024,  # STM32F042K6
              "microbit": 16 * 1024}  # nRF51822
@@ -79,8 +82,13 @@ def main(argv):
         print(f"\n{title}")
         print(f"{'product ID':<18} {'flash':>7} {'RAM':>6} {'stack':>7} {'od':>6} {'board':>6}"
               f" {'SP max':>7}")
-        for elf in sorted(Path(build, "bin").glob("fw-*.elf")):
-            pid = elf.stem[3:]
+        # The images without a bootloader (fw-ID.elf): the applications
+        # under it (fw-ID-app.elf) are the same code at another address.
+        # Then the bootloader (boot.elf), where the board builds it.
+        elfs = [e for e in sorted(Path(build, "bin").glob("fw-*.elf")) if not e.stem.endswith("-app")]
+        elfs += [e for e in [Path(build, "bin", "boot.elf")] if e.exists()]
+        for elf in elfs:
+            pid = elf.stem[3:] if elf.stem != "boot" else "(bootloader)"
             text, data, bss = map(int, subprocess.run([size_tool, str(elf)], check=True,
                                   capture_output=True, text=True).stdout.splitlines()[1].split()[:3])
             s = shares(elf, size_tool.replace("-size", "-nm"), text + data)
@@ -92,6 +100,10 @@ def main(argv):
                 print(f"footprint: {pid} needs {data + bss + sp} bytes of RAM with its stack",
                       file=sys.stderr)
                 overflow = True
+            if check and arm and elf.stem == "boot" and text + data > BOOT_FLASH:
+                print(f"footprint: the {board} bootloader has {text + data} bytes of flash, "
+                      f"more than its {BOOT_FLASH}", file=sys.stderr)
+                failed = True
             if check and board == TARGET_BOARD and pid.startswith("dst-x730-"):
                 failed |= text + data > TARGET_FLASH or data + bss + sp > TARGET_RAM
     if overflow:

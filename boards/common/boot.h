@@ -6,20 +6,25 @@
  * heartbeat, SDO and the loader side of program download only. It runs
  * under the installed product's node-ID, bit rate and identity, which it
  * takes, best first, from:
- *  1. the hand-over block: RAM at a fixed address (each board's link
- *     scripts name it _boot_handover), written by the application just
- *     before it resets into the bootloader on 1F51h:1 = 0 (stop);
- *  2. the boot-info record, one flash page of its own, which the
- *     bootloader writes from a hand-over whose identity it does not hold
- *     yet, before anything of the application is erased: a power cut in
- *     the middle of an update leaves a bootloader that still answers with
- *     the product's 1000h and 1018h, as a CiA 302-2 master wants before it
- *     downloads again;
+ *  1. the hand-over block (boot_handover_t): RAM at a fixed address (each
+ *     board's link scripts name it _boot_handover), written by the
+ *     application just before it resets into the bootloader on
+ *     1F51h:1 = 0 (stop): its node-ID and bit rate. The identity (1000h,
+ *     1018h:1-3, the product ID) is the installed image's header's, which
+ *     the download checked against the application's own dictionary, and
+ *     1018h:4 is the board's serial number (board_serial): the block
+ *     carries no more, so that the application pays little flash for it;
+ *  2. the boot-info record (boot_ident_t), one flash page of its own,
+ *     which the bootloader writes from a hand-over whose identity it does
+ *     not hold yet, before anything of the application is erased: a power
+ *     cut in the middle of an update leaves a bootloader that still
+ *     answers with the product's 1000h and 1018h, as a CiA 302-2 master
+ *     wants before it downloads again;
  *  3. neither (a board that was never updated and holds no valid
  *     application): node-ID BOOT_DEFAULT_ID at BOOT_DEFAULT_KBPS, identity
  *     0.
- * Both carry the same bytes (boot_ident_t) with a magic and a CRC-32, so
- * that RAM left from a power-on or a page half written reads as none.
+ * Each carries a magic (the boot-info record also a CRC-32), so that RAM
+ * left from a power-on or a page half written reads as none.
  */
 #ifndef BOOT_H
 #define BOOT_H
@@ -37,8 +42,23 @@
 #define BOOT_DEFAULT_ID 127u            /* a blank board's node-ID (CiA 301's last) */
 #define BOOT_DEFAULT_KBPS 250u          /* and bit rate (CiA 301's default) */
 
-/* What the bootloader runs as. Little-endian words, 4-aligned, the same
- * layout in RAM (hand-over) and flash (boot-info). */
+/* The hand-over block: what the application leaves in RAM for the
+ * bootloader (boot_handover_poll). */
+typedef struct boot_handover {
+    uint32_t magic;  /* BOOT_HANDOVER_MAGIC */
+    uint8_t node_id; /* the active node-ID, 1..127 */
+    uint8_t pad;     /* 0 */
+    uint16_t kbps;   /* the active bit rate, kbit/s */
+} boot_handover_t;
+
+/* Whether h holds a hand-over: the magic, a node-ID of 1..127 and a bit
+ * rate. No check word: RAM that a power-on left holds the 32-bit magic
+ * by chance once in 2^32, and the block is written whole right before
+ * the reset (its flash cost counts in the DST X730's budget). */
+bool boot_handover_valid(const boot_handover_t *h);
+
+/* What the bootloader runs as, kept in its boot-info page (boot_main.c).
+ * Little-endian words, 4-aligned. */
 typedef struct boot_ident {
     uint32_t magic;           /* BOOT_HANDOVER_MAGIC or BOOT_INFO_MAGIC */
     uint32_t device_type;     /* 1000h */
@@ -49,20 +69,12 @@ typedef struct boot_ident {
     uint8_t node_id;          /* the active node-ID, 1..127 */
     uint8_t pad;              /* 0 */
     uint16_t kbps;            /* the active bit rate, kbit/s */
-    char id[CO_IMAGE_ID_LEN]; /* product ID, from the installed image's header
-                               * (the bootloader's; a hand-over leaves it 0) */
+    char id[CO_IMAGE_ID_LEN]; /* product ID, from the installed image's header */
     uint32_t crc;             /* co_crc32 of the bytes before it */
 } boot_ident_t;
 
 /* Bytes of boot_ident_t covered by its CRC. */
 #define BOOT_IDENT_CRC_LEN ((uint32_t)offsetof(boot_ident_t, crc))
-
-/* Whether b holds a record with magic: the magic, the CRC, a node-ID of
- * 1..127 and a bit rate. */
-bool boot_ident_valid(const boot_ident_t *b, uint32_t magic);
-
-/* Fill in b's magic and CRC. */
-void boot_ident_seal(boot_ident_t *b, uint32_t magic);
 
 /* ---- What a board provides to the bootloader -------------------------------
  * One line each; none is called from an interrupt. */
@@ -89,16 +101,13 @@ _Noreturn void board_reset(void);
 
 /* ---- The application's side (boot_ident.c) ---------------------------------- */
 
-/* Write the hand-over block with identity b and reset into the
- * bootloader. Never returns. The block may lie over the application's own
- * memory: nothing of it is used after. */
-_Noreturn void boot_handover(const boot_ident_t *b);
-
-/* The main loop's call after each frame's answer (mcu_main.c): when a
- * stop asked for it (co_port_prog_handover), hand over node's node-ID,
- * bit rate (product p's table) and identity (1000h, 1018h:1-4). A node
- * without a node-ID (LSS unconfigured) or a bit rate hands over a block
- * the bootloader does not take: it boots the application again. */
+/* The main loop's call after each pass (mcu_main.c): when a stop asked
+ * for it (co_port_prog_handover), write the hand-over block with node's
+ * node-ID and bit rate (product p's table) and reset into the bootloader
+ * (board_reset): it does not return then. The block may lie over the
+ * application's own memory: nothing of it is used after. A node without
+ * a node-ID (LSS unconfigured) or a bit rate hands over a block the
+ * bootloader does not take: it boots the application again. */
 void boot_handover_poll(co_node_t *node, const product_t *p);
 
 #endif /* BOOT_H */

@@ -1,33 +1,17 @@
 /*
- * boot_ident.c - the identity record that the application hands over to
- * the bootloader and the bootloader keeps in flash (boot.h); linked into
- * both.
+ * boot_ident.c - the application's side of the hand-over to the
+ * bootloader (boot.h): linked into every product image, and into the
+ * bootloader, which reads the block.
  */
 #include "boot.h"
 
-#include <string.h>
-
 /* Where the hand-over block lies (each board's link scripts). */
-extern boot_ident_t _boot_handover;
+extern boot_handover_t _boot_handover;
 
-bool boot_ident_valid(const boot_ident_t *b, uint32_t magic)
+bool boot_handover_valid(const boot_handover_t *h)
 {
-    return b->magic == magic && b->crc == co_crc32(0, (const uint8_t *)b, BOOT_IDENT_CRC_LEN) &&
-           b->node_id >= 1u && b->node_id <= CO_NODE_ID_MAX && b->kbps != 0u;
-}
-
-void boot_ident_seal(boot_ident_t *b, uint32_t magic)
-{
-    b->magic = magic;
-    b->crc = co_crc32(0, (const uint8_t *)b, BOOT_IDENT_CRC_LEN);
-}
-
-void boot_handover(const boot_ident_t *b)
-{
-    boot_ident_t h = *b; /* b may lie where the block goes */
-    boot_ident_seal(&h, BOOT_HANDOVER_MAGIC);
-    _boot_handover = h;
-    board_reset();
+    return h->magic == BOOT_HANDOVER_MAGIC && h->node_id >= 1u && h->node_id <= CO_NODE_ID_MAX &&
+           h->kbps != 0u;
 }
 
 /* The application side of program download (co_progdl.h): a stop
@@ -46,16 +30,8 @@ void boot_handover_poll(co_node_t *node, const product_t *p)
     if (!handover_due) {
         return;
     }
-    boot_ident_t b;
-    memset(&b, 0, sizeof b);
-    uint32_t *w = &b.device_type; /* 1000h, then 1018h:1..4 */
-    for (uint8_t i = 0; i < 5u; i++) {
-        const co_od_entry_t *e = co_node_entry(node, i == 0u ? 0x1000u : 0x1018u, i);
-        if (e != NULL) {
-            (void)co_od_get(node, e, &w[i]);
-        }
-    }
-    b.node_id = co_node_id(node);
-    b.kbps = product_kbps(p, co_node_bitrate(node));
-    boot_handover(&b);
+    _boot_handover = (boot_handover_t){.magic = BOOT_HANDOVER_MAGIC,
+                                       .node_id = co_node_id(node),
+                                       .kbps = product_kbps(p, co_node_bitrate(node))};
+    board_reset();
 }

@@ -33,7 +33,14 @@
 #include <string.h>
 
 /* Where the application writes its hand-over (each board's link scripts). */
-extern boot_ident_t _boot_handover;
+extern boot_handover_t _boot_handover;
+
+static bool boot_ident_valid(const boot_ident_t *b)
+{
+    return b->magic == BOOT_INFO_MAGIC &&
+           b->crc == co_crc32(0, (const uint8_t *)b, BOOT_IDENT_CRC_LEN) && b->node_id >= 1u &&
+           b->node_id <= CO_NODE_ID_MAX && b->kbps != 0u;
+}
 
 typedef struct boot_para {
     uint16_t hb_ms; /* 1017h */
@@ -91,7 +98,7 @@ static void keep_info(const boot_ident_t *id)
         return;
     }
     f->ops->read(f->ctx, f->base, &old, sizeof old);
-    if (boot_ident_valid(&old, BOOT_INFO_MAGIC) && memcmp(&old, id, sizeof old) == 0) {
+    if (boot_ident_valid(&old) && memcmp(&old, id, sizeof old) == 0) {
         return;
     }
     if (!f->ops->erase(f->ctx, f->base)) {
@@ -107,8 +114,8 @@ static void keep_info(const boot_ident_t *id)
 }
 
 /* What the bootloader runs as (boot.h: hand-over, boot-info, defaults).
- * The product ID comes from the installed image (h, when valid) or the
- * boot-info record. */
+ * With a hand-over: its node-ID and bit rate, the identity of the
+ * installed image's header h (valid), else of the boot-info record. */
 static void identity(boot_ident_t *id, bool handed, bool valid, const co_image_hdr_t *h)
 {
     const flash_ee_t *f = board_boot_info();
@@ -117,24 +124,27 @@ static void identity(boot_ident_t *id, bool handed, bool valid, const co_image_h
     if (f != NULL) {
         f->ops->read(f->ctx, f->base, &info, sizeof info);
     }
-    bool have_info = boot_ident_valid(&info, BOOT_INFO_MAGIC);
-    if (handed) {
-        *id = _boot_handover;
-        memset(id->id, 0, sizeof id->id);
-        if (valid) {
-            memcpy(id->id, h->id, sizeof id->id);
-        } else if (have_info) {
-            memcpy(id->id, info.id, sizeof id->id);
-        }
-        boot_ident_seal(id, BOOT_INFO_MAGIC);
-        keep_info(id);
+    bool have_info = boot_ident_valid(&info);
+    memset(id, 0, sizeof *id);
+    if (handed && valid) {
+        id->device_type = h->device_type;
+        id->vendor = h->vendor;
+        id->product = h->product;
+        id->revision = h->revision;
+        memcpy(id->id, h->id, sizeof id->id);
     } else if (have_info) {
         *id = info;
-    } else {
-        memset(id, 0, sizeof *id);
+    }
+    id->serial = board_serial(0);
+    if (handed) {
+        id->node_id = _boot_handover.node_id;
+        id->kbps = _boot_handover.kbps;
+        id->magic = BOOT_INFO_MAGIC;
+        id->crc = co_crc32(0, (const uint8_t *)id, BOOT_IDENT_CRC_LEN);
+        keep_info(id);
+    } else if (!have_info) {
         id->node_id = BOOT_DEFAULT_ID;
         id->kbps = BOOT_DEFAULT_KBPS;
-        id->serial = board_serial(0);
     }
     /* Taken: a reset from here on (a start, NMT reset node, a cut) sees
      * no hand-over. */
@@ -318,7 +328,7 @@ static const product_t boot_product = {.nodes = 1};
 int main(void)
 {
     co_image_hdr_t h;
-    bool handed = boot_ident_valid(&_boot_handover, BOOT_HANDOVER_MAGIC);
+    bool handed = boot_handover_valid(&_boot_handover);
     boot.area = board_boot_area();
     bool valid = app_valid(boot.area, &h);
     if (valid && !handed) {

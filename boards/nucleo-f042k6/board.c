@@ -14,6 +14,7 @@
 
 #include "boot.h"
 #include "co_port.h"
+#include "co_progdl.h"
 #include "flash_ee.h"
 #include "stm32f042.h"
 #include "uid_serial.h"
@@ -327,6 +328,61 @@ void board_reset(void)
          n++) {
     }
     WR32(SCB_AIRCR, SCB_AIRCR_SYSRESETREQ);
+    for (;;) {
+    }
+}
+
+/* ---- bootloader ------------------------------------------------------------ */
+
+/* The layout (layout.ld; docs/program-download.md): the application area
+ * and the boot-info page in the same 1 KiB pages as the EEPROM, written
+ * through the same driver. */
+extern const uint8_t _app_area[], _app_area_end[], _app_vectors[], _boot_info[];
+extern volatile uint32_t _app_running;
+#define BOOT_APP_RUNNING 0x4E555241u /* startup.c's */
+
+const flash_ee_t *board_boot_area(void)
+{
+    static const flash_ee_t area = {.ops = &f042_flash,
+                                    .ctx = 0,
+                                    .base = (uint32_t)(uintptr_t)_app_area,
+                                    .page_size = 1024u,
+                                    .pages = 19u}; /* layout.ld's area: 0x08001400 .. 0x08006000 */
+    return &area;
+}
+
+const flash_ee_t *board_boot_info(void)
+{
+    static const flash_ee_t info = {.ops = &f042_flash,
+                                    .ctx = 0,
+                                    .base = (uint32_t)(uintptr_t)_boot_info,
+                                    .page_size = 1024u,
+                                    .pages = 1u};
+    return &info;
+}
+
+uint8_t board_boot_check(const co_image_hdr_t *h)
+{
+    if (h->board != CO_IMAGE_BOARD_NUCLEO_F042K6) {
+        return CO_PROGDL_FORMAT;
+    }
+    if (h->load_addr != (uint32_t)(uintptr_t)_app_vectors ||
+        h->length > (uint32_t)(_app_area_end - _app_area)) {
+        return CO_PROGDL_ADDRESS;
+    }
+    return CO_PROGDL_OK;
+}
+
+/* Enter the application as a reset would: its stack pointer and reset
+ * handler from its table, the bootloader's vectors forwarding to it. */
+void board_boot_app(const co_image_hdr_t *h)
+{
+    const uint32_t *v = (const uint32_t *)(uintptr_t)h->load_addr;
+    _app_running = BOOT_APP_RUNNING;
+    __asm__ volatile("msr msp, %0\n"
+                     "bx %1\n"
+                     :
+                     : "r"(v[0]), "r"(v[1]));
     for (;;) {
     }
 }

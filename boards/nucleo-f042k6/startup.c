@@ -12,8 +12,17 @@ void default_handler(void);
 void systick_handler(void);
 void can_irq_handler(void);
 
+#ifdef BOARD_BOOT
+#define BOOT_APP_RUNNING 0x4E555241u /* "ARUN" */
+extern volatile uint32_t _app_running;
+extern const uint32_t _app_vectors[];
+#endif
+
 void reset_handler(void)
 {
+#ifdef BOARD_BOOT
+    _app_running = 0;
+#endif
     uint32_t *src = &_sidata;
     for (uint32_t *dst = &_sdata; dst < &_edata;) {
         *dst++ = *src++;
@@ -34,15 +43,47 @@ void default_handler(void)
 
 typedef void (*vector_t)(void);
 
+#ifdef BOARD_BOOT
+/* The application's handler of exception n while it runs, else own. */
+#define FORWARD(name, n, own)                                                                      \
+    static void name(void)                                                                         \
+    {                                                                                              \
+        if (_app_running == BOOT_APP_RUNNING) {                                                    \
+            ((vector_t)(uintptr_t)_app_vectors[n])();                                              \
+        } else {                                                                                   \
+            own();                                                                                 \
+        }                                                                                          \
+    }
+FORWARD(nmi_fwd, 2, default_handler)
+FORWARD(hardfault_fwd, 3, default_handler)
+FORWARD(svc_fwd, 11, default_handler)
+FORWARD(pendsv_fwd, 14, default_handler)
+FORWARD(systick_fwd, 15, systick_handler)
+FORWARD(can_fwd, 16 + 30, can_irq_handler)
+#define nmi_h nmi_fwd
+#define hardfault_h hardfault_fwd
+#define svc_h svc_fwd
+#define pendsv_h pendsv_fwd
+#define systick_h systick_fwd
+#define can_h can_fwd
+#else
+#define nmi_h default_handler
+#define hardfault_h default_handler
+#define svc_h default_handler
+#define pendsv_h default_handler
+#define systick_h systick_handler
+#define can_h can_irq_handler
+#endif
+
 /* 16 core exceptions, then IRQ 0..31 (RM0091 table 37). Vectors left 0
  * fault into the hard-fault handler if their interrupt ever fires. */
 __attribute__((section(".isr_vector"), used)) static const vector_t vectors[48] = {
     (vector_t)(uintptr_t)&_estack, /* initial stack pointer */
     reset_handler,
-    default_handler,        /* NMI */
-    default_handler,        /* HardFault */
-    [11] = default_handler, /* SVCall */
-    [14] = default_handler, /* PendSV */
-    [15] = systick_handler,
-    [16 + 30] = can_irq_handler, /* CEC_CAN */
+    nmi_h,             /* NMI */
+    hardfault_h,       /* HardFault */
+    [11] = svc_h,      /* SVCall */
+    [14] = pendsv_h,   /* PendSV */
+    [15] = systick_h,  /* SysTick */
+    [16 + 30] = can_h, /* CEC_CAN */
 };
