@@ -46,14 +46,16 @@
  * Layering of src/ (no include or call cycle but through this object):
  *   node        owns every module's state; dispatches frames, polls, resets
  *     -> nmt, sdo, sync, tpdo, hb, emcy, store, the optional services
- *        (guard, hbc, lss, rtr): the protocol modules
- *          -> od (the dictionary), common: the leaves
+ *        (guard, hbc, lss, rtr, progdl): the protocol modules
+ *          -> od (the dictionary), image (program images), common: the leaves
  *   incl (CiA 410), filter, led: libraries the products (led: the node)
  *   call, calling no other module but filter
  * A protocol module reaches another only downwards (sync -> tpdo at a
  * SYNC, nmt -> tpdo at a state change, store -> emcy for 6300h, lss ->
  * store, sdo -> nmt (SDO allowed in this state), guard and hbc -> nmt and
- * emcy (their timeouts), guard asks hb through co_hb_period_ms()), and everything may call
+ * emcy (their timeouts), guard asks hb through co_hb_period_ms(); the SDO
+ * server hands a DOMAIN's bytes to the config's handler, progdl's, through
+ * co_node_cfg_t.sdo_domain, a pointer), and everything may call
  * back into the node (co_node_send, co_node_entry, co_node_reset, the NMT
  * state in node->nmt). The dictionary calls no protocol module: a write
  * hook of a product table (co_store_write_save, co_tpdo_write_comm, ...) is
