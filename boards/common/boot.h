@@ -7,7 +7,7 @@
  * under the installed product's node-ID, bit rate and identity, which it
  * takes, best first, from:
  *  1. the hand-over block (boot_handover_t): RAM at a fixed address (each
- *     board's link scripts name it _boot_handover), written by the
+ *     board's link scripts name it boot_handover_block), written by the
  *     application just before it resets into the bootloader on
  *     1F51h:1 = 0 (stop): its node-ID and bit rate. The identity (1000h,
  *     1018h:1-3, the product ID) is the installed image's header's, which

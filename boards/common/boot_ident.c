@@ -6,7 +6,7 @@
 #include "boot.h"
 
 /* Where the hand-over block lies (each board's link scripts). */
-extern boot_handover_t _boot_handover;
+extern boot_handover_t boot_handover_block;
 
 bool boot_handover_valid(const boot_handover_t *h)
 {
@@ -30,8 +30,8 @@ void boot_handover_poll(co_node_t *node, const product_t *p)
     if (!handover_due) {
         return;
     }
-    _boot_handover = (boot_handover_t){.magic = BOOT_HANDOVER_MAGIC,
-                                       .node_id = co_node_id(node),
-                                       .kbps = product_kbps(p, co_node_bitrate(node))};
+    boot_handover_block = (boot_handover_t){.magic = BOOT_HANDOVER_MAGIC,
+                                            .node_id = co_node_id(node),
+                                            .kbps = product_kbps(p, co_node_bitrate(node))};
     board_reset();
 }

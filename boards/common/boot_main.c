@@ -33,7 +33,7 @@
 #include <string.h>
 
 /* Where the application writes its hand-over (each board's link scripts). */
-extern boot_handover_t _boot_handover;
+extern boot_handover_t boot_handover_block;
 
 static bool boot_ident_valid(const boot_ident_t *b)
 {
@@ -137,8 +137,8 @@ static void identity(boot_ident_t *id, bool handed, bool valid, const co_image_h
     }
     id->serial = board_serial(0);
     if (handed) {
-        id->node_id = _boot_handover.node_id;
-        id->kbps = _boot_handover.kbps;
+        id->node_id = boot_handover_block.node_id;
+        id->kbps = boot_handover_block.kbps;
         id->magic = BOOT_INFO_MAGIC;
         id->crc = co_crc32(0, (const uint8_t *)id, BOOT_IDENT_CRC_LEN);
         keep_info(id);
@@ -148,7 +148,7 @@ static void identity(boot_ident_t *id, bool handed, bool valid, const co_image_h
     }
     /* Taken: a reset from here on (a start, NMT reset node, a cut) sees
      * no hand-over. */
-    _boot_handover.magic = 0;
+    boot_handover_block.magic = 0;
 }
 
 /* ---- the stack's port: program download's loader side ------------------------ */
@@ -328,7 +328,7 @@ static const product_t boot_product = {.nodes = 1};
 int main(void)
 {
     co_image_hdr_t h;
-    bool handed = boot_handover_valid(&_boot_handover);
+    bool handed = boot_handover_valid(&boot_handover_block);
     boot.area = board_boot_area();
     bool valid = app_valid(boot.area, &h);
     if (valid && !handed) {

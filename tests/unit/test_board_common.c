@@ -240,7 +240,7 @@ static bool rx_pending(void)
 
 /* The hand-over to the bootloader (boot.h): the block it writes, and the
  * reset that follows, which leaves the loop. */
-boot_handover_t _boot_handover;
+boot_handover_t boot_handover_block;
 static unsigned resets;         /* board_reset() calls */
 static unsigned tx_at_reset;    /* frames sent when it came */
 static bool handover_on_answer; /* the next SDO answer asks for the hand-over */
@@ -783,7 +783,7 @@ static void test_main_loop_hands_over(void)
 {
     bd_reset(true, true, 1000000u);
     memset(nvm, 0xFF, sizeof(nvm));
-    memset(&_boot_handover, 0, sizeof _boot_handover);
+    memset(&boot_handover_block, 0, sizeof boot_handover_block);
     resets = 0;
     uint32_t start = bd.now;
     deliver((co_frame_t){.id = 0x67F, .dlc = 8, .data = {0x40, 0x00, 0x10, 0x00}}, start + 300000u);
@@ -798,18 +798,18 @@ static void test_main_loop_hands_over(void)
         CHECK_EQ(bd.tx[tx_at_reset - 1u].id, 0x5FF);
         CHECK_EQ(bd.tx_at[tx_at_reset - 1u] - start, 300000);
     }
-    CHECK(boot_handover_valid(&_boot_handover));
-    CHECK_EQ(_boot_handover.node_id, 0x7F);
-    CHECK_EQ(_boot_handover.kbps, 250);
+    CHECK(boot_handover_valid(&boot_handover_block));
+    CHECK_EQ(boot_handover_block.node_id, 0x7F);
+    CHECK_EQ(boot_handover_block.kbps, 250);
     /* Another magic, no node-ID, no bit rate: the bootloader takes no block. */
-    _boot_handover.magic ^= 1u;
-    CHECK(!boot_handover_valid(&_boot_handover));
-    _boot_handover.magic ^= 1u;
-    _boot_handover.node_id = 0;
-    CHECK(!boot_handover_valid(&_boot_handover));
-    _boot_handover.node_id = 0x7F;
-    _boot_handover.kbps = 0;
-    CHECK(!boot_handover_valid(&_boot_handover));
+    boot_handover_block.magic ^= 1u;
+    CHECK(!boot_handover_valid(&boot_handover_block));
+    boot_handover_block.magic ^= 1u;
+    boot_handover_block.node_id = 0;
+    CHECK(!boot_handover_valid(&boot_handover_block));
+    boot_handover_block.node_id = 0x7F;
+    boot_handover_block.kbps = 0;
+    CHECK(!boot_handover_valid(&boot_handover_block));
 }
 
 int main(void)
