@@ -2,6 +2,7 @@
 the EDS that shows the objects of program download only with it (off
 keeps exactly the manual's dictionary). On the bus: test_progdl.py."""
 import pathlib
+import struct
 import subprocess
 import sys
 
@@ -61,3 +62,30 @@ def test_eds(pid, tmp_path):
     for line in plain.stdout.splitlines():
         if line.startswith("[") or line.startswith("ParameterName"):
             assert line in with_pd.stdout, line
+
+
+def test_lely_dcfgen_takes_the_bus_yml_of_the_docs(tmp_path):
+    """docs/program-download.md's bus.yml: Lely's dcfgen (dcf-tools) takes
+    it with the EDS of --program-download without a warning, and writes
+    the update into the master's configuration (1F55h, 1F58h's
+    UploadFile, 1F81h bits 5 and 6); with the manual's EDS it warns that
+    1F56h:1 is missing."""
+    dcfgen = pathlib.Path(sys.executable).with_name("dcfgen")
+    (tmp_path / "x730.img").write_bytes(b"")  # dcfgen only names it
+    bus = ('options:\n  dcf_path: "."\nmaster:\n  node_id: 1\nx730:\n  dcf: "x730.eds"\n'
+           '  node_id: 0x7F\n  software_file: "x730.img"\n  software_version: 0x10001\n')
+    (tmp_path / "bus.yml").write_text(bus)
+    for args, warns in ((("--eds", "--program-download"), False), (("--eds",), True)):
+        r = run("--product", "dst-x730-xy30", *args)
+        (tmp_path / "x730.eds").write_text(r.stdout)
+        g = subprocess.run([str(dcfgen), "-r", "bus.yml"], cwd=tmp_path, capture_output=True,
+                           text=True, timeout=60)
+        assert g.returncode == 0, g.stderr
+        assert ("sub-object 0x1F56/1 does not exist" in g.stderr) == warns, g.stderr
+        if not warns:
+            dcf = (tmp_path / "master.dcf").read_text()
+            assert "UploadFile=x730.img" in dcf
+            assert "127=0x00000365" in dcf  # 1F81h: boot, check (bit 5), update (bit 6)
+            # 1F55h:7Fh = 10001h among the master's own SDO writes (concise DCF)
+            concise = struct.pack("<HBII", 0x1F55, 0x7F, 4, 0x10001)
+            assert concise in (tmp_path / "master.bin").read_bytes()
