@@ -3,8 +3,10 @@ line (SLCAN), with the `canopen` master: it boots a valid application; it
 stays, with the product's identity, when the application is invalid; an
 update from the running application (stop: hand-over, clear, download by
 block and by segmented SDO, start) ends in the new application's boot-up;
-a power cut after the clear leaves a bootloader that takes the next
-download. docs/program-download.md, "Bootloaders and flash layouts".
+power cuts at the hand-over, after the clear, during the download (in
+the header, an erase, the programming) and after the start leave either
+the old program (before the clear), the new one (whole and checked) or a
+bootloader that takes the next download. docs/program-download.md, "Bootloaders and flash layouts".
 
 The bootloader and the application images come from build-rv32-virt
 (bin/boot.elf, bin/fw-ID-app.elf; ctest's fixture emu.images_rv32-virt
@@ -185,4 +187,60 @@ def test_power_cut_after_the_clear(device, tmp_path):
     assert device.u32(0x1F56, 1) == 7
     device.control(1)
     time.sleep(1.0)
+    assert device.u32(0x1F51, 1) == 1
+
+
+@pytest.mark.parametrize("cut_at", [64, 4000, 15000])
+def test_power_cut_during_the_download(device, tmp_path, cut_at):
+    """Cut after cut_at bytes of the image went to the master's block
+    download (the device a little behind: somewhere in the header, a page
+    erase or the programming): the device comes back in its bootloader,
+    no valid program, the product's identity; the next download completes
+    and the new program starts."""
+    device.start(install=image(tmp_path, 5))
+    device.control(0)
+    time.sleep(0.5)
+    device.control(3)
+    data = image(tmp_path, 6).read_bytes()
+    f = device.node.sdo.open(0x1F50, 1, "wb", size=len(data), block_transfer=True)
+    f.write(data[:cut_at])
+    device.cut()
+    device.start()
+    assert device.bootups == [b"\x00"]
+    assert device.u32(0x1000, 0) == 0x0008019A
+    assert device.u32(0x1F51, 1) == 3
+    assert device.u32(0x1F57, 1) == STATUS_NO_VALID
+    device.control(3)
+    device.download(image(tmp_path, 7), True)
+    assert device.u32(0x1F56, 1) == 7
+    device.bootups.clear()
+    device.control(1)
+    time.sleep(1.0)
+    assert device.bootups == [b"\x00"]
+    assert device.u32(0x1F51, 1) == 1
+
+
+def test_power_cut_at_the_hand_over(device, tmp_path):
+    """Cut right after the stop (the hand-over, the bootloader's start):
+    nothing was cleared, so the old program runs again at power-on."""
+    device.start(install=image(tmp_path, 5))
+    device.control(0)
+    device.cut()
+    device.start()
+    assert device.bootups == [b"\x00"]
+    assert device.u32(0x1F51, 1) == 1  # the application: it answers started
+
+
+def test_power_cut_after_the_start(device, tmp_path):
+    """Cut right after the start of a verified download: the new program
+    runs at power-on (its image is whole and checks)."""
+    device.start(install=image(tmp_path, 5))
+    device.control(0)
+    time.sleep(0.5)
+    device.control(3)
+    device.download(image(tmp_path, 6), False)
+    device.control(1)
+    device.cut()
+    device.start()
+    assert device.bootups == [b"\x00"]
     assert device.u32(0x1F51, 1) == 1
