@@ -18,6 +18,7 @@
 
 #include "boot.h"
 #include "co_port.h"
+#include "co_progdl.h"
 #include "flash_ee.h"
 #include "nrf51.h"
 #include "serial_link.h"
@@ -295,6 +296,61 @@ bool board_init(void)
 void board_reset(void)
 {
     SCB_AIRCR = 0x05FA0004u; /* the key, and a system reset */
+    for (;;) {
+    }
+}
+
+/* ---- bootloader ------------------------------------------------------------ */
+
+/* The layout (layout.ld; docs/program-download.md): the application area
+ * and the boot-info page in 1 KiB pages like the EEPROM's, written
+ * through the same driver. */
+extern const uint8_t _app_area[], _app_area_end[], _app_vectors[], _boot_info[];
+extern volatile uint32_t _app_running;
+#define BOOT_APP_RUNNING 0x4E555241u /* startup.c's */
+
+const flash_ee_t *board_boot_area(void)
+{
+    static const flash_ee_t area = {.ops = &nrf51_flash,
+                                    .ctx = 0,
+                                    .base = (uint32_t)(uintptr_t)_app_area,
+                                    .page_size = NRF51_PAGE_SIZE,
+                                    .pages = 243u}; /* layout.ld's area: 0x1400 .. 0x3E000 */
+    return &area;
+}
+
+const flash_ee_t *board_boot_info(void)
+{
+    static const flash_ee_t info = {.ops = &nrf51_flash,
+                                    .ctx = 0,
+                                    .base = (uint32_t)(uintptr_t)_boot_info,
+                                    .page_size = NRF51_PAGE_SIZE,
+                                    .pages = 1u};
+    return &info;
+}
+
+uint8_t board_boot_check(const co_image_hdr_t *h)
+{
+    if (h->board != CO_IMAGE_BOARD_MICROBIT) {
+        return CO_PROGDL_FORMAT;
+    }
+    if (h->load_addr != (uint32_t)(uintptr_t)_app_vectors ||
+        h->length > (uint32_t)(_app_area_end - _app_area)) {
+        return CO_PROGDL_ADDRESS;
+    }
+    return CO_PROGDL_OK;
+}
+
+/* Enter the application as a reset would: its stack pointer and reset
+ * handler from its table, the bootloader's vectors forwarding to it. */
+void board_boot_app(const co_image_hdr_t *h)
+{
+    const uint32_t *v = (const uint32_t *)(uintptr_t)h->load_addr;
+    _app_running = BOOT_APP_RUNNING;
+    __asm__ volatile("msr msp, %0\n"
+                     "bx %1\n"
+                     :
+                     : "r"(v[0]), "r"(v[1]));
     for (;;) {
     }
 }

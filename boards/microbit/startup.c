@@ -3,7 +3,9 @@
  * .data, clear .bss, then main(). The same steps as the Nucleo's
  * start-up; only the vector table differs (the chip's interrupt numbers).
  * Unused interrupts stop in default_handler; a hard fault too (a debugger
- * shows where).
+ * shows where). Built twice, as the Nucleo's: with BOARD_BOOT the
+ * bootloader's table forwards to the application's while it runs (the
+ * Nucleo's startup.c says how and why).
  */
 #include <stdint.h>
 
@@ -16,8 +18,17 @@ void default_handler(void);
 void uart0_handler(void);
 void timer0_handler(void);
 
+#ifdef BOARD_BOOT
+#define BOOT_APP_RUNNING 0x4E555241u /* "ARUN" */
+extern volatile uint32_t _app_running;
+extern const uint32_t _app_vectors[];
+#endif
+
 void reset_handler(void)
 {
+#ifdef BOARD_BOOT
+    _app_running = 0;
+#endif
     uint32_t *src = &_sidata;
     for (uint32_t *dst = &_sdata; dst < &_edata;) {
         *dst++ = *src++;
@@ -38,6 +49,38 @@ void default_handler(void)
 
 typedef void (*vector_t)(void);
 
+#ifdef BOARD_BOOT
+/* The application's handler of exception n while it runs, else own. */
+#define FORWARD(name, n, own)                                                                      \
+    static void name(void)                                                                         \
+    {                                                                                              \
+        if (_app_running == BOOT_APP_RUNNING) {                                                    \
+            ((vector_t)(uintptr_t)_app_vectors[n])();                                              \
+        } else {                                                                                   \
+            own();                                                                                 \
+        }                                                                                          \
+    }
+FORWARD(nmi_fwd, 2, default_handler)
+FORWARD(hardfault_fwd, 3, default_handler)
+FORWARD(svc_fwd, 11, default_handler)
+FORWARD(pendsv_fwd, 14, default_handler)
+FORWARD(uart_fwd, 16 + UART_IRQ, uart0_handler)
+FORWARD(timer_fwd, 16 + TIMER0_IRQ, timer0_handler)
+#define nmi_h nmi_fwd
+#define hardfault_h hardfault_fwd
+#define svc_h svc_fwd
+#define pendsv_h pendsv_fwd
+#define uart_h uart_fwd
+#define timer_h timer_fwd
+#else
+#define nmi_h default_handler
+#define hardfault_h default_handler
+#define svc_h default_handler
+#define pendsv_h default_handler
+#define uart_h uart0_handler
+#define timer_h timer0_handler
+#endif
+
 /* 16 core exceptions (the nRF51's Cortex-M0 has no SysTick), then IRQ
  * 0..31 (nRF51 reference manual, the instantiation table: the ID of a
  * peripheral is its interrupt number). Vectors left 0 fault into the
@@ -45,10 +88,10 @@ typedef void (*vector_t)(void);
 __attribute__((section(".isr_vector"), used)) static const vector_t vectors[48] = {
     (vector_t)(uintptr_t)&_estack, /* initial stack pointer */
     reset_handler,
-    default_handler,        /* NMI */
-    default_handler,        /* HardFault */
-    [11] = default_handler, /* SVCall */
-    [14] = default_handler, /* PendSV */
-    [16 + UART_IRQ] = uart0_handler,
-    [16 + TIMER0_IRQ] = timer0_handler,
+    nmi_h,           /* NMI */
+    hardfault_h,     /* HardFault */
+    [11] = svc_h,    /* SVCall */
+    [14] = pendsv_h, /* PendSV */
+    [16 + UART_IRQ] = uart_h,
+    [16 + TIMER0_IRQ] = timer_h,
 };
