@@ -41,7 +41,13 @@ def test_given_twice():
     assert r.returncode == 2 and "--program-download given twice" in r.stderr
 
 
-@pytest.mark.parametrize("pid", ["dst-x730-xy30", "gsh-a-redundant", "jd2xxx", "inx360d"])
+def product_ids():
+    out = subprocess.run([BINARY, "--list-products"], capture_output=True, text=True,
+                         check=True).stdout
+    return [line.split()[0] for line in out.splitlines()]
+
+
+@pytest.mark.parametrize("pid", product_ids())
 def test_eds(pid, tmp_path):
     plain = run("--product", pid, "--eds")
     with_pd = run("--product", pid, "--eds", "--program-download")

@@ -30,12 +30,14 @@
 typedef struct box {
     const product_t *prod;
     _Alignas(max_align_t) unsigned char inst[sizeof(product_any_t)];
-    uint8_t mem[CO_STORE_NVM_SIZE];
+    uint8_t mem[PRODUCT_MAX_NODES * CO_STORE_NVM_SIZE];
     lp_nvm_t nvm;
-    lp_port_t port;
+    lp_port_t port[PRODUCT_MAX_NODES];
     lp_tx_t tx;
     int sv[2];
-    co_node_t *node;
+    unsigned n;
+    co_node_t *nodes[PRODUCT_MAX_NODES];
+    co_node_t *node; /* nodes[0], the loader */
     lp_prog_t prog;
     uint32_t t;
     char err[600];
@@ -51,22 +53,29 @@ static void dev_on(box_t *d, const product_t *p)
     memset(d, 0, sizeof(*d));
     d->prod = p;
     CHECK(socketpair(AF_UNIX, SOCK_DGRAM | SOCK_NONBLOCK, 0, d->sv) == 0);
-    CHECK_EQ(
-        lp_nvm_open(&d->nvm, "--nvm", nvm_path, d->mem, sizeof(d->mem), d->err, sizeof(d->err)), 0);
+    d->n = p->nodes;
+    CHECK_EQ(lp_nvm_open(&d->nvm, "--nvm", nvm_path, d->mem, d->n * CO_STORE_NVM_SIZE, d->err,
+                         sizeof(d->err)),
+             0);
     d->tx.fd = d->sv[0];
-    d->port.fd = -1;
-    d->port.nvm = &d->nvm;
-    d->port.iface = "pair";
-    void *ports[1] = {&d->port};
-    co_node_t *nodes[1];
-    p->create(p, d->inst, ports, nodes);
-    d->node = nodes[0];
+    void *ports[PRODUCT_MAX_NODES];
+    for (unsigned i = 0; i < d->n; i++) {
+        d->port[i].fd = -1;
+        d->port[i].node = i;
+        d->port[i].nvm = &d->nvm;
+        d->port[i].iface = "pair";
+        ports[i] = &d->port[i];
+    }
+    p->create(p, d->inst, ports, d->nodes);
+    d->node = d->nodes[0];
     CHECK_EQ(lp_prog_build(&d->prog, co_cfg(d->node), d->err, sizeof(d->err)), 0);
-    CHECK_EQ(lp_prog_open(&d->prog, p->id, d->nvm.real, nodes, 1, d->err, sizeof(d->err)), 0);
-    d->port.prog = &d->prog;
-    d->port.progdl = &d->prog.pd;
+    CHECK_EQ(lp_prog_open(&d->prog, p->id, d->nvm.real, d->nodes, d->n, d->err, sizeof(d->err)), 0);
     d->t = 1000u;
-    co_node_start(d->node, d->t);
+    for (unsigned i = 0; i < d->n; i++) {
+        d->port[i].prog = &d->prog;
+        d->port[i].progdl = &d->prog.pd;
+        co_node_start(d->nodes[i], d->t);
+    }
 }
 
 static void dev_off(box_t *d)
@@ -81,7 +90,7 @@ static void dev_off(box_t *d)
 /* The frames the node sent since the last call (at most max). */
 static int sent(box_t *d, struct can_frame *f, int max)
 {
-    (void)lp_tx_flush(&d->tx, &d->port, 1);
+    (void)lp_tx_flush(&d->tx, d->port, d->n);
     int k = 0;
     while (k < max && read(d->sv[1], &f[k], sizeof(f[k])) == (ssize_t)sizeof(f[k])) {
         k++;
@@ -326,10 +335,10 @@ static void test_update(void)
     co_node_poll(d.node, d.t);
     CHECK_EQ(sdo_read(&d, 0x1F51, 1), 0);
     CHECK(!lp_prog_running(&d.prog));
-    unsigned before = d.port.txn;
+    unsigned before = d.port[0].txn;
     co_frame_t tpdo = {.id = (uint16_t)(0x180u + co_node_id(d.node)), .dlc = 8};
-    CHECK(co_port_can_send(&d.port, &tpdo)); /* not made: nothing queued */
-    CHECK_EQ(d.port.txn, before);
+    CHECK(co_port_can_send(&d.port[0], &tpdo)); /* not made: nothing queued */
+    CHECK_EQ(d.port[0].txn, before);
     /* Clear: FILE.prog empty (no valid program, also after a kill). */
     CHECK_EQ(sdo_write_u8(&d, 0x1F51, 1, 3), 0);
     CHECK_EQ(file_size(prog_path), 0);
@@ -543,6 +552,53 @@ static void test_refused(void)
     dev_off(&d);
 }
 
+/* Every product with the option: an update by segmented SDO ends in the
+ * boot-up of each of its nodes (both of a two-node product) as the new
+ * program. */
+static void test_every_product(void)
+{
+    static box_t d;
+    for (size_t i = 0; product_list[i] != NULL; i++) {
+        const product_t *p = product_list[i];
+        uint32_t pid = 0x500u + (uint32_t)i;
+        unlink(prog_path);
+        unlink(nvm_path);
+        dev_on(&d, p);
+        struct can_frame f[64];
+        (void)sent(&d, f, 64);
+        CHECK_EQ(sdo_read(&d, 0x1F56, 1), CO_PROGRAM_ID);
+        stop_clear(&d);
+        uint32_t n = make_image(img, p, d.node, pid, 500);
+        CHECK_EQ(download(&d, img, n, n), 0);
+        CHECK_EQ(flash_status(&d), 0);
+        (void)sent(&d, f, 64);
+        CHECK_EQ(sdo_write_u8(&d, 0x1F51, 1, 1), 0);
+        unsigned booted = 0;
+        for (int k = 0; k < 5; k++) {
+            d.t += 1000u;
+            for (unsigned j = 0; j < d.n; j++) {
+                co_node_poll(d.nodes[j], d.t);
+            }
+            int m = sent(&d, f, 64);
+            for (int j = 0; j < m; j++) {
+                for (unsigned q = 0; q < d.n; q++) {
+                    if (f[j].can_id == 0x700u + co_node_id(d.nodes[q]) && f[j].len == 1 &&
+                        f[j].data[0] == 0) {
+                        booted |= 1u << q;
+                    }
+                }
+            }
+        }
+        if (booted != (1u << d.n) - 1u) {
+            fprintf(stderr, "%s: boot-ups of nodes %#x\n", p->id, booted);
+            FAIL("not every node booted up after the start");
+        }
+        CHECK_EQ(sdo_read(&d, 0x1F56, 1), pid);
+        CHECK_EQ(sdo_read(&d, 0x1F51, 1), 1);
+        dev_off(&d);
+    }
+}
+
 /* The dictionary: the loader's entries put in order into the product's,
  * 100Ah reading the manual's text until an image runs; the product's own
  * configuration untouched. */
@@ -582,6 +638,7 @@ int main(void)
     RUN(test_update);
     RUN(test_killed);
     RUN(test_refused);
+    RUN(test_every_product);
     lp_log_open(NULL);
     fclose(log);
     unlink(prog_path);
