@@ -477,6 +477,9 @@ static co_res_t watch(co_node_t *node, const co_od_entry_t *e, uint32_t at, cons
 
 /* The pieces: the largest multiple of 28 bytes within the buffer (56 of
  * 64), in order; a block fills one piece (the acknowledge follows it). */
+/* Segments of a piece: what a block the server asks for at most has. */
+#define SDO_PIECE_SEGMENTS (CO_SDO_BUF / 28u * 4u)
+
 static void test_pieces(void)
 {
     static img_t m;
@@ -497,6 +500,111 @@ static void test_pieces(void)
             /* The server asked for blocks of one piece each. */
             CHECK_EQ(blocks_seen, seen.pieces);
         }
+    }
+}
+
+/* A block download that loses segment `lost` of every block once: the
+ * server acknowledges what came in order, the client sends the rest
+ * again, and the next block is sized to what the piece lacks, so that
+ * every piece still goes whole before an acknowledge. */
+static void test_block_lost_segments(void)
+{
+    static img_t m;
+    make_image(&m, 1500, 8);
+    for (unsigned lost = 1; lost <= 8u; lost += 3u) {
+        h_dev_t *d = boot_loader(CO_PROGDL_NO_PROGRAM, 0);
+        cfg_buf.cfg.sdo_domain = watch;
+        memset(&seen, 0, sizeof(seen));
+        clear(d);
+        uint8_t q[8] = {0xC6, 0x50, 0x1F, 1, 0, 0, 0, 0};
+        co_put_u32(&q[4], m.len);
+        send(d, q);
+        const co_frame_t *r = answer(d);
+        CHECK_EQ(abort_of(r), 0);
+        uint32_t blksize = r->data[4];
+        uint32_t at = 0;
+        uint32_t dropped_at = UINT32_MAX; /* a block's start: its loss is sent again */
+        unsigned short_blocks = 0;
+        while (at < m.len) {
+            uint32_t start = at;
+            bool done = false;
+            for (uint8_t seq = 1; seq <= blksize && !done; seq++) {
+                uint32_t k = co_min_u32(7u, m.len - start - 7u * (seq - 1u));
+                done = start + 7u * (seq - 1u) + k >= m.len;
+                uint8_t f[8] = {(uint8_t)(seq | (done ? 0x80u : 0u))};
+                memcpy(&f[1], &m.b[start + 7u * (seq - 1u)], k);
+                if (seq == lost && dropped_at != start && !done) {
+                    dropped_at = start; /* this one never arrives; once from here */
+                    continue;
+                }
+                send(d, f);
+            }
+            r = answer(d);
+            CHECK_EQ(abort_of(r), 0);
+            if (r == NULL || abort_of(r) != 0u) {
+                return;
+            }
+            CHECK_EQ(r->data[0], 0xA2u);
+            uint32_t acked = r->data[1];
+            at = co_min_u32(start + 7u * acked, m.len);
+            short_blocks += r->data[2] < SDO_PIECE_SEGMENTS ? 1u : 0u;
+            blksize = r->data[2];
+            if (done && acked * 7u >= m.len - start) {
+                break;
+            }
+        }
+        uint32_t unused = (7u - m.len % 7u) % 7u;
+        uint8_t e[8] = {(uint8_t)(0xC1u | (unused << 2)), 0, 0, 0, 0, 0, 0, 0};
+        co_put_u16(&e[1], co_crc16_ccitt(0, m.b, m.len));
+        send(d, e);
+        CHECK_EQ(abort_of(answer(d)), 0);
+        /* Segments after the first lost: the server asked for the rest of a piece. */
+        CHECK(lost == 1u || short_blocks > 0u);
+        CHECK_EQ(seen.bad, 0);
+        CHECK_EQ(seen.max_len, CO_SDO_BUF / 28u * 28u);
+        CHECK(area_holds(d, &m));
+        until_idle(d);
+        CHECK_EQ(read_obj(d, 0x1F56, 1), 8);
+    }
+}
+
+/* A download cut short (the client's abort, the SDO timeout, a new
+ * request): no program, and the next needs a clear. */
+static void test_interrupted(void)
+{
+    static img_t m;
+    make_image(&m, 900, 6);
+    for (unsigned how = 0; how < 3u; how++) {
+        h_dev_t *d = boot_loader(CO_PROGDL_NO_PROGRAM, 0);
+        clear(d);
+        uint8_t q[8] = {0x21, 0x50, 0x1F, 1, 0, 0, 0, 0};
+        co_put_u32(&q[4], m.len);
+        send(d, q);
+        CHECK_EQ(abort_of(answer(d)), 0);
+        for (uint8_t i = 0; i < 20u; i++) { /* 140 bytes, the header among them */
+            uint8_t f[8] = {(uint8_t)((i & 1u) != 0u ? 0x10u : 0u)};
+            memcpy(&f[1], &m.b[7u * i], 7);
+            send(d, f);
+            CHECK_EQ(abort_of(answer(d)), 0);
+        }
+        if (how == 0u) {
+            uint8_t a[8] = {0x80, 0x50, 0x1F, 1, 0, 0, 0x04, 0x05};
+            send(d, a);
+        } else if (how == 1u) {
+            h_advance(d, CO_SDO_TIMEOUT_US + 1000u);
+            CHECK_EQ(abort_of(answer(d)), 0x05040000u);
+        } else {
+            CHECK_EQ(read_obj(d, 0x1F51, 1), CO_PROGDL_NO_PROGRAM);
+        }
+        h_advance(d, 10000);
+        CHECK_EQ(d->port.prog.commits, 0);
+        CHECK_EQ(download(d, 0x1F51, 1, 1, 1), E_STATE);
+        CHECK_EQ(seg_download(d, m.b, m.len), E_STATE);
+        CHECK_EQ(status_of(d), CO_PROGDL_NOT_CLEARED << 1);
+        clear(d);
+        CHECK_EQ(seg_download(d, m.b, m.len), 0);
+        until_idle(d);
+        CHECK_EQ(read_obj(d, 0x1F56, 1), 6);
     }
 }
 
@@ -852,6 +960,8 @@ int main(void)
     RUN(test_update_block_no_crc);
     RUN(test_update_lengths);
     RUN(test_pieces);
+    RUN(test_block_lost_segments);
+    RUN(test_interrupted);
     RUN(test_refuse_magic);
     RUN(test_refuse_identity);
     RUN(test_refuse_product_board);
