@@ -1,5 +1,6 @@
-"""tools/update without a bus: the image header it reads (against the
-format of include/co_image.h, written out here byte by byte), and its
+"""tools/update without a bus: the image header it reads (tools/mkimage's
+reader, against the format of include/co_image.h written out here byte by
+byte), and its
 command line's refusals (exit 2, the cause on stderr, nothing sent). The
 updates themselves: tests/integration/test_progdl.py (vcan)."""
 import importlib.machinery
@@ -48,10 +49,12 @@ class Header(unittest.TestCase):
 
     def test_refused_headers(self):
         for data, why in ((image()[:63], "shorter than the 64-byte header"),
-                          (image(magic=b"ELF\x7f"), "no image (magic"),
+                          (image(magic=b"ELF\x7f"), "not an image"),
                           (image()[:4] + b"\x40\x00\x02\x00" + image()[8:], "version 2"),
-                          (image(product="two words"), "malformed header"),
-                          (image(product=""), "malformed header"),
+                          (image()[:4] + b"\x20\x00\x01\x00" + image()[8:], "header size 32"),
+                          (image(product="two words"), "product ID field"),
+                          (image(product=""), "product ID field"),
+                          (image()[:44] + b"\1\0\0\0" + image()[48:], "reserved word"),
                           (image(length=10), "length 10: shorter than the header")):
             with self.assertRaises(tool.ImageError) as e:
                 tool.parse_header(data)
@@ -112,7 +115,7 @@ class CommandLine(unittest.TestCase):
         bad.write_bytes(image(crc=1))
         self.refused(f"{bad}: CRC-32", "--node", "5", bad)
         bad.write_bytes(b"\x7fELF" + bytes(100))
-        self.refused(f"{bad}: no image", "--node", "5", bad)
+        self.refused(f"{bad}: magic b'\\x7fELF', not b'COIM': not an image", "--node", "5", bad)
         self.refused("No such file", "--node", "5", self.dir / "none.img")
         twin = self.dir / "twin.img"
         twin.write_bytes(image(pid=7))
