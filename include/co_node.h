@@ -11,7 +11,8 @@
  *    pointers to them and never frees anything.
  *  - Read, at any time (static inline, free): co_node_app(),
  *    co_node_id(), co_node_serial(), co_node_bitrate(), co_node_nmt_state(),
- *    co_node_can_state(), co_node_tx_dropped(), co_node_store_status();
+ *    co_node_can_state(), co_node_can_kbps(), co_node_tx_dropped(),
+ *    co_node_store_status();
  *    dictionary values through co_node_entry() and co_od_get();
  *    co_store_limit_reached(); co_od_checking() in a write hook.
  *  - Change, from the product's reset hook only (co_node_ops_t.reset):
@@ -284,6 +285,15 @@ static inline uint8_t co_node_bitrate(const co_node_t *node)
 static inline co_nmt_state_t co_node_nmt_state(const co_node_t *node)
 {
     return (co_nmt_state_t)node->nmt.state;
+}
+
+/** The bit rate (kbit/s) the board was last asked for
+ * (co_port_can_bitrate): the one the node runs at, LSS "activate bit
+ * timing" included; 0 when its code names none, 0xFFFF before the first
+ * reset. A bootloader's hand-over reads it (boards/common/boot.h). */
+static inline uint16_t co_node_can_kbps(const co_node_t *node)
+{
+    return node->can_kbps;
 }
 
 /** The CAN controller's state as the board last reported it. */

@@ -103,7 +103,7 @@ def main(argv):
             if check and arm and elf.stem == "boot" and text + data > BOOT_FLASH:
                 print(f"footprint: the {board} bootloader has {text + data} bytes of flash, "
                       f"more than its {BOOT_FLASH}", file=sys.stderr)
-                failed = True
+                overflow = True  # said here; the X730's message below is not its
             if check and board == TARGET_BOARD and pid.startswith("dst-x730-"):
                 failed |= text + data > TARGET_FLASH or data + bss + sp > TARGET_RAM
     if overflow:

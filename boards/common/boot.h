@@ -35,7 +35,6 @@
 #include "co_image.h"
 #include "co_node.h"
 #include "flash_ee.h"
-#include "product.h"
 
 #define BOOT_HANDOVER_MAGIC 0x4F564448u /* "HDVO": the hand-over block */
 #define BOOT_INFO_MAGIC 0x464E4942u     /* "BINF": the boot-info record */
@@ -103,11 +102,11 @@ _Noreturn void board_reset(void);
 
 /* The main loop's call after each pass (mcu_main.c): when a stop asked
  * for it (co_port_prog_handover), write the hand-over block with node's
- * node-ID and bit rate (product p's table) and reset into the bootloader
- * (board_reset): it does not return then. The block may lie over the
- * application's own memory: nothing of it is used after. A node without
- * a node-ID (LSS unconfigured) or a bit rate hands over a block the
- * bootloader does not take: it boots the application again. */
-void boot_handover_poll(co_node_t *node, const product_t *p);
+ * node-ID and the bit rate it runs at (co_node_can_kbps) and reset into
+ * the bootloader (board_reset): it does not return then. The block may
+ * lie over the application's own memory: nothing of it is used after. A
+ * node without a node-ID (LSS unconfigured) or a bit rate hands over a
+ * block the bootloader does not take: it boots the application again. */
+void boot_handover_poll(co_node_t *node);
 
 #endif /* BOOT_H */

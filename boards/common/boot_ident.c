@@ -25,13 +25,12 @@ void co_port_prog_handover(void *port)
     handover_due = true;
 }
 
-void boot_handover_poll(co_node_t *node, const product_t *p)
+void boot_handover_poll(co_node_t *node)
 {
     if (!handover_due) {
         return;
     }
-    boot_handover_block = (boot_handover_t){.magic = BOOT_HANDOVER_MAGIC,
-                                            .node_id = co_node_id(node),
-                                            .kbps = product_kbps(p, co_node_bitrate(node))};
+    boot_handover_block = (boot_handover_t){
+        .magic = BOOT_HANDOVER_MAGIC, .node_id = co_node_id(node), .kbps = co_node_can_kbps(node)};
     board_reset();
 }

@@ -129,7 +129,7 @@ int main(void)
 #ifdef BOARD_RX_FILTER
         rx_filter(nodes, p->nodes);
 #endif
-        boot_handover_poll(nodes[0], p); /* after a stop, its answer on its way (board_can_state) */
+        boot_handover_poll(nodes[0]); /* after a stop, its answer on its way (board_can_state) */
         board_sleep(co_min_u32(wait, leds(nodes[0], now)));
     }
 }
