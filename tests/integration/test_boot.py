@@ -36,13 +36,13 @@ def need(path):
         pytest.fail(f"{path} is missing: build the rv32-virt images (docs/emulator.md)")
 
 
-def image(tmp_path, program_id, corrupt=False):
+def image(tmp_path, program_id, corrupt=False, product=PRODUCT):
     """The application wrapped by tools/mkimage; corrupt: one payload byte
-    changed afterwards (its CRC no longer checks)."""
-    elf = BUILD / f"fw-{PRODUCT}-app.elf"
+    changed afterwards (its CRC no longer checks); product: another's."""
+    elf = BUILD / f"fw-{product}-app.elf"
     need(elf)
-    out = tmp_path / f"app-{program_id}.img"
-    subprocess.run([str(ROOT / "tools" / "mkimage"), "--product", PRODUCT, "--board", "rv32-virt",
+    out = tmp_path / f"app-{product}-{program_id}.img"
+    subprocess.run([str(ROOT / "tools" / "mkimage"), "--product", product, "--board", "rv32-virt",
                     "--program-id", str(program_id), "--elf", str(elf), "-o", str(out)],
                    check=True, capture_output=True,
                    env={**os.environ, "CANOPEN_SENSOR": os.environ.get(
@@ -177,6 +177,30 @@ def test_update_from_the_application(device, tmp_path, block):
     time.sleep(1.0)
     assert device.bootups == [b"\x00"]
     assert device.u32(0x1F51, 1) == 1  # the new application runs
+
+
+def test_refuses_another_products_image(device, tmp_path):
+    """An image of another product (the DST X710 on the same board): the
+    download is refused with 08000020h, 1F57h status 3; the bootloader
+    stays ready, and the product's own image goes in after a new clear."""
+    device.start(install=image(tmp_path, 5))
+    device.control(0)
+    time.sleep(0.5)
+    device.control(3)
+    answers = []
+    device.net.subscribe(0x580 + NODE, lambda i, d, t: answers.append(bytes(d)))
+    # The master's own abort code may be of what the server said to the
+    # frames it sent after the refusal (more block segments; canopen's
+    # close sends one more): the server's first abort is the refusal.
+    with pytest.raises(canopen.SdoAbortedError):
+        device.download(image(tmp_path, 6, product="dst-x710-xy30"), True)
+    aborts = [a for a in answers if a[0] == 0x80]
+    assert aborts and aborts[0] == bytes.fromhex("80501f0120000008")  # 1F50h:01, 08000020h
+    assert device.u32(0x1F57, 1) == 3 << 1
+    assert device.u32(0x1F51, 1) == 3
+    device.control(3)
+    device.download(image(tmp_path, 7), True)
+    assert device.u32(0x1F56, 1) == 7
 
 
 def test_power_cut_after_the_clear(device, tmp_path):
