@@ -101,7 +101,7 @@
  */
 typedef struct co_progdl {
     uint8_t state;                  /**< CO_PROGDL_STOPPED, _STARTED, _NO_PROGRAM */
-    uint8_t status;                 /**< 1F57h bits 1-7, CO_PROGDL_OK .. */
+    uint8_t status;                 /**< 1F57h bits 1-7: CO_PROGDL_OK and the codes above */
     uint8_t phase;                  /**< where the download is (progdl.c) */
     uint8_t pending;                /**< start or stop due once the answer is out */
     uint32_t program_id;            /**< 1F56h:1 */
