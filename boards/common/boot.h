@@ -50,6 +50,11 @@ typedef struct boot_handover {
     uint16_t kbps;   /* the active bit rate, kbit/s */
 } boot_handover_t;
 
+/* Where the application writes its hand-over and the bootloader reads
+ * it: RAM at a fixed address (each board's link scripts place it; the
+ * host's unit tests define it). */
+extern boot_handover_t boot_handover_block;
+
 /* Whether h holds a hand-over: the magic, a node-ID of 1..127 and a bit
  * rate. No check word: RAM that a power-on left holds the 32-bit magic
  * by chance once in 2^32, and the block is written whole right before

@@ -5,9 +5,6 @@
  */
 #include "boot.h"
 
-/* Where the hand-over block lies (each board's link scripts). */
-extern boot_handover_t boot_handover_block;
-
 bool boot_handover_valid(const boot_handover_t *h)
 {
     return h->magic == BOOT_HANDOVER_MAGIC && h->node_id >= 1u && h->node_id <= CO_NODE_ID_MAX &&
