@@ -251,7 +251,10 @@ static void verify_step(co_node_t *node, co_progdl_t *pd)
         return;
     }
     uint32_t hdr = pd->pos < CO_IMAGE_HDR_SIZE ? co_min_u32(n, CO_IMAGE_HDR_SIZE - pd->pos) : 0u;
-    if (memcmp(b, &pd->raw[pd->pos], hdr) != 0) {
+    /* Past the header hdr is 0, and so is the comparison: raw is not
+     * indexed there (its address past the end was undefined behaviour,
+     * caught by UBSan in the clang build). */
+    if (hdr != 0u && memcmp(b, &pd->raw[pd->pos], hdr) != 0) {
         (void)fail(pd, CO_PROGDL_FLASH, CO_E_HW); /* the header is not what came */
         return;
     }
