@@ -13,11 +13,6 @@ static uint32_t le32(const uint8_t *p)
     return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24);
 }
 
-static uint16_t le16(const uint8_t *p)
-{
-    return (uint16_t)(p[0] | (p[1] << 8));
-}
-
 /* The product ID field: one or more printable characters without spaces
  * (an ID names a product, "dst-x730-xy30"), then NULs to the end. A byte
  * after the first NUL that is not NUL is refused: two images of one
@@ -49,20 +44,28 @@ bool co_image_parse(const uint8_t b[CO_IMAGE_HDR_SIZE], co_image_hdr_t *h)
     if (!CO_CHECK(b != NULL && h != NULL)) {
         return false;
     }
-    if (le32(b) != CO_IMAGE_MAGIC || le16(b + 4) != CO_IMAGE_HDR_SIZE ||
-        le16(b + 6) != CO_IMAGE_VERSION) {
+    /* The header's words 0-11, then the product ID (co_image.h's table):
+     * read in a loop, which costs a 4 KiB bootloader less than a line a
+     * field. */
+    uint32_t w[12];
+    for (unsigned i = 0; i < 12u; i++) {
+        w[i] = le32(b + (size_t)4u * i);
+    }
+    if (w[0] != CO_IMAGE_MAGIC ||
+        w[1] != (CO_IMAGE_HDR_SIZE | ((uint32_t)CO_IMAGE_VERSION << 16)) ||
+        w[2] < CO_IMAGE_HDR_SIZE || w[11] != 0u) {
         return false;
     }
-    h->length = le32(b + 8);
-    h->crc = le32(b + 12);
-    h->board = le32(b + 16);
-    h->device_type = le32(b + 20);
-    h->vendor = le32(b + 24);
-    h->product = le32(b + 28);
-    h->revision = le32(b + 32);
-    h->program_id = le32(b + 36);
-    h->load_addr = le32(b + 40);
-    return h->length >= CO_IMAGE_HDR_SIZE && le32(b + 44) == 0u && id_ok(b + 48, h->id);
+    h->length = w[2];
+    h->crc = w[3];
+    h->board = w[4];
+    h->device_type = w[5];
+    h->vendor = w[6];
+    h->product = w[7];
+    h->revision = w[8];
+    h->program_id = w[9];
+    h->load_addr = w[10];
+    return id_ok(b + 48, h->id);
 }
 
 /* Not inlined: the store's two callers (a record's read and its write)

@@ -2,8 +2,9 @@
  * boot.h - the bootloader of the MCU boards and its hand-over with the
  * application (docs/program-download.md, "Bootloaders and flash layouts").
  *
- * The bootloader (boot_main.c) is a node of this stack with NMT,
- * heartbeat, SDO and the loader side of program download only. It runs
+ * The bootloader (boot_main.c) speaks NMT, heartbeat, SDO and the loader
+ * side of program download only, with progdl.c's answers, in the 4 KiB
+ * of a Cortex-M0. It runs
  * under the installed product's node-ID, bit rate and identity, which it
  * takes, best first, from:
  *  1. the hand-over block (boot_handover_t): RAM at a fixed address (each

@@ -29,6 +29,7 @@ void serial_link_sample(serial_link_t *s, const product_t *p, int32_t values[], 
 
 /* ---- output --------------------------------------------------------------- */
 
+#ifndef BOARD_BOOT
 /* Printable ASCII only: an answer echoes parts of a rejected line, and a
  * byte such as BEL (an SLCAN line end for python-can) or one above 0x7E
  * (no text to python-can's decoder) would forge or break the master's
@@ -41,7 +42,9 @@ static void put_str(serial_put_fn put, const char *t)
                                                           : '?')); /* '\r': ours, ends a line */
     }
 }
+#endif
 
+#ifndef BOARD_BOOT
 static void put_uint(serial_put_fn put, uint32_t v)
 {
     char d[10];
@@ -54,6 +57,7 @@ static void put_uint(serial_put_fn put, uint32_t v)
         put(d[--n]);
     }
 }
+#endif
 
 static char hex_digit(unsigned v)
 {
@@ -119,6 +123,18 @@ static int hex_value(char c)
         return c - 'A' + 10;
     }
     return c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1;
+}
+
+#ifndef BOARD_BOOT
+/* The answer to a rejected line: "error: " and the cause's parts. */
+static bool fail(serial_put_fn put, const char *a, const char *b, const char *c)
+{
+    put_str(put, "error: ");
+    put_str(put, a);
+    put_str(put, b);
+    put_str(put, c);
+    put('\r');
+    return false;
 }
 
 /* Tokens: the line split at spaces, in place. */
@@ -192,17 +208,6 @@ static bool parse_milli(const char *t, int32_t limit, int32_t *out)
     }
     *out = neg ? -(int32_t)milli : (int32_t)milli;
     return true;
-}
-
-/* The answer to a rejected line: "error: " and the cause's parts. */
-static bool fail(serial_put_fn put, const char *a, const char *b, const char *c)
-{
-    put_str(put, "error: ");
-    put_str(put, a);
-    put_str(put, b);
-    put_str(put, c);
-    put('\r');
-    return false;
 }
 
 static bool cmd_set(serial_link_t *s, tokens_t *t, serial_put_fn put)
@@ -415,6 +420,7 @@ static void input_line(serial_link_t *s, serial_put_fn put)
         fail_verbs(put, "'", cmd, "' is not on this target");
     }
 }
+#endif
 
 /* A frame line of n characters ("t" or "r", 3 hex digits of identifier,
  * 1 of length, the data) into *f; false for anything else. */
@@ -439,6 +445,29 @@ static bool frame_line(const serial_link_t *s, unsigned n, co_frame_t *f)
     return true;
 }
 
+#ifdef BOARD_BOOT
+/* The bootloader's line: SLCAN frames only. Anything else (a line too
+ * long, a NUL, an SLCAN command, an input line) is dropped without an
+ * answer: the bootloader simulates no sensor, and the line language does
+ * not fit its 4 KiB. */
+bool serial_link_rx(serial_link_t *s, char c, co_frame_t *f, serial_put_fn put)
+{
+    (void)put;
+    if (c != '\r' && c != '\n') {
+        s->overflow = s->overflow || s->len == SERIAL_LINE_MAX;
+        s->line[s->len < SERIAL_LINE_MAX ? s->len++ : 0] = c;
+        return false;
+    }
+    unsigned n = s->len;
+    bool ok = !s->overflow && n <= 21u;
+    s->len = 0;
+    s->overflow = false;
+    for (unsigned i = 1; i < n && ok; i++) {
+        ok = hex_value(s->line[i]) >= 0;
+    }
+    return ok && frame_line(s, n, f);
+}
+#else
 bool serial_link_rx(serial_link_t *s, char c, co_frame_t *f, serial_put_fn put)
 {
     if (c != '\r' && c != '\n') {
@@ -473,3 +502,4 @@ bool serial_link_rx(serial_link_t *s, char c, co_frame_t *f, serial_put_fn put)
     input_line(s, put);
     return false;
 }
+#endif

@@ -60,6 +60,7 @@ void timer0_handler(void)
 
 /* ---- UART: the serial line --------------------------------------------- */
 
+#ifndef BOARD_BOOT
 /* Received bytes between two main-loop passes. When the ring is full the
  * interrupt stops taking bytes (the UART's FIFO then holds them, and
  * qemu's holds the rest back on the socket) until the main loop has taken
@@ -84,6 +85,7 @@ void uart0_handler(void)
         rx_head++;
     }
 }
+#endif
 
 /* One byte out; waits until the UART took it: at once in qemu. Deviation
  * from co_port.h's "must not block", as on rv32-virt: on silicon, 87 us a
@@ -100,6 +102,22 @@ static void put(char c)
 /* The serial line: SLCAN frames and simulated-input lines (serial_link.h). */
 static serial_link_t link;
 
+#ifdef BOARD_BOOT
+/* The bootloader reads the UART from its loop, which never sleeps
+ * (board_sleep): no interrupt, no ring, 200 bytes less of its 4 KiB. The
+ * UART's FIFO (and qemu's, which holds bytes back on the socket) keeps
+ * what comes while the flash is written, and the client waits for the
+ * answer then anyway. */
+bool board_can_receive(co_frame_t *f)
+{
+    bool got = false;
+    while (!got && UART_EVENTS_RXDRDY != 0u) {
+        UART_EVENTS_RXDRDY = 0u;
+        got = serial_link_rx(&link, (char)UART_RXD, f, put);
+    }
+    return got;
+}
+#else
 bool board_can_receive(co_frame_t *f)
 {
     bool got = false;
@@ -111,6 +129,7 @@ bool board_can_receive(co_frame_t *f)
     UART_INTENSET = UART_INT_RXDRDY; /* room in the ring (again) */
     return got;
 }
+#endif
 
 bool co_port_can_send(void *port, const co_frame_t *f)
 {
@@ -130,6 +149,12 @@ uint8_t board_can_state(void)
     return (uint8_t)serial_link_can_state(&link, board_now_us());
 }
 
+#ifdef BOARD_BOOT
+void board_sleep(uint32_t us)
+{
+    (void)us; /* the bootloader polls (board_can_receive) */
+}
+#else
 void board_sleep(uint32_t us)
 {
     if (us == 0u) {
@@ -149,6 +174,7 @@ void board_sleep(uint32_t us)
     }
     __asm__ volatile("cpsie i" ::: "memory");
 }
+#endif
 
 /* ---- LEDs ------------------------------------------------------------------ */
 
@@ -276,7 +302,9 @@ bool board_init(void)
     TIMER0_MODE = 0u; /* timer */
     TIMER0_BITMODE = TIMER_BITMODE_32;
     TIMER0_PRESCALER = 4u; /* 16 MHz / 2^4 */
+#ifndef BOARD_BOOT
     TIMER0_INTENSET = TIMER_INT_COMPARE(ALARM_CC);
+#endif
     TIMER0_TASKS_CLEAR = 1u;
     TIMER0_TASKS_START = 1u;
     /* The micro:bit's USB serial line: P0.24 TX, P0.25 RX, 115200 8N1. */
@@ -286,8 +314,10 @@ bool board_init(void)
     UART_ENABLE = UART_ENABLE_ON;
     UART_TASKS_STARTTX = 1u;
     UART_TASKS_STARTRX = 1u;
+#ifndef BOARD_BOOT
     UART_INTENSET = UART_INT_RXDRDY;
     NVIC_ISER = (1u << UART_IRQ) | (1u << TIMER0_IRQ);
+#endif
     return true;
 }
 
