@@ -483,7 +483,7 @@ static CO_NOINLINE void sdo_rx(boot_t *b, const uint8_t *d, uint32_t now)
             b->sdo = SDO_SEG;
         }
         if (r == 0u) {
-            sdo_send(b, (uint8_t)(0x20u | (b->toggle << 4)), 0, 0);
+            sdo_send(b, (uint8_t)(0x20u | ((uint32_t)b->toggle << 4)), 0, 0);
             b->toggle ^= 1u;
         }
     } else {

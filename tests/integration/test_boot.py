@@ -43,7 +43,8 @@ def image(tmp_path, program_id, corrupt=False, product=PRODUCT):
     need(elf)
     out = tmp_path / f"app-{product}-{program_id}.img"
     subprocess.run([str(ROOT / "tools" / "mkimage"), "--product", product, "--board", "rv32-virt",
-                    "--program-id", str(program_id), "--elf", str(elf), "-o", str(out)],
+                    "--program-id", str(program_id), "--other-program-id", "--elf", str(elf),
+                    "-o", str(out)],
                    check=True, capture_output=True,
                    env={**os.environ, "CANOPEN_SENSOR": os.environ.get(
                        "CANOPEN_SENSOR", str(ROOT / "build" / "bin" / "canopen-sensor"))})

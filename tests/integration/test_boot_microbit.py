@@ -45,7 +45,7 @@ def image(tmp_path, program_id, product=PRODUCT):
     """The product's application wrapped by tools/mkimage for this board."""
     out = tmp_path / f"{product}-{program_id:x}.img"
     subprocess.run([str(ROOT / "tools" / "mkimage"), "--product", product, "--board", "microbit",
-                    "--program-id", str(program_id),
+                    "--program-id", str(program_id), "--other-program-id",
                     "--elf", str(need(BUILD / f"fw-{product}-app.elf")), "-o", str(out)],
                    check=True, capture_output=True,
                    env={**os.environ, "CANOPEN_SENSOR": os.environ.get(

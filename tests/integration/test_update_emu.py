@@ -37,7 +37,8 @@ def image(tmp_path, pid):
         pytest.fail(f"{elf} is missing: build the rv32-virt images (docs/emulator.md)")
     out = tmp_path / f"app-{pid:x}.img"
     r = subprocess.run([sys.executable, str(ROOT / "tools" / "mkimage"), "--product", PRODUCT,
-                        "--board", "rv32-virt", "--program-id", hex(pid), "--elf", str(elf),
+                        "--board", "rv32-virt", "--program-id", hex(pid), "--other-program-id",
+                        "--elf", str(elf),
                         "--program", program(), "-o", str(out)],
                        capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr

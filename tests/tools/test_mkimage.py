@@ -60,6 +60,25 @@ def elf32(segments, machine=40, cls=1):
     return bytes(data)
 
 
+def with_symbol(elf, name, value):
+    """elf (elf32's) with a symbol table holding name = value (absolute),
+    as a link's --defsym leaves it: a null section, .symtab, .strtab."""
+    data = bytearray(elf)
+    strtab = b"\0" + name.encode() + b"\0"
+    symtab = bytes(16) + struct.pack("<IIIBBH", 1, value, 0, 0x10, 0, 0xFFF1)  # SHN_ABS
+    sym_off = len(data)
+    data += symtab
+    str_off = len(data)
+    data += strtab
+    shoff = len(data)
+    data += bytes(40)  # section 0
+    data += struct.pack("<10I", 0, 2, 0, 0, sym_off, len(symtab), 2, 1, 4, 16)
+    data += struct.pack("<10I", 0, 3, 0, 0, str_off, len(strtab), 0, 0, 1, 0)
+    struct.pack_into("<I", data, 32, shoff)
+    struct.pack_into("<HHH", data, 46, 40, 3, 0)
+    return bytes(data)
+
+
 class Base(unittest.TestCase):
     def setUp(self):
         self.dir = tempfile.TemporaryDirectory(prefix="mkimage-")
@@ -169,6 +188,33 @@ class Payload(Base):
         self.assertEqual(b[64:], text + b"\xff\xff" + data + b"\xff" * 3)
         self.assertEqual(fields(b)["load_addr"], 0x80020000)
         self.assertEqual(c_reads(out, 3, 9, 0x80020000)[0], 0)
+
+    def test_program_id_from_the_elf(self):
+        """An application of this tree carries the 1F56h:1 it reports
+        (co_program_id): the image takes it when --program-id is left out;
+        another --program-id is refused (a master would update at every
+        boot) unless --other-program-id; an ELF without it needs one."""
+        elf = with_symbol(elf32([(1, 0x80020000, b"\x01\x02\x03\x04", 4)]), "co_program_id",
+                          0x10005)
+        (self.tmp / "a.elf").write_bytes(elf)
+        common = ("--product", "dst-x730-xy30", "--board", "rv32-virt", "--elf",
+                  self.tmp / "a.elf", "--program", PROGRAM)
+        out = self.tmp / "a.img"
+        run = mkimage(*common, "-o", out)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        self.assertEqual(fields(out.read_bytes())["program_id"], 0x10005)
+        run = mkimage(*common, "--program-id", "0x10005", "-o", out)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        self.refused(1, ["--program-id 0x00010006", "reports 1F56h:1 = 0x00010005",
+                         "every boot", "--other-program-id"],
+                     *common, "--program-id", "0x10006", "-o", self.tmp / "b.img")
+        run = mkimage(*common, "--program-id", "0x10006", "--other-program-id", "-o", out)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        self.assertEqual(fields(out.read_bytes())["program_id"], 0x10006)
+        (self.tmp / "n.elf").write_bytes(elf32([(1, 0x80020000, b"\x01\x02\x03\x04", 4)]))
+        self.refused(2, ["no symbol co_program_id", "give --program-id"], "--product",
+                     "dst-x730-xy30", "--board", "rv32-virt", "--elf", self.tmp / "n.elf",
+                     "--program", PROGRAM, "-o", self.tmp / "c.img")
 
     def test_bad_elf_files(self):
         common = ("--product", "dst-x730-xy30", "--board", "rv32-virt", "--program-id", 9,
