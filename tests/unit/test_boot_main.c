@@ -100,8 +100,7 @@ uint8_t board_boot_check(const co_image_hdr_t *h)
     if (h->board != CO_IMAGE_BOARD_RV32_VIRT) {
         return CO_PROGDL_FORMAT;
     }
-    return h->load_addr == LOAD && h->length <= sizeof area_mem ? CO_PROGDL_OK
-                                                                 : CO_PROGDL_ADDRESS;
+    return h->load_addr == LOAD && h->length <= sizeof area_mem ? CO_PROGDL_OK : CO_PROGDL_ADDRESS;
 }
 
 void board_boot_app(const co_image_hdr_t *h)
@@ -414,15 +413,15 @@ static void test_dictionary_refusals(void)
         uint32_t v;
         uint32_t code;
     } cases[] = {
-        {0x40, 0x2000, 0, 0, CO_E_NO_OBJ},     {0x40, 0x1018, 5, 0, CO_E_NO_SUB},
-        {0x40, 0x1000, 1, 0, CO_E_NO_SUB},     {0x40, 0x1F50, 1, 0, CO_E_WO},
-        {0x2B, 0x1000, 0, 1, CO_E_RO},         {0x2F, 0x1F56, 0, 1, CO_E_RO},
-        {0x23, 0x1F51, 1, 3, CO_E_LEN_HIGH},   {0x2F, 0x1017, 0, 1, CO_E_LEN_LOW},
-        {0x21, 0x1017, 0, 2, CO_E_LEN},        {0xC2, 0x1F51, 1, 1, CO_E_LEN},
-        {0x2F, 0x1F51, 1, 2, CO_E_VAL},        {0x2F, 0x1F51, 1, 9, CO_E_VAL},
-        {0x2F, 0x1F51, 1, 1, CO_E_STATE},      {0x00, 0x1000, 0, 0, CO_E_CMD},
-        {0x60, 0x1000, 0, 0, CO_E_CMD},        {0xA0, 0x1000, 0, 0, CO_E_CMD},
-        {0xE0, 0x1000, 0, 0, CO_E_CMD},        {0xC1, 0x1F50, 1, 0, CO_E_CMD},
+        {0x40, 0x2000, 0, 0, CO_E_NO_OBJ},   {0x40, 0x1018, 5, 0, CO_E_NO_SUB},
+        {0x40, 0x1000, 1, 0, CO_E_NO_SUB},   {0x40, 0x1F50, 1, 0, CO_E_WO},
+        {0x2B, 0x1000, 0, 1, CO_E_RO},       {0x2F, 0x1F56, 0, 1, CO_E_RO},
+        {0x23, 0x1F51, 1, 3, CO_E_LEN_HIGH}, {0x2F, 0x1017, 0, 1, CO_E_LEN_LOW},
+        {0x21, 0x1017, 0, 2, CO_E_LEN},      {0xC2, 0x1F51, 1, 1, CO_E_LEN},
+        {0x2F, 0x1F51, 1, 2, CO_E_VAL},      {0x2F, 0x1F51, 1, 9, CO_E_VAL},
+        {0x2F, 0x1F51, 1, 1, CO_E_STATE},    {0x00, 0x1000, 0, 0, CO_E_CMD},
+        {0x60, 0x1000, 0, 0, CO_E_CMD},      {0xA0, 0x1000, 0, 0, CO_E_CMD},
+        {0xE0, 0x1000, 0, 0, CO_E_CMD},      {0xC1, 0x1F50, 1, 0, CO_E_CMD},
         {0x21, 0x1F50, 1, 100, CO_E_STATE}, /* not cleared */
     };
     for (unsigned i = 0; i < sizeof cases / sizeof cases[0]; i++) {
@@ -697,8 +696,8 @@ static void test_hand_over_and_power_cut(void)
     CHECK_EQ(write8(0x1F51, 1, 3), 0);
     CHECK_EQ(seg_download(img, n), 0);
     memset(info_mem, 0xFF, sizeof info_mem); /* a board never updated before */
-    boot_handover_block = (boot_handover_t){.magic = BOOT_HANDOVER_MAGIC, .node_id = NODE,
-                                            .kbps = 500};
+    boot_handover_block = (boot_handover_t){
+        .magic = BOOT_HANDOVER_MAGIC, .node_id = NODE, .kbps = 500};
     CHECK_EQ(run(true), BACK_IDLE);
     CHECK_EQ(boot_handover_block.magic, 0); /* taken */
     CHECK_EQ(read32(0x1F51, 1), CO_PROGDL_STOPPED);
@@ -720,8 +719,8 @@ static void test_hand_over_and_power_cut(void)
     CHECK_EQ(read32(0x1000, 0), 0);
     /* A hand-over block with no valid program: its node, the page's
      * identity (none here). */
-    boot_handover_block = (boot_handover_t){.magic = BOOT_HANDOVER_MAGIC, .node_id = NODE,
-                                            .kbps = 250};
+    boot_handover_block = (boot_handover_t){
+        .magic = BOOT_HANDOVER_MAGIC, .node_id = NODE, .kbps = 250};
     CHECK_EQ(run(true), BACK_IDLE);
     CHECK_EQ(read32(0x1000, 0), 0);
     /* A bit rate the board cannot: no boot-up (the red LED, for ever;
