@@ -156,7 +156,9 @@ else()
   set(co_bdir ${PROJECT_SOURCE_DIR}/boards/${CO_BOARD})
   set(co_cdir ${PROJECT_SOURCE_DIR}/boards/common)
   string(REPLACE "-" "_" co_bname ${CO_BOARD})
-  set(co_bsrc ${co_bdir}/board.c ${co_cdir}/libc_min.c)
+  # boot_ident.c: the application's side of the hand-over to the board's
+  # bootloader (boot.h), which mcu_main.c calls after each pass.
+  set(co_bsrc ${co_bdir}/board.c ${co_cdir}/libc_min.c ${co_cdir}/boot_ident.c)
   set_source_files_properties(${co_cdir}/libc_min.c ${co_cdir}/aeabi_div.c PROPERTIES
     COMPILE_OPTIONS -fno-lto) # called behind LTO's back (boards/CMakeLists.txt)
   set(co_sim_input OFF)
@@ -183,7 +185,7 @@ else()
   if(CO_BOARD STREQUAL "rv32-virt")
     target_compile_definitions(co_board_${co_bname} PUBLIC BOARD_RX_FILTER)
   endif()
-  list(APPEND co_headers ${co_cdir}/board.h)
+  list(APPEND co_headers ${co_cdir}/board.h ${co_cdir}/boot.h ${co_cdir}/flash_ee.h)
 
   # The main loop as a source of the consumer's image: it names the
   # product (PRODUCT_SYM ...), so the consumer compiles it. Board and
@@ -197,6 +199,7 @@ else()
   target_link_libraries(co_mcu_main INTERFACE co_board_${co_bname} co_stack co_board_${co_bname}
     co_stack gcc)
   target_link_options(co_mcu_main INTERFACE
+    -L$<BUILD_INTERFACE:${co_bdir}>$<INSTALL_INTERFACE:$<INSTALL_PREFIX>/${CO_INSTALL_DATADIR}>
     -T$<BUILD_INTERFACE:${co_bdir}/link.ld>$<INSTALL_INTERFACE:$<INSTALL_PREFIX>/${CO_INSTALL_DATADIR}/link.ld>)
   list(APPEND co_lib_targets co_mcu_main)
 endif()
@@ -212,7 +215,10 @@ install(FILES ${co_headers} DESTINATION ${CO_INSTALL_INCLUDEDIR})
 if(NOT CMAKE_CROSSCOMPILING)
   install(FILES ${co_linux_headers} DESTINATION ${CO_INSTALL_INCLUDEDIR}/linux)
 else()
-  install(FILES ${co_cdir}/mcu_main.c ${co_bdir}/link.ld DESTINATION ${CO_INSTALL_DATADIR})
+  # link.ld includes layout.ld (the flash layout it shares with the
+  # bootloader's): found through the -L above.
+  install(FILES ${co_cdir}/mcu_main.c ${co_bdir}/link.ld ${co_bdir}/layout.ld
+    DESTINATION ${CO_INSTALL_DATADIR})
   # The toolchain files (the one this was built with includes others): a
   # consumer builds with the same.
   install(FILES ${PROJECT_SOURCE_DIR}/cmake/arm-none-eabi.cmake
