@@ -160,6 +160,21 @@ def _input_kept():
         cls.reset_input_buffer = saved
 
 
+def nodelay(bus):
+    """Each frame of an slcan bus on a TCP serial line sent at once:
+    pyserial's socket:// leaves Nagle's algorithm on, which holds a small
+    line for the peer's delayed acknowledge (40 ms a round trip instead of
+    1; a block download's segments after the first, 40 ms a block)."""
+    bus.serialPortOrig._socket.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    return bus
+
+
+def slcan_bus(port):
+    """python-can's slcan bus on the serial line at 127.0.0.1:PORT."""
+    return nodelay(can.Bus(interface="slcan", channel=f"socket://127.0.0.1:{port}",
+                           sleep_after_open=0))
+
+
 class SerialLine(slcanBus):
     """python-can's slcan bus on an emulated board's serial line, which also
     carries the simulated input language's answers: lines that are no SLCAN
@@ -175,9 +190,7 @@ class SerialLine(slcanBus):
         self.lost = False
         with _input_kept():
             super().__init__(channel=f"socket://127.0.0.1:{port}", sleep_after_open=0)
-        # Small lines, one request at a time: Nagle's algorithm would hold each
-        # for the peer's delayed ACK (40 ms a round trip instead of 1).
-        self.serialPortOrig._socket.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        nodelay(self)
 
     def _read(self, timeout):
         if self.lost:

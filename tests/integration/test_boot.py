@@ -21,7 +21,7 @@ import time
 import can
 import canopen
 import pytest
-from targets import free_port
+from targets import free_port, slcan_bus
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 # CO_RV32_BUILD: another build directory of the board (default build-rv32-virt).
@@ -58,8 +58,12 @@ def image(tmp_path, program_id, corrupt=False, product=PRODUCT):
 class Device:
     """tools/emu --boot: the bootloader, the flash file kept across starts."""
 
-    def __init__(self, tmp_path, can_iface=None):
+    def __init__(self, tmp_path, can_iface=None, product=PRODUCT, node=NODE):
+        """product: the one tools/emu runs (its factory image and identity);
+        node: its node-ID, or None for the one its first boot-up names."""
         need(BUILD / "boot.elf")
+        self.product = product
+        self.node_id = node
         self.flash = tmp_path / "flash.bin"
         self.log = open(tmp_path / "emu.log", "a")
         self.proc = None
@@ -67,7 +71,7 @@ class Device:
 
     def start(self, install=None):
         port = free_port()
-        cmd = [str(ROOT / "tools" / "emu"), "--board", "rv32-virt", "--product", PRODUCT,
+        cmd = [str(ROOT / "tools" / "emu"), "--board", "rv32-virt", "--product", self.product,
                "--port", str(port), "--flash", str(self.flash), "--boot",
                "--image", str(BUILD / "boot.elf")]
         if install is not None:
@@ -87,16 +91,32 @@ class Device:
             pytest.fail(f"tools/emu did not start: see {self.log.name}")
         self.bootups = []
         if self.can_iface is None:
-            self.bus = can.Bus(interface="slcan", channel=f"socket://127.0.0.1:{port}",
-                               sleep_after_open=0)
+            self.bus = slcan_bus(port)
         self.net = canopen.Network(self.bus)
         self.net.notifier = can.Notifier(self.bus, self.net.listeners, 0.1)
-        self.net.subscribe(0x700 + NODE, lambda i, d, t: self.bootups.append(bytes(d)))
-        self.node = self.net.add_node(NODE, canopen.ObjectDictionary())
+        if self.node_id is None:
+            self.node_id = self.first_bootup()
+        self.net.subscribe(0x700 + self.node_id, lambda i, d, t: self.bootups.append(bytes(d)))
+        self.node = self.net.add_node(self.node_id, canopen.ObjectDictionary())
         # Inside User-Mode Linux QEMU's flash writes through to its file took
         # up to 285 ms for a block erase (targets.py, CanEmuTarget).
         self.node.sdo.RESPONSE_TIMEOUT = 1.0 if self.can_iface is None else 2.0
         time.sleep(0.5 if self.can_iface is None else 2.0)
+
+    def first_bootup(self, timeout=5.0):
+        """The node-ID of the first boot-up frame (70xh, one byte 0)."""
+        seen = []
+        listener = can.BufferedReader()
+        self.net.notifier.add_listener(listener)
+        end = time.monotonic() + timeout
+        while not seen and time.monotonic() < end:
+            msg = listener.get_message(0.1)
+            if msg is not None and 0x701 <= msg.arbitration_id <= 0x77F and bytes(msg.data) == b"\0":
+                seen.append(msg.arbitration_id - 0x700)
+        self.net.notifier.remove_listener(listener)
+        if not seen:
+            pytest.fail(f"no boot-up within {timeout} s: see {self.log.name}")
+        return seen[0]
 
     def cut(self):
         """A power cut: the emulator's process group killed."""
@@ -189,7 +209,7 @@ def test_refuses_another_products_image(device, tmp_path):
     time.sleep(0.5)
     device.control(3)
     answers = []
-    device.net.subscribe(0x580 + NODE, lambda i, d, t: answers.append(bytes(d)))
+    device.net.subscribe(0x580 + device.node_id, lambda i, d, t: answers.append(bytes(d)))
     # The master's own abort code may be of what the server said to the
     # frames it sent after the refusal (more block segments; canopen's
     # close sends one more): the server's first abort is the refusal.

@@ -24,7 +24,7 @@ import zlib
 import can
 import canopen
 import pytest
-from targets import free_port
+from targets import free_port, slcan_bus
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 BUILD = pathlib.Path(os.environ.get("CO_MICROBIT_BUILD", ROOT / "build-microbit")) / "bin"
@@ -83,8 +83,7 @@ class Microbit:
         end = time.monotonic() + 10
         while True:  # QEMU listens a moment after it starts
             try:
-                self.bus = can.Bus(interface="slcan", channel=f"socket://127.0.0.1:{port}",
-                                   sleep_after_open=0)
+                self.bus = slcan_bus(port)
                 break
             except Exception:
                 if time.monotonic() > end or self.proc.poll() is not None:
