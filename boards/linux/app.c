@@ -99,11 +99,12 @@ void app_start(app_t *a, uint32_t t)
     for (unsigned i = 0; i < a->nnodes; i++) {
         const product_t *prod = a->inst[a->node_inst[i]].prod;
         co_node_start(a->nodes[i], t);
-        lp_log("node %u: %s, node-ID 0x%02X on %s, bit-rate code %u = %u kbit/s (vcan ignores "
-               "it); factory node-ID 0x%02X, serial 0x%08lX",
+        lp_log("node %u: %s, node-ID 0x%02X on %s, bit-rate code %u = %u kbit/s (%s); factory "
+               "node-ID 0x%02X, serial 0x%08lX",
                i, prod->id, co_node_id(a->nodes[i]), a->ifn[i], co_node_bitrate(a->nodes[i]),
-               product_kbps(prod, co_node_bitrate(a->nodes[i])), co_node_factory_id(a->nodes[i]),
-               (unsigned long)co_node_serial(a->nodes[i]));
+               product_kbps(prod, co_node_bitrate(a->nodes[i])),
+               a->ports[i].udp ? "a udp_multicast bus has none" : "vcan ignores it",
+               co_node_factory_id(a->nodes[i]), (unsigned long)co_node_serial(a->nodes[i]));
     }
 }
 
@@ -224,7 +225,7 @@ void app_shut_down(app_t *a)
     for (unsigned i = 0; i < a->nnodes; i++) {
         co_store_flush(a->nodes[i]);
     }
-    if (a->tx.fd >= 0) {
+    if (a->nnodes != 0u) {
         (void)lp_tx_flush(&a->tx, a->ports, a->nnodes);
         lp_log("%lu frames sent in %lu system calls", a->tx.frames, a->tx.calls);
     }

@@ -13,11 +13,13 @@
 #include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <sys/uio.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "co_port.h"
 #include "co_progdl.h"
 #include "log.h"
+#include "udp_bus.h"
 
 /* ---- CAN: link watch ---------------------------------------------------- */
 
@@ -88,6 +90,9 @@ static lp_link_t link_probe(lp_port_t *p, int *index, const char **cause)
  */
 static void link_check(lp_port_t *p, uint32_t now, bool lost)
 {
+    if (p->udp) {
+        return; /* a udp_multicast bus has no CAN link to watch */
+    }
     int index = p->ifindex;
     const char *cause;
     lp_link_t l = link_probe(p, &index, &cause);
@@ -145,6 +150,37 @@ static int can_socket(char *err, unsigned errlen)
     return fd;
 }
 
+/* lp_open on a udp_multicast bus: always "up" (no cable to watch). */
+static int udp_open(lp_port_t *p, char *err, unsigned errlen)
+{
+    p->fd = -1;
+#ifdef HAVE_MSGPACK
+    lp_udp_addr_t a;
+    if (lp_udp_parse(p->iface, &a, err, errlen) != 0) {
+        return -1;
+    }
+    p->zone = lp_udp_zone_new();
+    if (p->zone == NULL) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    if (lp_udp_open(&a, &p->fd, &p->txfd, &p->self, err, errlen) != 0) {
+        lp_udp_zone_free(p->zone);
+        p->zone = NULL;
+        return -1;
+    }
+    p->udp = true;
+    p->ifindex = (int)a.ifindex;
+    p->link = LP_LINK_UP;
+    return 0;
+#else
+    snprintf(err, errlen,
+             "this build has no udp_multicast bus (msgpack-c, Debian's libmsgpack-dev, was "
+             "missing when it was built)");
+    return -1;
+#endif
+}
+
 int lp_open(lp_port_t *p, const char *iface, unsigned node, lp_nvm_t *nvm, uint32_t now, char *err,
             unsigned errlen)
 {
@@ -153,6 +189,10 @@ int lp_open(lp_port_t *p, const char *iface, unsigned node, lp_nvm_t *nvm, uint3
     p->node = node;
     p->nvm = nvm;
     p->now = now;
+    p->txfd = -1;
+    if (lp_udp_is(iface)) {
+        return udp_open(p, err, errlen);
+    }
     p->fd = can_socket(err, errlen);
     if (p->fd < 0) {
         return -1;
@@ -190,6 +230,14 @@ void lp_close(lp_port_t *p)
         close(p->fd);
         p->fd = -1;
     }
+    if (p->txfd >= 0) {
+        close(p->txfd);
+        p->txfd = -1;
+    }
+#ifdef HAVE_MSGPACK
+    lp_udp_zone_free(p->zone);
+#endif
+    p->zone = NULL;
 }
 
 co_can_state_t lp_can_state(const lp_port_t *p)
@@ -285,6 +333,10 @@ uint32_t lp_poll(lp_port_t *p, uint32_t now)
  * it every entry of every socket was tried on every frame on the bus. */
 static void filter_install(lp_port_t *p)
 {
+    if (p->udp) {
+        p->filt_changes++;
+        return; /* no kernel filter on a UDP socket: lp_read applies filt[] */
+    }
     struct can_filter cf[CO_NODE_RX_IDS_MAX];
     for (unsigned k = 0; k < p->nfilt; k++) {
         cf[k].can_id = p->filt[k].id | (p->filt[k].rtr ? CAN_RTR_FLAG : 0u);
@@ -374,6 +426,51 @@ static unsigned txq_total(const lp_port_t *ports, unsigned n)
     return total;
 }
 
+/* A udp_multicast port's queue through its own socket (as many
+ * datagrams a call as lp_tx_flush's frames); the frames left queued. */
+static unsigned udp_flush(lp_tx_t *tx, lp_port_t *p)
+{
+    (void)tx;
+#ifdef HAVE_MSGPACK
+    uint8_t dg[LP_TXB][256];
+    struct iovec iov[LP_TXB];
+    struct mmsghdr mm[LP_TXB];
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    double now = (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+    while (p->txn != 0u) {
+        unsigned cnt = 0;
+        for (unsigned k = 0; k < p->txn && cnt < LP_TXB; k++, cnt++) {
+            const co_frame_t *f = &p->txq[(p->txh + k) % LP_TXQ];
+            iov[cnt].iov_base = dg[cnt];
+            iov[cnt].iov_len = lp_udp_encode(f, now, dg[cnt], sizeof(dg[cnt]));
+            memset(&mm[cnt], 0, sizeof(mm[cnt]));
+            mm[cnt].msg_hdr.msg_iov = &iov[cnt];
+            mm[cnt].msg_hdr.msg_iovlen = 1;
+        }
+        int r = sendmmsg(p->txfd, mm, cnt, MSG_DONTWAIT);
+        if (r > 0) {
+            for (unsigned k = 0; k < co_min_u32((unsigned)r, cnt); k++) {
+                txq_pop(p);
+            }
+            tx->calls++;
+            tx->frames += co_min_u32((unsigned)r, cnt);
+            continue;
+        }
+        int e = errno;
+        if (r < 0 && (e == EAGAIN || e == ENOBUFS || e == EINTR)) {
+            break; /* the socket's queue is full: later */
+        }
+        txq_pop(p); /* refused: lost (the interface went down or away) */
+        if (lp_rate_allow(&p->err_rate, p->now, 3u)) {
+            lp_log("node %u: UDP send on %s failed: %s", p->node, p->iface,
+                   r < 0 ? strerror(e) : "nothing sent");
+        }
+    }
+#endif
+    return p->txn;
+}
+
 unsigned lp_tx_flush(lp_tx_t *tx, lp_port_t *ports, unsigned n)
 {
     struct can_frame cf[LP_TXB];
@@ -388,6 +485,9 @@ unsigned lp_tx_flush(lp_tx_t *tx, lp_port_t *ports, unsigned n)
             lp_port_t *p = &ports[i];
             if (p->txn != 0u && lp_can_state(p) == CO_CAN_BUSOFF) {
                 drop_txq(p); /* off the bus since it queued them */
+            }
+            if (p->udp) {
+                continue; /* sent through its own socket, below */
             }
             for (unsigned k = 0; k < p->txn && cnt < LP_TXB; k++, cnt++) {
                 const co_frame_t *f = &p->txq[(p->txh + k) % LP_TXQ];
@@ -411,7 +511,13 @@ unsigned lp_tx_flush(lp_tx_t *tx, lp_port_t *ports, unsigned n)
             }
         }
         if (cnt == 0u) {
-            return 0;
+            unsigned left = 0;
+            for (unsigned i = 0; i < n; i++) {
+                if (ports[i].udp) {
+                    left += udp_flush(tx, &ports[i]);
+                }
+            }
+            return left;
         }
         int r = sendmmsg(tx->fd, mm, cnt, MSG_DONTWAIT);
         if (r > 0) {
@@ -513,9 +619,94 @@ static void error_frame(lp_port_t *p, const struct can_frame *cf)
     p->ctrl_state = (int)s;
 }
 
+/* The drop count in a message's control data (SO_RXQ_OVFL). */
+static void rx_overflow(lp_port_t *p, struct msghdr *mh)
+{
+    for (struct cmsghdr *c = CMSG_FIRSTHDR(mh); c != NULL; c = CMSG_NXTHDR(mh, c)) {
+        if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
+            uint32_t total;
+            memcpy(&total, CMSG_DATA(c), sizeof(total));
+            uint32_t d = total - p->rx_ovfl; /* the kernel's counter wraps at 2^32 */
+            p->rx_ovfl = total;
+            p->rx_dropped += d;
+            p->rx_unlogged += d;
+        }
+    }
+}
+
+#ifdef HAVE_MSGPACK
+/* read_batch on a udp_multicast bus: each datagram decoded into p->rxb;
+ * its rxlen 0 when it is no frame for the node (its own, malformed, FD,
+ * 29-bit, truncated), a classic frame's size otherwise. */
+static unsigned udp_read_batch(lp_port_t *p, uint32_t now)
+{
+    struct mmsghdr mm[LP_RXB];
+    struct iovec iov[LP_RXB];
+    struct sockaddr_in from[LP_RXB];
+    uint8_t dg[LP_RXB][LP_UDP_DGRAM_MAX];
+    _Alignas(size_t) char ctrl[LP_RXB][CMSG_SPACE(sizeof(uint32_t))];
+    memset(mm, 0, sizeof(mm));
+    for (unsigned k = 0; k < LP_RXB; k++) {
+        iov[k].iov_base = dg[k];
+        iov[k].iov_len = sizeof(dg[k]);
+        mm[k].msg_hdr.msg_iov = &iov[k];
+        mm[k].msg_hdr.msg_iovlen = 1;
+        mm[k].msg_hdr.msg_name = &from[k];
+        mm[k].msg_hdr.msg_namelen = sizeof(from[k]);
+        mm[k].msg_hdr.msg_control = ctrl[k];
+        mm[k].msg_hdr.msg_controllen = sizeof(ctrl[k]);
+    }
+    int n = recvmmsg(p->fd, mm, LP_RXB, MSG_DONTWAIT, NULL);
+    if (n < 0) {
+        if (errno != EAGAIN && errno != EINTR && lp_rate_allow(&p->err_rate, now, 3u)) {
+            lp_log("node %u: UDP read on %s failed: %s", p->node, p->iface, strerror(errno));
+        }
+        return 0;
+    }
+    for (int k = 0; k < n; k++) {
+        struct msghdr *mh = &mm[k].msg_hdr;
+        rx_overflow(p, mh);
+        p->rxlen[k] = 0;
+        if (mh->msg_namelen == sizeof(from[k]) && from[k].sin_port == p->self.sin_port &&
+            from[k].sin_addr.s_addr == p->self.sin_addr.s_addr) {
+            continue; /* the node's own frame: a node does not hear itself */
+        }
+        if ((mh->msg_flags & MSG_TRUNC) != 0 ||
+            lp_udp_decode(dg[k], mm[k].msg_len, p->zone, &p->rxb[k]) != LP_UDP_FRAME) {
+            p->rx_ignored++;
+            continue;
+        }
+        p->rxlen[k] = (uint8_t)sizeof(p->rxb[k]);
+    }
+    report_drops(p, now);
+    return (unsigned)n;
+}
+#endif
+
+/* Whether the node consumes frame cf (udp: the filter kept in software). */
+static bool filter_passes(const lp_port_t *p, const struct can_frame *cf)
+{
+    if (!p->filt_set) {
+        return true;
+    }
+    uint16_t id = (uint16_t)(cf->can_id & CAN_SFF_MASK);
+    bool rtr = (cf->can_id & CAN_RTR_FLAG) != 0u;
+    for (unsigned k = 0; k < p->nfilt; k++) {
+        if (p->filt[k].id == id && p->filt[k].rtr == rtr) {
+            return true;
+        }
+    }
+    return false;
+}
+
 /* Read the next batch of messages into p->rxb; their count (0: none). */
 static unsigned read_batch(lp_port_t *p, uint32_t now)
 {
+#ifdef HAVE_MSGPACK
+    if (p->udp) {
+        return udp_read_batch(p, now);
+    }
+#endif
     struct mmsghdr mm[LP_RXB];
     struct iovec iov[LP_RXB];
     /* control data: the drop count; aligned as a cmsghdr (size_t fields) */
@@ -542,18 +733,8 @@ static unsigned read_batch(lp_port_t *p, uint32_t now)
         return 0;
     }
     for (int k = 0; k < n; k++) {
-        struct msghdr *mh = &mm[k].msg_hdr;
         p->rxlen[k] = (uint8_t)(mm[k].msg_len < 255u ? mm[k].msg_len : 255u);
-        for (struct cmsghdr *c = CMSG_FIRSTHDR(mh); c != NULL; c = CMSG_NXTHDR(mh, c)) {
-            if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_RXQ_OVFL) {
-                uint32_t total;
-                memcpy(&total, CMSG_DATA(c), sizeof(total));
-                uint32_t d = total - p->rx_ovfl; /* the kernel's counter wraps at 2^32 */
-                p->rx_ovfl = total;
-                p->rx_dropped += d;
-                p->rx_unlogged += d;
-            }
-        }
+        rx_overflow(p, &mm[k].msg_hdr);
     }
     report_drops(p, now);
     return (unsigned)n;
@@ -584,6 +765,10 @@ int lp_read(lp_port_t *p, co_frame_t *f, uint32_t now)
     }
     if ((cf->can_id & CAN_EFF_FLAG) != 0u || cf->len > 8u) {
         return 2; /* 29-bit identifiers are not CANopen: ignored */
+    }
+    if (p->udp && !filter_passes(p, cf)) {
+        p->rx_filtered++;
+        return 2; /* not the node's (the kernel's filter does this on SocketCAN) */
     }
     p->rx_frames++;
     memset(f, 0, sizeof(*f));

@@ -20,6 +20,7 @@
 
 #include <linux/can.h>
 #include <net/if.h>
+#include <netinet/in.h>
 #include <stdio.h>
 
 #include "co_node.h"
@@ -64,11 +65,22 @@ typedef struct lp_tx {
 
 typedef struct lp_port {
     int fd; /* CAN_RAW socket, non-blocking; kept across link changes;
-             * receives (frames go out through an lp_tx_t) */
+             * receives (frames go out through an lp_tx_t); on a
+             * udp_multicast bus the group's receiving socket */
     const char *iface;
-    unsigned node; /* index, for log lines */
-    uint16_t kbps; /* the node's bit rate (co_port_can_bitrate; vcan has none) */
-    bool kbps_set; /* kbps was given (at the node's start) */
+    /* A udp_multicast bus (udp_bus.h) instead of SocketCAN: the node
+     * sends through its own socket txfd, whose address self tells its own
+     * datagrams from the others' (a node does not hear itself, as on
+     * SocketCAN); the receive filter is kept here, not in the kernel. */
+    bool udp;
+    int txfd;
+    struct sockaddr_in self;
+    void *zone;                /* the decoder's (udp_bus.h) */
+    unsigned long rx_ignored;  /* datagrams no classic frame (malformed, FD, 29-bit) */
+    unsigned long rx_filtered; /* frames the node does not consume (udp) */
+    unsigned node;             /* index, for log lines */
+    uint16_t kbps;             /* the node's bit rate (co_port_can_bitrate; vcan has none) */
+    bool kbps_set;             /* kbps was given (at the node's start) */
     lp_nvm_t *nvm;
     /* The instance's program download (prog.h; --program-download), NULL:
      * off; set after lp_open. While its state is not "started" the port
@@ -118,7 +130,10 @@ bool lp_halted_may_send(uint32_t id);
 
 /*
  * Open a non-blocking raw CAN socket on iface, error frames and the drop
- * count enabled. A down interface is accepted (bus-off until it comes up).
+ * count enabled; or, when iface is a udp_multicast bus (udp_bus.h:
+ * "udp_multicast:GROUP[:PORT][%IFNAME]"), the node's two sockets on it
+ * (an error when the program was built without msgpack-c). A down
+ * interface is accepted (bus-off until it comes up).
  * Returns 0, or -1 with a one-line cause in err (errlen bytes; the
  * interface not named: the caller says which option named it) when the
  * interface does not exist, is not a CAN interface, or the kernel has no CAN.

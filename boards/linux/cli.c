@@ -190,7 +190,7 @@ static int split_ifaces(node_spec_t *o, const char *opt, const char *val)
         if (comma != NULL) {
             *comma = '\0';
         }
-        if (s[0] == '\0' || strlen(s) >= IFNAMSIZ) {
+        if (s[0] == '\0' || strlen(s) >= (lp_udp_is(s) ? LP_IFACE_MAX : IFNAMSIZ)) {
             return USAGE_ERROR("%s %s: '%s' is not an interface name", opt, val, s);
         }
         if (nif == prod->nodes) {
@@ -264,7 +264,7 @@ static int check_specs(options_t *o)
                 return USAGE_ERROR("--node %s: no interface (give /IFACE or --iface)", n->arg);
             }
             size_t l = strcspn(o->iface, ",");
-            if (l >= IFNAMSIZ) {
+            if (l >= (lp_udp_is(o->iface) ? LP_IFACE_MAX : IFNAMSIZ)) {
                 return USAGE_ERROR("--iface %s: too long", o->iface);
             }
             memcpy(n->ifbuf, o->iface, l); /* the first of --iface's */

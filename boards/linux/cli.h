@@ -24,6 +24,7 @@
 
 #include "app.h"
 #include "product.h"
+#include "udp_bus.h"
 
 /* Exit statuses (above). */
 #define CLI_OK 0
@@ -39,7 +40,7 @@ typedef struct node_spec {
     const char *iface; /* its interfaces ("A" or "A,B"), NULL: --iface's first */
     const char *arg;   /* the option's text, for messages */
     /* the interfaces split at their commas; ifn[] points into ifbuf */
-    char ifbuf[PRODUCT_MAX_NODES * IFNAMSIZ + 8];
+    char ifbuf[PRODUCT_MAX_NODES * LP_IFACE_MAX + 8]; /* LP_IFACE_MAX: udp_bus.h */
     const char *ifn[PRODUCT_MAX_NODES];
 } node_spec_t;
 

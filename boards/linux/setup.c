@@ -267,9 +267,14 @@ int setup_run(app_t *a, loop_t *l, const options_t *o)
             return rc;
         }
     }
-    /* Every node sends through one socket (can_port.h, lp_tx_t). */
+    /* Every node on SocketCAN sends through one socket (can_port.h,
+     * lp_tx_t); a node on a udp_multicast bus through its own. */
     char err[600];
-    if (lp_tx_open(&a->tx, err, sizeof(err)) != 0) {
+    bool socketcan = false;
+    for (unsigned i = 0; i < a->nnodes; i++) {
+        socketcan = socketcan || !a->ports[i].udp;
+    }
+    if (socketcan && lp_tx_open(&a->tx, err, sizeof(err)) != 0) {
         return cli_start_failure(CLI_FAILED, err);
     }
     int r = loop_open(l, a, o->control, o->quit_on_eof, err, sizeof(err));

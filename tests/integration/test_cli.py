@@ -224,6 +224,39 @@ def test_missing_interface_is_a_clear_error(tmp_path):
     assert not (tmp_path / "e.bin").exists()  # nothing written before a save
 
 
+@pytest.mark.parametrize("iface, cause", [
+    ("udp_multicast:[ff15::1]", "an IPv6 group: only IPv4 groups"),
+    ("udp_multicast:10.0.0.1", "10.0.0.1 is not a multicast group (224.0.0.0/4)"),
+    ("udp_multicast:239.1.2.3:0", "'0' is not a UDP port (1-65535)"),
+    ("udp_multicast:239.1.2.3:65536", "'65536' is not a UDP port (1-65535)"),
+    ("udp_multicast:239.1.2.3:x1", "'x1' is not a UDP port (1-65535)"),
+    ("udp_multicast:239.1.2.3%nosuchif0", "nosuchif0: no such network interface"),
+    ("udp_multicast:239.1.2.3%", "'' after % is not an interface name"),
+    ("udp_multicast:239.1.2.300", "'239.1.2.300' is not an IPv4 address"),
+])
+def test_udp_multicast_refusals(tmp_path, iface, cause):
+    """A udp_multicast bus that cannot be: the start fails (as a missing
+    CAN interface does), naming the option, the form and the cause; nothing
+    is sent and no file is written."""
+    r = run("--product", "gsh-a", "--iface", iface, "--nvm", str(tmp_path / "e.bin"))
+    assert r.returncode == 1
+    last = r.stderr.strip().splitlines()[-1]
+    assert last.startswith(f"canopen-sensor: --iface {iface}: {cause}"), last
+    assert not (tmp_path / "e.bin").exists()
+
+
+def test_udp_multicast_name_length():
+    """The form is longer than a kernel's interface name (15 characters):
+    taken up to 63, refused beyond, in --iface and in --node's /IFACE."""
+    taken = "udp_multicast:239.1.2.3:43113%" + "x" * 33  # 63 characters
+    for args in (["--product", "gsh-a", "--iface", taken + "x"], ["--node", f"gsh-a/{taken}x"]):
+        r = run(*args)
+        one_line(r, 2, f"{' '.join(args[-2:])}: '{taken}x' is not an interface name (see --help)")
+    r = run("--node", f"gsh-a/{taken}")
+    assert r.returncode == 1 and "'" + "x" * 33 + "' after % is not an interface name" in r.stderr, \
+        r.stderr
+
+
 def test_every_option_once_but_node():
     """One rule for every option: given twice, it is a wrong command line
     naming it (the last one silently won for --iface, --nvm, ...); only
