@@ -2,7 +2,9 @@
 installed into the venv by tools/setup): its pytest fixture starts a
 simulated bus of several nodes in one canopen-sensor process and drives
 them through the control socket, while the canopen master sees them on
-vcan0 - the way a machine builder's own test would use it."""
+vcan0, or on python-can's udp_multicast bus where there is no vcan0 (the
+fixture's default; integration.udp_bus runs this file so, in a private
+network namespace) - the way a machine builder's own test would use it."""
 import time
 
 import canopen
@@ -11,10 +13,10 @@ import pytest
 from canopen_sensor_sim import SimBus, SimError
 
 
-def test_two_sensors_driven_from_the_test(sensor_bus, sensor_interface):
+def test_two_sensors_driven_from_the_test(sensor_bus, sensor_can_args):
     sim = sensor_bus(["inx360d@0x30", "jd2xxx@0x31"])
     net = canopen.Network()
-    net.connect(interface="socketcan", channel=sensor_interface)
+    net.connect(**sensor_can_args)
     try:
         inx = net.add_node(0x30)
         jd = net.add_node(0x31)
@@ -37,10 +39,10 @@ def test_two_sensors_driven_from_the_test(sensor_bus, sensor_interface):
         net.disconnect()
 
 
-def test_restart_keeps_the_stored_set(sensor_bus, sensor_interface):
+def test_restart_keeps_the_stored_set(sensor_bus, sensor_can_args):
     sim = sensor_bus(["inx360d@0x30"])
     net = canopen.Network()
-    net.connect(interface="socketcan", channel=sensor_interface)
+    net.connect(**sensor_can_args)
     try:
         node = net.add_node(0x30)
         node.sdo.download(0x1017, 0, (250).to_bytes(2, "little"))  # P+F: stored at once

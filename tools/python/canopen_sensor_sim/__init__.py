@@ -1,7 +1,8 @@
 """Simulated CANopen sensors for machine tests.
 
 A ``SimBus`` runs one ``canopen-sensor`` process with any number of nodes
-(``--node PRODUCT[@NODEID][/IFACE]``) on a SocketCAN interface, each with its
+(``--node PRODUCT[@NODEID][/IFACE]``) on a SocketCAN interface (or on
+python-can's udp_multicast bus: ``default_interface()``), each with its
 own stored parameters in a directory, and talks to it through its control
 socket (``--control unix:PATH``): the same line language as its standard
 input, one command a line, answered ``ok ...`` or ``error: <cause>``.
@@ -27,7 +28,12 @@ import subprocess
 import tempfile
 import time
 
-__all__ = ["ControlClient", "SimBus", "SimError", "VERBS", "find_program"]
+__all__ = ["ControlClient", "SimBus", "SimError", "UDP_LOOPBACK", "VERBS", "default_interface",
+           "find_program", "python_can_args"]
+
+# python-can's udp_multicast bus on this machine's loopback: its IPv4
+# default group and port, joined on lo (the program's interface form).
+UDP_LOOPBACK = "udp_multicast:239.74.163.2:43113%lo"
 
 # The line language's verbs, in the program's order (its table,
 # boards/linux/cmd.c): each is a SimBus method of the same name.
@@ -53,6 +59,32 @@ def find_program():
         if candidate.exists():
             return str(candidate)
     raise SimError("canopen-sensor not found: set CANOPEN_SENSOR or build the repository (tools/setup)")
+
+
+def default_interface():
+    """vcan0 where it exists, else python-can's udp_multicast bus on the
+    loopback (UDP_LOOPBACK): no CAN in the kernel needed. A master that
+    joins that bus with python-can sends on the host's default interface
+    unless it runs in a network namespace with the loopback alone
+    (tools/netns-run); see python_can_args."""
+    # if_nameindex: this network namespace's interfaces (sysfs may show another's)
+    names = [name for _, name in socket.if_nameindex()]
+    return "vcan0" if "vcan0" in names else UDP_LOOPBACK
+
+
+def python_can_args(interface):
+    """The keyword arguments of ``can.Bus`` (and ``canopen.Network.connect``)
+    for a master on the program's interface: SocketCAN for a CAN
+    interface name, ``udp_multicast`` with the group and port for the
+    program's ``udp_multicast:GROUP[:PORT][%IFNAME]`` form (python-can has
+    no interface option: it joins and sends where the routing table says,
+    which is why the tests run in tools/netns-run)."""
+    prefix = "udp_multicast:"
+    if not interface.startswith(prefix):
+        return {"interface": "socketcan", "channel": interface}
+    spec = interface[len(prefix):].split("%", 1)[0]
+    group, _, port = spec.partition(":")
+    return {"interface": "udp_multicast", "channel": group, "port": int(port or 43113)}
 
 
 def _selector(node):
