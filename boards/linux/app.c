@@ -108,6 +108,34 @@ void app_start(app_t *a, uint32_t t)
     }
 }
 
+void app_udp_receive(app_t *a, unsigned reader, uint32_t t)
+{
+    lp_port_t *r = &a->ports[reader];
+    /* Two batches at most, then the timers again (as a CAN port's 64). */
+    for (int b = 0; b < 2; b++) {
+        unsigned n = lp_udp_batch(r, t);
+        if (n == 0u) {
+            break;
+        }
+        /* Frame by frame, each to every node on the group in turn: the
+         * order of the bus, as SocketCAN delivers it to each socket. */
+        for (unsigned k = 0; k < n; k++) {
+            for (unsigned i = 0; i < a->nnodes; i++) {
+                co_frame_t f;
+                if (a->ports[i].udp && a->ports[i].udp_reader == reader &&
+                    lp_udp_take(&a->ports[i], r, k, &f) == 1) {
+                    co_node_receive(a->nodes[i], &f, t);
+                }
+            }
+        }
+    }
+    for (unsigned i = 0; i < a->nnodes; i++) {
+        if (a->ports[i].udp && a->ports[i].udp_reader == reader) {
+            app_sync_can_state(a, i);
+        }
+    }
+}
+
 uint32_t app_poll(app_t *a, uint32_t t, uint32_t wait, bool *backlog)
 {
     for (unsigned i = 0; i < a->nnodes; i++) {

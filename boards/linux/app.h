@@ -89,6 +89,10 @@ void app_start(app_t *a, uint32_t t);
 /* One pass over the nodes at time t: ports, CAN state, timers, LEDs, the
  * transmit queue. Returns the delay until one of them needs the next
  * pass (at most wait); *backlog tells that frames wait for the kernel. */
+/* Datagrams on the udp_multicast socket of port reader (lp_udp_share), each
+ * given to every node that shares it (can_port.h, lp_udp_take). */
+void app_udp_receive(app_t *a, unsigned reader, uint32_t t);
+
 uint32_t app_poll(app_t *a, uint32_t t, uint32_t wait, bool *backlog);
 
 /* Node `node`'s NMT state as a word ("operational", ...). */

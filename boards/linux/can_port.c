@@ -667,9 +667,10 @@ static unsigned udp_read_batch(lp_port_t *p, uint32_t now)
         struct msghdr *mh = &mm[k].msg_hdr;
         rx_overflow(p, mh);
         p->rxlen[k] = 0;
-        if (mh->msg_namelen == sizeof(from[k]) && from[k].sin_port == p->self.sin_port &&
-            from[k].sin_addr.s_addr == p->self.sin_addr.s_addr) {
-            continue; /* the node's own frame: a node does not hear itself */
+        if (mh->msg_namelen == sizeof(from[k])) {
+            p->rxfrom[k] = from[k];
+        } else {
+            memset(&p->rxfrom[k], 0, sizeof(p->rxfrom[k]));
         }
         if ((mh->msg_flags & MSG_TRUNC) != 0 ||
             lp_udp_decode(dg[k], mm[k].msg_len, p->zone, &p->rxb[k]) != LP_UDP_FRAME) {
@@ -740,6 +741,60 @@ static unsigned read_batch(lp_port_t *p, uint32_t now)
     return (unsigned)n;
 }
 
+void lp_udp_share(lp_port_t *ports, unsigned n)
+{
+    for (unsigned i = 0; i < n; i++) {
+        lp_port_t *p = &ports[i];
+        if (!p->udp) {
+            continue;
+        }
+        p->udp_reader = i;
+        for (unsigned j = 0; j < i; j++) {
+            const lp_port_t *q = &ports[j];
+            if (q->udp && q->udp_reader == j && strcmp(q->iface, p->iface) == 0) {
+                p->udp_reader = j; /* the same form: the same group, port and interface */
+                close(p->fd);
+                p->fd = -1;
+                break;
+            }
+        }
+    }
+}
+
+unsigned lp_udp_batch(lp_port_t *reader, uint32_t now)
+{
+    reader->now = now;
+    reader->rxi = 0;
+    reader->rxn = read_batch(reader, now);
+    return reader->rxn;
+}
+
+int lp_udp_take(lp_port_t *m, const lp_port_t *reader, unsigned k, co_frame_t *f)
+{
+    if (k >= reader->rxn || reader->rxlen[k] == 0u) {
+        return 0; /* no classic frame (udp_read_batch) */
+    }
+    if (reader->rxfrom[k].sin_port == m->self.sin_port &&
+        reader->rxfrom[k].sin_addr.s_addr == m->self.sin_addr.s_addr) {
+        return 0; /* m's own frame: a node does not hear itself */
+    }
+    const struct can_frame *cf = &reader->rxb[k];
+    if (lp_can_state(m) == CO_CAN_BUSOFF) {
+        return 0; /* a controller off the bus receives nothing */
+    }
+    if (!filter_passes(m, cf)) {
+        m->rx_filtered++;
+        return 0; /* not m's (the kernel's filter does this on SocketCAN) */
+    }
+    m->rx_frames++;
+    memset(f, 0, sizeof(*f));
+    f->id = (uint16_t)(cf->can_id & CAN_SFF_MASK);
+    f->rtr = (cf->can_id & CAN_RTR_FLAG) != 0u;
+    f->dlc = cf->len;
+    memcpy(f->data, cf->data, cf->len);
+    return 1;
+}
+
 int lp_read(lp_port_t *p, co_frame_t *f, uint32_t now)
 {
     p->now = now;
@@ -749,6 +804,10 @@ int lp_read(lp_port_t *p, co_frame_t *f, uint32_t now)
         if (p->rxn == 0u) {
             return 0;
         }
+    }
+    if (p->udp) {
+        unsigned k = p->rxi++;
+        return lp_udp_take(p, p, k, f) == 1 ? 1 : 2;
     }
     const struct can_frame *cf = &p->rxb[p->rxi];
     bool classic = p->rxlen[p->rxi] == sizeof(*cf);
@@ -765,10 +824,6 @@ int lp_read(lp_port_t *p, co_frame_t *f, uint32_t now)
     }
     if ((cf->can_id & CAN_EFF_FLAG) != 0u || cf->len > 8u) {
         return 2; /* 29-bit identifiers are not CANopen: ignored */
-    }
-    if (p->udp && !filter_passes(p, cf)) {
-        p->rx_filtered++;
-        return 2; /* not the node's (the kernel's filter does this on SocketCAN) */
     }
     p->rx_frames++;
     memset(f, 0, sizeof(*f));

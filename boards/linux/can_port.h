@@ -75,12 +75,18 @@ typedef struct lp_port {
     bool udp;
     int txfd;
     struct sockaddr_in self;
-    void *zone;                /* the decoder's (udp_bus.h) */
-    unsigned long rx_ignored;  /* datagrams no classic frame (malformed, FD, 29-bit) */
-    unsigned long rx_filtered; /* frames the node does not consume (udp) */
-    unsigned node;             /* index, for log lines */
-    uint16_t kbps;             /* the node's bit rate (co_port_can_bitrate; vcan has none) */
-    bool kbps_set;             /* kbps was given (at the node's start) */
+    /* The port whose socket receives for every node of the process on the
+     * same group (lp_udp_share): its own index, or the first such port's;
+     * the others' fd is closed. One socket reads each datagram once, where
+     * a socket a node made 127 nodes read 127 copies (a core's worth). */
+    unsigned udp_reader;
+    struct sockaddr_in rxfrom[LP_RXB]; /* the reader's batch: each sender */
+    void *zone;                        /* the decoder's (udp_bus.h) */
+    unsigned long rx_ignored;          /* datagrams no classic frame (malformed, FD, 29-bit) */
+    unsigned long rx_filtered;         /* frames the node does not consume (udp) */
+    unsigned node;                     /* index, for log lines */
+    uint16_t kbps; /* the node's bit rate (co_port_can_bitrate; vcan has none) */
+    bool kbps_set; /* kbps was given (at the node's start) */
     lp_nvm_t *nvm;
     /* The instance's program download (prog.h; --program-download), NULL:
      * off; set after lp_open. While its state is not "started" the port
@@ -169,6 +175,28 @@ void lp_sim_can(lp_port_t *p, co_can_state_t s, uint32_t now, uint32_t hold_us,
  * recovery of 128 x 11 bits at the node's bit rate (125 kbit/s when its
  * code means none), a bus-off's hold given in milliseconds. */
 void lp_sim_can_command(lp_port_t *p, co_can_state_t s, uint32_t now, uint32_t hold_ms);
+
+/*
+ * udp_multicast: the n ports (an array, all open) that are on one group,
+ * port and interface share the first one's receiving socket (udp_reader);
+ * the others' are closed. Call once, after every port is open.
+ */
+void lp_udp_share(lp_port_t *ports, unsigned n);
+
+/*
+ * udp_multicast, the reader's side: read the next batch of datagrams into
+ * reader (the port whose udp_reader is its own index). Returns how many
+ * (0: none); each is then offered to every member with lp_udp_take.
+ */
+unsigned lp_udp_batch(lp_port_t *reader, uint32_t now);
+
+/*
+ * Datagram k of reader's batch for member m (a port that shares reader's
+ * socket, reader itself included): 1 with *f filled when it is a classic
+ * frame that m receives (not its own, m on the bus, on m's receive list),
+ * else 0.
+ */
+int lp_udp_take(lp_port_t *m, const lp_port_t *reader, unsigned k, co_frame_t *f);
 
 /* Log the dropped frames not logged yet, whatever the rate (at exit). */
 void lp_report_drops(lp_port_t *p);

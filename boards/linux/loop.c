@@ -284,6 +284,8 @@ static void handle_event(loop_t *l, uint32_t src, uint32_t t)
                 l->ctl.cl[k].events = want;
             }
         }
+    } else if (src < a->nnodes && a->ports[src].udp) {
+        app_udp_receive(a, src, t);
     } else if (src < a->nnodes) {
         co_frame_t f;
         /* At most 64 frames, then the timers again: a flooded bus must

@@ -261,6 +261,7 @@ int setup_run(app_t *a, loop_t *l, const options_t *o)
             return rc;
         }
     }
+    lp_udp_share(a->ports, a->nnodes); /* one receiving socket a udp_multicast group */
     for (unsigned k = 0; k < a->ninst && o->progdl; k++) {
         rc = open_inst_prog(a, k);
         if (rc != CLI_GO_ON) {

@@ -38,8 +38,9 @@ int lp_udp_parse(const char *iface, lp_udp_addr_t *a, char *err, unsigned errlen
         snprintf(a->ifname, sizeof(a->ifname), "%s", name);
     }
     if (buf[0] == '[') {
-        snprintf(err, errlen, "an IPv6 group: only IPv4 groups (224.0.0.0/4, python-can: "
-                              "channel='239.74.163.2') are supported");
+        snprintf(err, errlen,
+                 "an IPv6 group: only IPv4 groups (224.0.0.0/4, python-can: "
+                 "channel='239.74.163.2') are supported");
         return -1;
     }
     unsigned long port = LP_UDP_PORT;
@@ -58,8 +59,9 @@ int lp_udp_parse(const char *iface, lp_udp_addr_t *a, char *err, unsigned errlen
     a->group.sin_family = AF_INET;
     a->group.sin_port = htons((uint16_t)port);
     if (inet_pton(AF_INET, buf, &a->group.sin_addr) != 1) {
-        snprintf(err, errlen, "'%s' is not an IPv4 address (an IPv4 multicast group, e.g. "
-                              "239.74.163.2)",
+        snprintf(err, errlen,
+                 "'%s' is not an IPv4 address (an IPv4 multicast group, e.g. "
+                 "239.74.163.2)",
                  buf);
         return -1;
     }
@@ -232,7 +234,8 @@ void lp_udp_zone_free(void *zone)
 static bool key_is(const msgpack_object *k, const char *s)
 {
     size_t n = strlen(s);
-    return k->type == MSGPACK_OBJECT_STR && k->via.str.size == n && memcmp(k->via.str.ptr, s, n) == 0;
+    return k->type == MSGPACK_OBJECT_STR && k->via.str.size == n &&
+           memcmp(k->via.str.ptr, s, n) == 0;
 }
 
 /* A boolean entry: its value, false when it is no boolean (*ok cleared). */

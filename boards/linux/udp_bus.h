@@ -79,7 +79,7 @@ int lp_udp_open(const lp_udp_addr_t *a, int *rx, int *tx, struct sockaddr_in *se
 size_t lp_udp_encode(const co_frame_t *f, double ts, uint8_t *buf, size_t cap);
 
 typedef enum lp_udp_verdict {
-    LP_UDP_FRAME = 0, /* a classic CAN frame: *cf filled */
+    LP_UDP_FRAME = 0,   /* a classic CAN frame: *cf filled */
     LP_UDP_NOT_CLASSIC, /* a CAN FD, error or 29-bit frame: not CANopen's */
     LP_UDP_MALFORMED,   /* not a frame python-can would accept */
 } lp_udp_verdict_t;
