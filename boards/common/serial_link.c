@@ -366,8 +366,11 @@ static const struct {
  * that would need a clock and per-input state in the image (a master
  * scripts the same motion as a series of `set` lines); replay reads a
  * file, and the image has no file system; quit: the image runs until QEMU
- * ends (tools/emu, SIGTERM). */
-static const char *const absent[] = {"ramp", "sine", "noise", "replay", "quit"};
+ * ends (tools/emu, SIGTERM); unplug and heartbeat, the master-facing
+ * faults, are the Linux program's port's so far (the images' board code
+ * would carry them: not yet written). */
+static const char *const absent[] = {"ramp", "sine",   "noise",    "replay",
+                                     "quit", "unplug", "heartbeat"};
 
 const char *serial_link_verb(unsigned i)
 {

@@ -82,6 +82,20 @@ void app_sim_can(app_t *a, unsigned node, co_can_state_t s, uint32_t hold_ms, ui
     app_sync_can_state(a, node);
 }
 
+void app_unplug(app_t *a, unsigned node, bool on, uint32_t hold_ms, uint32_t now)
+{
+    if (on) {
+        lp_unplug(&a->ports[node], now, hold_ms);
+    } else {
+        lp_unplug_off(&a->ports[node]);
+    }
+}
+
+void app_heartbeat(app_t *a, unsigned node, bool on)
+{
+    lp_heartbeat(&a->ports[node], on);
+}
+
 void app_sample(app_t *a, uint32_t t)
 {
     for (unsigned k = 0; k < a->ninst; k++) {

@@ -76,6 +76,11 @@ uint32_t app_derived_serial(const char *product, const char *iface, uint8_t id);
 /* The node sees the CAN state its port shows (link, error frames, simulator). */
 void app_sync_can_state(app_t *a, unsigned node);
 
+/* `unplug` (on, for hold_ms; 0: until `unplug off`) and `unplug off` (on
+ * false) of a node's port; `heartbeat stop|start` (can_port.h). */
+void app_unplug(app_t *a, unsigned node, bool on, uint32_t hold_ms, uint32_t now);
+void app_heartbeat(app_t *a, unsigned node, bool on);
+
 /* The simulated controller of node `node` goes to state s (bus-off: the
  * bus stays unusable hold_ms, then 128 x 11 bits at the node's bit rate). */
 void app_sim_can(app_t *a, unsigned node, co_can_state_t s, uint32_t hold_ms, uint32_t now);

@@ -296,10 +296,51 @@ static void report_drops(lp_port_t *p, uint32_t now)
     }
 }
 
+void lp_unplug(lp_port_t *p, uint32_t now, uint32_t hold_ms)
+{
+    p->unplugged = true;
+    p->unplug_timed = hold_ms != 0u;
+    p->unplug_until = now +
+                      hold_ms * 1000u; /* hold_ms <= CMD_HOLD_MAX_S s: within half the clock */
+    drop_txq(p);
+    if (p->unplug_timed) {
+        lp_log("node %u: cable pulled for %u ms: no frame in or out, the error counters as they "
+               "were",
+               p->node, hold_ms);
+    } else {
+        lp_log("node %u: cable pulled until `unplug off`: no frame in or out, the error counters "
+               "as they were",
+               p->node);
+    }
+}
+
+void lp_unplug_off(lp_port_t *p)
+{
+    if (p->unplugged) {
+        lp_log("node %u: cable plugged in again (%lu frames lost to it)", p->node, p->tx_unplugged);
+    }
+    p->unplugged = false;
+    p->unplug_timed = false;
+}
+
+void lp_heartbeat(lp_port_t *p, bool on)
+{
+    p->hb_stopped = !on;
+    lp_log("node %u: heartbeat %s", p->node,
+           on ? "sent again" : "stopped (and guarding answers): boot-up only");
+}
+
 uint32_t lp_poll(lp_port_t *p, uint32_t now)
 {
     p->now = now;
     uint32_t next = CO_NEVER;
+    if (p->unplugged && p->unplug_timed) {
+        if (!co_time_before(now, p->unplug_until)) {
+            lp_unplug_off(p);
+        } else {
+            next = co_time_until(now, p->unplug_until);
+        }
+    }
     p->link_blip = false;
     if (p->link != LP_LINK_UP) {
         if (!co_time_before(now, p->link_check_at)) {
@@ -575,6 +616,14 @@ bool co_port_can_send(void *port, const co_frame_t *frame)
         p->tx_off++; /* a controller off the bus sends nothing */
         return false;
     }
+    if (p->unplugged) {
+        p->tx_unplugged++;
+        return true; /* onto a cable that leads nowhere */
+    }
+    if (p->hb_stopped && frame->id >= 0x701u && frame->id <= 0x77Fu && frame->dlc == 1u &&
+        frame->data[0] != 0u) {
+        return true; /* `heartbeat stop`: the boot-up (0) alone still goes */
+    }
     if (p->progdl != NULL && co_progdl_state(p->progdl) != CO_PROGDL_STARTED &&
         !lp_halted_may_send(frame->id)) {
         return true; /* the program is halted: what it would send is not made */
@@ -779,8 +828,8 @@ int lp_udp_take(lp_port_t *m, const lp_port_t *reader, unsigned k, co_frame_t *f
         return 0; /* m's own frame: a node does not hear itself */
     }
     const struct can_frame *cf = &reader->rxb[k];
-    if (lp_can_state(m) == CO_CAN_BUSOFF) {
-        return 0; /* a controller off the bus receives nothing */
+    if (lp_can_state(m) == CO_CAN_BUSOFF || m->unplugged) {
+        return 0; /* a controller off the bus, or its cable pulled: nothing */
     }
     if (!filter_passes(m, cf)) {
         m->rx_filtered++;
@@ -819,8 +868,8 @@ int lp_read(lp_port_t *p, co_frame_t *f, uint32_t now)
         error_frame(p, cf);
         return 2;
     }
-    if (lp_can_state(p) == CO_CAN_BUSOFF) {
-        return 2; /* a controller off the bus receives nothing */
+    if (lp_can_state(p) == CO_CAN_BUSOFF || p->unplugged) {
+        return 2; /* a controller off the bus, or its cable pulled: nothing */
     }
     if ((cf->can_id & CAN_EFF_FLAG) != 0u || cf->len > 8u) {
         return 2; /* 29-bit identifiers are not CANopen: ignored */

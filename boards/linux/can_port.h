@@ -103,6 +103,16 @@ typedef struct lp_port {
     uint32_t link_check_at; /* next look while not up */
     bool link_blip;         /* the link went down and came back before it was
                              * looked at: bus-off until the next lp_poll */
+    /* Faults a master must survive (the line language's `unplug`,
+     * `heartbeat`): the cable pulled, no frame in or out and the error
+     * counters unchanged, until unplug_until (unplug_timed) or `unplug
+     * off`; the node's heartbeats (and guarding answers: the NMT error
+     * control frames other than its boot-up) not sent. */
+    bool unplugged;
+    bool unplug_timed;
+    uint32_t unplug_until;
+    unsigned long tx_unplugged; /* frames lost to the pulled cable */
+    bool hb_stopped;
     /* CAN controller */
     int ctrl_state;          /* co_can_state_t from the kernel's error frames */
     int sim_state;           /* co_can_state_t of the simulated controller */
@@ -197,6 +207,14 @@ unsigned lp_udp_batch(lp_port_t *reader, uint32_t now);
  * else 0.
  */
 int lp_udp_take(lp_port_t *m, const lp_port_t *reader, unsigned k, co_frame_t *f);
+
+/* `unplug`: the cable pulled for hold_ms (0: until lp_unplug_off). */
+void lp_unplug(lp_port_t *p, uint32_t now, uint32_t hold_ms);
+void lp_unplug_off(lp_port_t *p);
+
+/* `heartbeat stop|start`: the node's NMT error-control frames other than
+ * its boot-up (heartbeats, guarding answers) not sent / sent again. */
+void lp_heartbeat(lp_port_t *p, bool on);
 
 /* Log the dropped frames not logged yet, whatever the rate (at exit). */
 void lp_report_drops(lp_port_t *p);

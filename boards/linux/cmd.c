@@ -431,6 +431,66 @@ static void apply_can(cmd_ctx_t *c, unsigned k, unsigned node, const cmd_args_t 
     app_sim_can(c->a, node, (co_can_state_t)args->can_state, args->hold_ms, c->now);
 }
 
+/* `unplug [SECONDS]`, `unplug off`. */
+static bool parse_unplug(cmd_ctx_t *c, unsigned k, char **save, cmd_args_t *args, char *err,
+                         size_t errlen)
+{
+    (void)c;
+    (void)k;
+    char *arg = token(save);
+    double hold = 0.0;
+    args->on = true;
+    if (arg != NULL && strcmp(arg, "off") == 0) {
+        args->on = false;
+    } else if (arg != NULL) {
+        char *end;
+        hold = strtod(arg, &end);
+        if (end == arg || *end != '\0' || !isfinite(hold) || hold <= 0.0 ||
+            hold > (double)CMD_HOLD_MAX_S) {
+            snprintf(err, errlen, "'%s': not a number of seconds within 0..%u (more than 0)", arg,
+                     CMD_HOLD_MAX_S);
+            return false;
+        }
+    }
+    if (token(save) != NULL) {
+        snprintf(err, errlen, "usage: unplug [SECONDS] | unplug off");
+        return false;
+    }
+    args->hold_ms = (uint32_t)lround(hold * 1000.0);
+    if (args->on && arg != NULL && args->hold_ms == 0u) {
+        args->hold_ms = 1u; /* more than 0 s, less than half a millisecond */
+    }
+    return true;
+}
+
+static void apply_unplug(cmd_ctx_t *c, unsigned k, unsigned node, const cmd_args_t *args)
+{
+    (void)k;
+    app_unplug(c->a, node, args->on, args->hold_ms, c->now);
+}
+
+/* `heartbeat stop|start`. */
+static bool parse_heartbeat(cmd_ctx_t *c, unsigned k, char **save, cmd_args_t *args, char *err,
+                            size_t errlen)
+{
+    (void)c;
+    (void)k;
+    char *what = token(save);
+    if (what == NULL || (strcmp(what, "stop") != 0 && strcmp(what, "start") != 0) ||
+        token(save) != NULL) {
+        snprintf(err, errlen, "usage: heartbeat stop | heartbeat start");
+        return false;
+    }
+    args->on = strcmp(what, "start") == 0;
+    return true;
+}
+
+static void apply_heartbeat(cmd_ctx_t *c, unsigned k, unsigned node, const cmd_args_t *args)
+{
+    (void)k;
+    app_heartbeat(c->a, node, args->on);
+}
+
 /* Nothing after the verb (get, quit). */
 static bool parse_nothing(cmd_ctx_t *c, unsigned k, char **save, cmd_args_t *args, char *err,
                           size_t errlen, const char *verb)
@@ -488,6 +548,14 @@ const cmd_verb_t cmd_verbs[] = {
      "the nodes' simulated CAN controller: bus-off sends nothing; the bus stays unusable "
      "SECONDS (default 0, at most 1800), then it is back after 128 x 11 bits at its bit rate",
      CMD_NODES, parse_can, apply_can},
+    {"unplug", "[SECONDS] | off",
+     "the nodes' cable pulled: no frame in or out, the error counters unchanged, for SECONDS "
+     "(at most 1800) or until `unplug off`",
+     CMD_NODES, parse_unplug, apply_unplug},
+    {"heartbeat", "stop | start",
+     "the nodes' heartbeats (and guarding answers) not sent / sent again; the boot-up still "
+     "goes",
+     CMD_NODES, parse_heartbeat, apply_heartbeat},
     {"get", "", "one node's true inputs and NMT state: ok x=1.000 ... nmt=operational", CMD_QUERY,
      parse_get, NULL},
     {"quit", "", "stop the program", CMD_PROGRAM, parse_quit, apply_quit},
@@ -641,7 +709,14 @@ static void answer_get(const app_t *a, unsigned node, char *reply, size_t len)
                                v < 0 ? "-" : "", m / 1000u, m % 1000u);
     }
     if (at < len) {
-        snprintf(reply + at, len - at, " nmt=%s", app_nmt_name(a, node));
+        at += (size_t)snprintf(reply + at, len - at, " nmt=%s", app_nmt_name(a, node));
+    }
+    /* the master-facing faults that are on */
+    if (at < len && a->ports[node].unplugged) {
+        at += (size_t)snprintf(reply + at, len - at, " unplug=on");
+    }
+    if (at < len && a->ports[node].hb_stopped) {
+        snprintf(reply + at, len - at, " heartbeat=stopped");
     }
 }
 

@@ -231,3 +231,65 @@ def test_a_node_does_not_hear_itself(master, frames, sim):
     time.sleep(1.0)
     emcy = [m for m in frames if m.arbitration_id == 0x80 + 0x21]
     assert emcy == [], "the node heard its own heartbeat"
+
+
+def heartbeats(frames, nid, since):
+    return [m for m in frames if m.arbitration_id == 0x700 + nid and m.timestamp >= since
+            and not m.is_remote_frame]
+
+
+def test_unplug_as_the_master_sees_it(master, frames, sim):
+    """`unplug SECONDS` on one node: its heartbeats stop and its SDO goes
+    unanswered (a timeout, no abort; a write sent meanwhile never arrives),
+    no bus-off and no boot-up after; the
+    other node of the process goes on throughout; `unplug` until `unplug
+    off` the same."""
+    bus = sim(["gsh-a@0x30", "inx360d@0x31"])
+    nodes = {n: master.add_node(n, canopen.ObjectDictionary()) for n in (0x30, 0x31)}
+    for n in nodes.values():
+        n.sdo.download(0x1017, 0, (50).to_bytes(2, "little"))
+        n.sdo.RESPONSE_TIMEOUT = 0.3
+    for form, undo in (("unplug 1.5", None), ("unplug", "unplug off")):
+        time.sleep(0.2)
+        bus.command(form, 0x30)
+        t0 = time.time()
+        time.sleep(0.1)  # what was on its way
+        with pytest.raises(canopen.SdoCommunicationError):
+            nodes[0x30].sdo.upload(0x1000, 0)
+        with pytest.raises(canopen.SdoCommunicationError):  # never heard: the heartbeat stays
+            nodes[0x30].sdo.download(0x1017, 0, (0).to_bytes(2, "little"))
+        time.sleep(0.6)
+        t1 = time.time()
+        assert heartbeats(frames, 0x30, t0 + 0.1) == []
+        assert len(heartbeats(frames, 0x31, t0)) >= 2  # the other node: untouched
+        assert "unplug=on" in bus.command("get", 0x30)
+        if undo:
+            bus.command(undo, 0x30)
+        else:
+            time.sleep(max(0.0, t0 + 1.6 - time.time()))
+        assert wait_for(frames, lambda m: m.arbitration_id == 0x730 and m.timestamp > t1
+                        and m.data[:1] != b"\0", 2.0), "no heartbeat after the cable is back"
+        assert nodes[0x30].sdo.upload(0x1000, 0)
+        assert [m for m in frames if m.arbitration_id == 0x730 and m.data[:1] == b"\0"
+                and m.timestamp > t0] == []  # no boot-up: the node ran on
+        assert [m for m in frames if m.arbitration_id == 0x80 + 0x30 and m.timestamp > t0] == []
+
+
+def test_heartbeat_stop_and_start(master, frames, sim):
+    """`heartbeat stop`: the node's heartbeats end while its SDO answers;
+    the other node's go on; `heartbeat start`: back."""
+    bus = sim(["gsh-a@0x30", "inx360d@0x31"])
+    nodes = {n: master.add_node(n, canopen.ObjectDictionary()) for n in (0x30, 0x31)}
+    for n in nodes.values():
+        n.sdo.download(0x1017, 0, (50).to_bytes(2, "little"))
+    bus.heartbeat(0x30, False)
+    t0 = time.time()
+    time.sleep(0.6)
+    assert nodes[0x30].sdo.upload(0x1000, 0)
+    assert heartbeats(frames, 0x30, t0 + 0.1) == []
+    assert len(heartbeats(frames, 0x31, t0)) >= 2
+    assert "heartbeat=stopped" in bus.command("get", 0x30)
+    bus.heartbeat(0x30, True)
+    t1 = time.time()
+    assert wait_for(frames, lambda m: m.arbitration_id == 0x730 and m.timestamp > t1, 1.0)
+    assert "heartbeat" not in bus.command("get", 0x30)

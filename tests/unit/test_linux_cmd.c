@@ -111,13 +111,13 @@ static void test_verb_table(void)
     make((const product_t *const[]){&dst_x730_xy30, NULL});
     char names[200];
     cmd_verb_names(names, sizeof(names));
-    CHECK(is(names, "set, ramp, sine, noise, replay, fault, can, get, quit"));
+    CHECK(is(names, "set, ramp, sine, noise, replay, fault, can, unplug, heartbeat, get, quit"));
     CHECK(is(ask("tilt 5"), "error: unknown command 'tilt' (set, ramp, sine, noise, replay, "
-                            "fault, can, get, quit)"));
-    CHECK(is(ask("0x20"), "error: no command (set, ramp, sine, noise, replay, fault, can, get, "
-                          "quit)"));
+                            "fault, can, unplug, heartbeat, get, quit)"));
+    CHECK(is(ask("0x20"), "error: no command (set, ramp, sine, noise, replay, fault, can, unplug, "
+                          "heartbeat, get, quit)"));
     CHECK(is(ask("0x20 # note"), "error: no command (set, ramp, sine, noise, replay, fault, "
-                                 "can, get, quit)"));
+                                 "can, unplug, heartbeat, get, quit)"));
     /* Each verb is served: a line of it gets its own answer, never
      * "unknown command". */
     for (unsigned v = 0; v < cmd_nverbs; v++) {
@@ -175,6 +175,63 @@ static void test_can_on_selected_nodes(void)
     CHECK(is(ask("can bus-off 1 2"), ask("can")));
     CHECK(is(ask("can passive 3"), ask("can")));
     CHECK(is(ask("can bus-off 1800"), "ok"));
+}
+
+/* `unplug` and `heartbeat` on the selected nodes' ports: a pulled cable
+ * takes every frame and sends none, its CAN state unchanged, until its
+ * time or `unplug off`; a stopped heartbeat keeps the boot-up; `get`
+ * names what is on; bad lines change nothing. */
+static void test_unplug_and_heartbeat(void)
+{
+    make((const product_t *const[]){&jd2xxx, &gsh_a_redundant, NULL});
+    co_frame_t hb = {.id = 0x721, .dlc = 1, .data = {0x7F}};
+    co_frame_t boot = {.id = 0x721, .dlc = 1, .data = {0x00}};
+    co_frame_t sdo = {.id = 0x5A1, .dlc = 8, .data = {0x43}};
+    CHECK(is(ask("@1 unplug 2.5"), "ok"));
+    CHECK(app.ports[1].unplugged && !app.ports[0].unplugged && !app.ports[2].unplugged);
+    CHECK_EQ(lp_can_state(&app.ports[1]), CO_CAN_ACTIVE); /* no bus-off: counters unchanged */
+    unsigned before = app.ports[1].txn;
+    CHECK(co_port_can_send(&app.ports[1], &sdo)); /* taken, and lost */
+    CHECK_EQ(app.ports[1].txn, before);
+    CHECK_EQ(app.ports[1].tx_unplugged, 1u);
+    CHECK(strstr(ask("@1 get"), " unplug=on") != NULL);
+    CHECK(strstr(ask("@0 get"), "unplug") == NULL);
+    (void)lp_poll(&app.ports[1], 1000u + 2499999u);
+    CHECK(app.ports[1].unplugged);
+    (void)lp_poll(&app.ports[1], 1000u + 2500000u);
+    CHECK(!app.ports[1].unplugged); /* back by itself */
+    CHECK(is(ask("@all unplug"), "ok"));
+    (void)lp_poll(&app.ports[0], 1000u + 1800000000u);
+    CHECK(app.ports[0].unplugged && app.ports[2].unplugged); /* until `unplug off` */
+    CHECK(is(ask("@0 unplug off"), "ok"));
+    CHECK(!app.ports[0].unplugged && app.ports[2].unplugged);
+    CHECK(is(ask("@all unplug off"), "ok"));
+    CHECK(is(ask("unplug 0"), "error: '0': not a number of seconds within 0..1800 (more than 0)"));
+    CHECK(starts(ask("unplug 1800.5"), "error: '1800.5'"));
+    CHECK(starts(ask("unplug -1"), "error: '-1'"));
+    CHECK(is(ask("unplug 1 2"), "error: usage: unplug [SECONDS] | unplug off"));
+    CHECK(strstr(ask("@all unplug x"), "'x': not a number of seconds") != NULL);
+    CHECK(!app.ports[0].unplugged && !app.ports[1].unplugged && !app.ports[2].unplugged);
+
+    CHECK(is(ask("heartbeat stop"), "ok")); /* the first instance: the JD */
+    CHECK(app.ports[0].hb_stopped && !app.ports[1].hb_stopped);
+    before = app.ports[0].txn;
+    CHECK(co_port_can_send(&app.ports[0], &hb));
+    CHECK_EQ(app.ports[0].txn, before); /* not sent */
+    CHECK(co_port_can_send(&app.ports[0], &boot));
+    CHECK_EQ(app.ports[0].txn, before + 1u); /* the boot-up goes */
+    CHECK(co_port_can_send(&app.ports[0], &sdo));
+    CHECK_EQ(app.ports[0].txn, before + 2u);
+    CHECK(strstr(ask("get"), " heartbeat=stopped") != NULL);
+    CHECK(is(ask("heartbeat start"), "ok"));
+    CHECK(!app.ports[0].hb_stopped);
+    CHECK(co_port_can_send(&app.ports[0], &hb));
+    CHECK_EQ(app.ports[0].txn, before + 3u);
+    CHECK(strstr(ask("get"), "heartbeat") == NULL);
+    CHECK(is(ask("heartbeat"), "error: usage: heartbeat stop | heartbeat start"));
+    CHECK(is(ask("heartbeat pause"), ask("heartbeat")));
+    CHECK(is(ask("heartbeat stop now"), ask("heartbeat")));
+    CHECK(!app.ports[0].hb_stopped);
 }
 
 static void test_selectors_all_or_none(void)
@@ -475,6 +532,7 @@ int main(void)
     RUN(test_set_fault_get);
     RUN(test_verb_table);
     RUN(test_can_on_selected_nodes);
+    RUN(test_unplug_and_heartbeat);
     RUN(test_selectors_all_or_none);
     RUN(test_line_assembly);
     RUN(test_serial_line_verbs);

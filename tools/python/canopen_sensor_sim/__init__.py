@@ -38,7 +38,8 @@ UDP_LOOPBACK = "udp_multicast:239.74.163.2:43113%lo"
 # The line language's verbs, in the program's order (its table,
 # boards/linux/cmd.c): each is a SimBus method of the same name.
 # tests/integration/test_cli.py checks this list against the program's.
-VERBS = ("set", "ramp", "sine", "noise", "replay", "fault", "can", "get", "quit")
+VERBS = ("set", "ramp", "sine", "noise", "replay", "fault", "can", "unplug", "heartbeat", "get",
+         "quit")
 
 
 class SimError(RuntimeError):
@@ -325,6 +326,15 @@ class SimBus:
         or ``active``; node "@all" for every node."""
         hold = "" if seconds is None else f" {seconds}"
         self.command(f"can {state}{hold}", node)
+
+    def unplug(self, node, seconds=None, off=False):
+        """The node's cable pulled: no frame in or out, error counters as
+        they were, for ``seconds`` or until ``unplug(node, off=True)``."""
+        self.command("unplug off" if off else f"unplug {seconds}" if seconds else "unplug", node)
+
+    def heartbeat(self, node, on):
+        """The node's heartbeats stopped (on False) or sent again."""
+        self.command(f"heartbeat {'start' if on else 'stop'}", node)
 
     def quit(self):
         """Stop the program by its own command (stop() signals it instead);
