@@ -68,23 +68,7 @@ typedef struct lp_port {
              * receives (frames go out through an lp_tx_t); on a
              * udp_multicast bus the group's receiving socket */
     const char *iface;
-    /* A udp_multicast bus (udp_bus.h) instead of SocketCAN: the node
-     * sends through its own socket txfd, whose address self tells its own
-     * datagrams from the others' (a node does not hear itself, as on
-     * SocketCAN); the receive filter is kept here, not in the kernel. */
-    bool udp;
-    int txfd;
-    struct sockaddr_in self;
-    /* The port whose socket receives for every node of the process on the
-     * same group (lp_udp_share): its own index, or the first such port's;
-     * the others' fd is closed. One socket reads each datagram once, where
-     * a socket a node made 127 nodes read 127 copies (a core's worth). */
-    unsigned udp_reader;
-    struct sockaddr_in rxfrom[LP_RXB]; /* the reader's batch: each sender */
-    void *zone;                        /* the decoder's (udp_bus.h) */
-    unsigned long rx_ignored;          /* datagrams no classic frame (malformed, FD, 29-bit) */
-    unsigned long rx_filtered;         /* frames the node does not consume (udp) */
-    unsigned node;                     /* index, for log lines */
+    unsigned node; /* index, for log lines */
     uint16_t kbps; /* the node's bit rate (co_port_can_bitrate; vcan has none) */
     bool kbps_set; /* kbps was given (at the node's start) */
     lp_nvm_t *nvm;
@@ -103,16 +87,6 @@ typedef struct lp_port {
     uint32_t link_check_at; /* next look while not up */
     bool link_blip;         /* the link went down and came back before it was
                              * looked at: bus-off until the next lp_poll */
-    /* Faults a master must survive (the line language's `unplug`,
-     * `heartbeat`): the cable pulled, no frame in or out and the error
-     * counters unchanged, until unplug_until (unplug_timed) or `unplug
-     * off`; the node's heartbeats (and guarding answers: the NMT error
-     * control frames other than its boot-up) not sent. */
-    bool unplugged;
-    bool unplug_timed;
-    uint32_t unplug_until;
-    unsigned long tx_unplugged; /* frames lost to the pulled cable */
-    bool hb_stopped;
     /* CAN controller */
     int ctrl_state;          /* co_can_state_t from the kernel's error frames */
     int sim_state;           /* co_can_state_t of the simulated controller */
@@ -136,6 +110,33 @@ typedef struct lp_port {
     bool filt_set;              /* filt[] is what the kernel has */
     const co_node_t *filt_node; /* the node filtered for (lp_filter), or NULL */
     unsigned long filt_changes; /* times the filter was (re)installed */
+    /* A udp_multicast bus (udp_bus.h) instead of SocketCAN (udp): the
+     * node sends through its own socket txfd, whose address self tells
+     * its own datagrams from the others' (a node does not hear itself, as
+     * on SocketCAN); the receive filter is kept here, not in the kernel.
+     * udp_reader: the port whose socket receives for every node of the
+     * process on the same group (lp_udp_share): its own index, or the
+     * first such port's; the others' fd is closed. One socket reads each
+     * datagram once, where a socket a node made 127 nodes read 127 copies
+     * (a core's worth). */
+    struct sockaddr_in self;
+    struct sockaddr_in rxfrom[LP_RXB]; /* the reader's batch: each sender */
+    void *zone;                        /* the decoder's (udp_bus.h) */
+    unsigned long rx_ignored;          /* datagrams no classic frame (malformed, FD, 29-bit) */
+    unsigned long rx_filtered;         /* frames the node does not consume (udp) */
+    int txfd;
+    unsigned udp_reader;
+    /* Faults a master must survive (the line language's `unplug`,
+     * `heartbeat`): the cable pulled, no frame in or out and the error
+     * counters unchanged, until unplug_until (unplug_timed) or `unplug
+     * off`; the node's heartbeats (and guarding answers: the NMT error
+     * control frames other than its boot-up) not sent (hb_stopped). */
+    unsigned long tx_unplugged; /* frames lost to the pulled cable */
+    uint32_t unplug_until;
+    bool udp;
+    bool unplugged;
+    bool unplug_timed;
+    bool hb_stopped;
 } lp_port_t;
 
 /* Whether a node whose program is halted (stopped, or no valid program:
